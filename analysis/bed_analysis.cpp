@@ -1,0 +1,172 @@
+#include "analysis/bed_analysis.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "analysis/contact_statistics.hpp"
+#include "analysis/void_fraction.hpp"
+#include "core/error.hpp"
+
+namespace bedforge::analysis {
+
+namespace {
+
+struct Scales {
+  double d_ref, d_min;
+};
+Scales scales_of(const Bed& bed) {
+  double s3 = 0, s2 = 0, d_min = bed.diameters.empty() ? 0 : bed.diameters[0];
+  for (double d : bed.diameters) s3 += d * d * d, s2 += d * d, d_min = std::min(d_min, d);
+  return {s2 > 0 ? s3 / s2 : 0.0, d_min};
+}
+
+struct Slab {
+  double lo, hi;
+  bool valid;
+};
+Slab central_slab(const Bed& bed, const AnalysisParams& p, double d_ref) {
+  const double h = bed_height(bed), cut = p.exclude_d * d_ref;
+  return {cut, h - cut, h - cut > cut};
+}
+
+}  // namespace
+
+AnalysisParams read_analysis_params(SceneSection& s) {
+  AnalysisParams p;
+  p.exclude_d = s.number("exclude_d", p.exclude_d, Range::non_negative());
+  p.radial_bin_d = s.number("radial_bin_d", p.radial_bin_d, Range::open(0.0, 10.0));
+  p.axial_bin_d = s.number("axial_bin_d", p.axial_bin_d, Range::open(0.0, 10.0));
+  p.contact_tolerance_d = s.number("contact_tolerance_d", p.contact_tolerance_d, Range::closed(0.0, 0.5));
+  return p;
+}
+
+nlohmann::json to_json(const AnalysisParams& p) {
+  return {{"exclude_d", p.exclude_d},
+          {"radial_bin_d", p.radial_bin_d},
+          {"axial_bin_d", p.axial_bin_d},
+          {"contact_tolerance_d", p.contact_tolerance_d}};
+}
+
+nlohmann::json void_fraction_summary(const Bed& bed, const AnalysisParams& p) {
+  const Scales sc = scales_of(bed);
+  const double h = bed_height(bed);
+  const Slab slab = central_slab(bed, p, sc.d_ref);
+  nlohmann::json j{{"bed_height_m", h},
+                   {"bed_height_d", h / sc.d_ref},
+                   {"whole_bed", void_fraction(bed, 0.0, h)},
+                   {"central_slab", nullptr},
+                   {"central_slab_m", {slab.lo, slab.hi}}};
+  if (slab.valid) j["central_slab"] = void_fraction(bed, slab.lo, slab.hi);
+  return j;
+}
+
+AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (bed.size() == 0) throw InputError("the bed has no spheres to analyse");
+  const Scales sc = scales_of(bed);
+  const double d = sc.d_ref;
+  const double h = bed_height(bed);
+  const Slab slab = central_slab(bed, p, d);
+  const double z1 = slab.valid ? slab.lo : 0.0, z2 = slab.valid ? slab.hi : h;
+  AnalysisResult out;
+  nlohmann::json& j = out.report;
+  j["parameters"] = to_json(p);
+  j["reference_diameter_m"] = d;
+  j["smallest_diameter_m"] = sc.d_min;
+  j["spheres"] = bed.size();
+  j["container"] = bed.container->to_json();
+  j["void_fraction"] = void_fraction_summary(bed, p);
+  j["profiles_window_m"] = {z1, z2};
+
+  // Profiles.
+  const auto* cyl = dynamic_cast<const Cylinder*>(bed.container.get());
+  if (cyl) {
+    const Profile radial = radial_void_fraction(bed, *cyl, p.radial_bin_d * d, z1, z2);
+    std::string csv = "# radial void fraction between z = " + fmt::format("{} and {} m", z1, z2) +
+                      "; wall distance (R - r) in reference diameters and metres\nwall_distance_d,wall_distance_m,"
+                      "void_fraction\n";
+    for (std::size_t k = 0; k < radial.position.size(); ++k)
+      csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", radial.position[k] / d, radial.position[k], radial.void_fraction[k]);
+    out.csv_files["radial_profile.csv"] = csv;
+    const CentreDistribution centres = radial_centre_distribution(bed, *cyl, p.radial_bin_d * d, z1, z2);
+    csv = "# radial distribution of sphere centres between z = " + fmt::format("{} and {} m", z1, z2) +
+          "\nwall_distance_d,wall_distance_m,fraction,relative_density\n";
+    for (std::size_t k = 0; k < centres.position.size(); ++k)
+      csv += fmt::format("{:.6g},{:.9g},{:.9g},{:.9g}\n", centres.position[k] / d, centres.position[k],
+                         centres.fraction[k], centres.relative_density[k]);
+    out.csv_files["centre_distribution.csv"] = csv;
+    // Wall value and first minimum, the features the references quote.
+    double min_v = 2.0, min_at = 0.0;
+    for (std::size_t k = 0; k < radial.position.size() && radial.position[k] < 1.0 * d; ++k)
+      if (radial.void_fraction[k] < min_v) min_v = radial.void_fraction[k], min_at = radial.position[k] / d;
+    j["radial_profile"] = {{"wall_value", radial.void_fraction.front()},
+                           {"first_minimum", min_v},
+                           {"first_minimum_at_d", min_at},
+                           {"bin_d", p.radial_bin_d}};
+  }
+  const Profile axial = axial_void_fraction(bed, p.axial_bin_d * d, h);
+  std::string csv = "# axial void fraction over the whole cross-section\nz_d,z_m,void_fraction\n";
+  for (std::size_t k = 0; k < axial.position.size(); ++k)
+    csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", axial.position[k] / d, axial.position[k], axial.void_fraction[k]);
+  out.csv_files["axial_profile.csv"] = csv;
+
+  // Contacts and balance.
+  const ContactStatistics cs = contact_statistics(bed, p.contact_tolerance_d * sc.d_min);
+  long pair_sum = 0, bulk_n = 0, bulk_sum = 0, bulk_rattlers = 0, rattlers = 0, non_rattler_sum = 0, wall = 0, floor = 0;
+  const double cut = p.exclude_d * d;
+  csv = "# contacts per sphere (gap tolerance " + fmt::format("{} smallest diameters", p.contact_tolerance_d) +
+        ")\nindex,sphere_contacts,wall_contacts,floor_contact\n";
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const int total = cs.sphere_contacts[i] + cs.wall_contacts[i] + cs.floor_contact[i];
+    const bool rattler = total < 4;
+    pair_sum += cs.sphere_contacts[i];
+    rattlers += rattler;
+    if (!rattler) non_rattler_sum += cs.sphere_contacts[i];
+    wall += cs.wall_contacts[i] > 0;
+    floor += cs.floor_contact[i];
+    const auto& c = bed.centres[i];
+    WallContact probe[Container::kMaxWallContacts];
+    const bool near_wall = bed.container->wall_contacts(c, cut, probe) > 0;
+    if (!near_wall && c.z() > cut && c.z() < h - cut) {
+      if (rattler) ++bulk_rattlers;
+      else ++bulk_n, bulk_sum += cs.sphere_contacts[i];
+    }
+    csv += fmt::format("{},{},{},{}\n", i, cs.sphere_contacts[i], cs.wall_contacts[i], int(cs.floor_contact[i]));
+  }
+  out.csv_files["contacts.csv"] = csv;
+  const double n = static_cast<double>(bed.size());
+  j["coordination"] = {
+      {"mean_all", pair_sum / n},
+      {"mean_without_rattlers", rattlers < static_cast<long>(bed.size()) ? non_rattler_sum / (n - rattlers) : 0.0},
+      {"rattlers", rattlers},
+      {"bulk_mean_without_rattlers", bulk_n ? nlohmann::json(static_cast<double>(bulk_sum) / bulk_n) : nlohmann::json()},
+      {"bulk_spheres", bulk_n},
+      {"bulk_rattlers", bulk_rattlers},
+      {"rattler_definition", "fewer than 4 contacts with spheres, walls and floor"},
+      {"gap_tolerance_d", p.contact_tolerance_d}};
+  if (!cyl || bulk_n == 0) j["coordination"]["bulk_mean_without_rattlers"] = nullptr;
+  j["wall_contacts"] = {{"spheres_touching_lateral_wall", wall}, {"spheres_touching_floor", floor}};
+  j["overlaps"] = {{"max_pair_overlap_d", cs.max_pair_overlap / sc.d_min},
+                   {"max_wall_overlap_d", cs.max_wall_overlap / sc.d_min},
+                   {"max_floor_penetration_d", cs.max_floor_penetration / sc.d_min}};
+  j["force_residual"] = {{"rms", cs.residual_rms},
+                         {"max", cs.residual_max},
+                         {"definition", "net force / own weight at the best-fit linear contact stiffness"}};
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  j["time_s"] = time;
+  const auto& vf = j["void_fraction"];
+  out.summary = fmt::format(
+      "analysis: eps whole {:.4f}, central slab {}, Z bulk {}, max overlap {:.2g} d, residual {:.2g}, {:.2f} s",
+      vf["whole_bed"].get<double>(),
+      vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()),
+      j["coordination"]["bulk_mean_without_rattlers"].is_null()
+          ? std::string("n/a")
+          : fmt::format("{:.2f}", j["coordination"]["bulk_mean_without_rattlers"].get<double>()),
+      cs.max_pair_overlap / sc.d_min, cs.residual_rms, time);
+  j["summary"] = out.summary;
+  return out;
+}
+
+}  // namespace bedforge::analysis

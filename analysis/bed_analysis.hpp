@@ -1,0 +1,38 @@
+#pragma once
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/bed.hpp"
+#include "core/scene_section.hpp"
+
+namespace bedforge::analysis {
+
+// Scene section [analysis]. Lengths in reference diameters d (the bed's Sauter mean diameter);
+// the contact tolerance in smallest diameters, like the packer's tolerances.
+struct AnalysisParams {
+  double exclude_d = 2.0;              // slab excluded at the floor and below the top for "central" values
+  double radial_bin_d = 0.05;          // radial profile and centre distribution bin width
+  double axial_bin_d = 0.05;           // axial profile bin height
+  double contact_tolerance_d = 1e-4;   // largest surface gap still counted as a contact
+};
+AnalysisParams read_analysis_params(SceneSection& section);
+nlohmann::json to_json(const AnalysisParams& p);
+
+// Void fraction of the whole bed (floor to the top of the highest sphere) and of the central
+// slab, with the slab's bounds; the slab is null when the bed is shorter than 2 exclude_d.
+nlohmann::json void_fraction_summary(const Bed& bed, const AnalysisParams& p);
+
+struct AnalysisResult {
+  nlohmann::json report;                        // for report.json
+  std::map<std::string, std::string> csv_files; // file name -> contents
+  std::string summary;                          // one line
+};
+
+// Everything the analysis measures: void fractions, radial (central slab) and axial profiles,
+// radial centre distribution, coordination numbers (all spheres; bulk spheres more than
+// exclude_d from walls, floor and top, rattlers with fewer than 4 contacts set apart), wall and
+// floor contacts, maximum overlaps and the force residual.
+AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p);
+
+}  // namespace bedforge::analysis

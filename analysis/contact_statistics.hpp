@@ -1,0 +1,27 @@
+#pragma once
+#include <vector>
+
+#include "core/bed.hpp"
+
+namespace bedforge::analysis {
+
+// Contacts of a bed, for any bed (packed here or imported). Two spheres, or a sphere and a
+// wall, are in contact when the gap between their surfaces is at most `gap_tolerance` (m);
+// overlapping pairs have negative gaps and always count.
+struct ContactStatistics {
+  std::vector<int> sphere_contacts;  // per sphere: contacts with other spheres
+  std::vector<int> wall_contacts;    // per sphere: contacts with the lateral walls
+  std::vector<char> floor_contact;   // per sphere: 1 when touching the floor
+  double max_pair_overlap = 0;       // m
+  double max_wall_overlap = 0;       // m
+  double max_floor_penetration = 0;  // m (centre closer to the floor than its radius)
+  // Net force on each sphere relative to its weight when contact forces are linear in the
+  // overlap with the stiffness that best balances the bed (least squares), the floor carrying
+  // what presses on it. A measure of static balance that needs no knowledge of how the bed
+  // was made.
+  double residual_rms = 0, residual_max = 0;
+};
+
+ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance);
+
+}  // namespace bedforge::analysis

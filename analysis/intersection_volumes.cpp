@@ -1,0 +1,97 @@
+#include "analysis/intersection_volumes.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace bedforge::analysis {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Volume of the part of a sphere of radius r below height h above its lowest point.
+double cap_below(double r, double h) {
+  h = std::clamp(h, 0.0, 2.0 * r);
+  return kPi * h * h * (3.0 * r - h) / 3.0;
+}
+
+// n-point Gauss-Legendre nodes and weights on [-1, 1] (Newton on the Legendre recurrence).
+struct GaussLegendre {
+  static constexpr int n = 24;
+  std::array<double, n> x{}, w{};
+  GaussLegendre() {
+    for (int i = 0; i < (n + 1) / 2; ++i) {
+      double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0, p1 = 0.0;
+        for (int k = 1; k <= n; ++k) {
+          const double p2 = p1;
+          p1 = p0;
+          p0 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p2) / k;
+        }
+        dp = n * (z * p0 - p1) / (z * z - 1.0);
+        const double dz = p0 / dp;
+        z -= dz;
+        if (std::abs(dz) < 1e-16) break;
+      }
+      x[i] = -z, x[n - 1 - i] = z;
+      w[i] = w[n - 1 - i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+  }
+};
+
+}  // namespace
+
+double sphere_slab_volume(double r, double zc, double z1, double z2) {
+  if (z2 <= z1) return 0.0;
+  const double bottom = zc - r;
+  return cap_below(r, z2 - bottom) - cap_below(r, z1 - bottom);
+}
+
+double disk_lens_area(double a, double s, double rho) {
+  if (a <= 0.0 || rho <= 0.0) return 0.0;
+  if (s >= a + rho) return 0.0;
+  if (s <= std::abs(rho - a)) {
+    const double m = std::min(a, rho);
+    return kPi * m * m;
+  }
+  const double c1 = std::clamp((s * s + a * a - rho * rho) / (2.0 * s * a), -1.0, 1.0);
+  const double c2 = std::clamp((s * s + rho * rho - a * a) / (2.0 * s * rho), -1.0, 1.0);
+  const double k = (-s + a + rho) * (s + a - rho) * (s - a + rho) * (s + a + rho);
+  return a * a * std::acos(c1) + rho * rho * std::acos(c2) - 0.5 * std::sqrt(std::max(0.0, k));
+}
+
+double sphere_cylinder_volume(double r, double s, double zc, double rho, double z1, double z2) {
+  const double lo = std::max(z1, zc - r), hi = std::min(z2, zc + r);
+  if (hi <= lo || rho <= 0.0) return 0.0;
+  if (s + r <= rho) return sphere_slab_volume(r, zc, lo, hi);  // wholly inside
+  if (s >= r + rho) return 0.0;                                 // wholly outside
+  static const GaussLegendre gl;
+  // The lens changes form where the section radius a(z) = sqrt(r^2 - (z - zc)^2) equals
+  // |rho - s| or rho + s; split there.
+  std::vector<double> cuts = {lo, hi};
+  for (double c : {std::abs(rho - s), rho + s})
+    if (c < r) {
+      const double h = std::sqrt(r * r - c * c);
+      for (double z : {zc - h, zc + h})
+        if (z > lo && z < hi) cuts.push_back(z);
+    }
+  if (zc > lo && zc < hi) cuts.push_back(zc);
+  std::sort(cuts.begin(), cuts.end());
+  double v = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double mid = 0.5 * (cuts[k] + cuts[k + 1]), half = 0.5 * (cuts[k + 1] - cuts[k]);
+    if (half <= 0.0) continue;
+    for (int q = 0; q < GaussLegendre::n; ++q) {
+      const double z = mid + half * gl.x[q];
+      const double a = std::sqrt(std::max(0.0, r * r - (z - zc) * (z - zc)));
+      v += half * gl.w[q] * disk_lens_area(a, s, rho);
+    }
+  }
+  return v;
+}
+
+}  // namespace bedforge::analysis

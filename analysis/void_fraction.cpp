@@ -1,0 +1,122 @@
+#include "analysis/void_fraction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "analysis/intersection_volumes.hpp"
+
+namespace bedforge::analysis {
+
+namespace {
+
+// Adds, for every sphere, its contribution to every bin, in parallel but summed in an order
+// fixed by the bed alone (chunks of spheres in index order), so reruns give identical numbers.
+template <class PerSphere>
+std::vector<double> accumulate_bins(std::size_t spheres, std::size_t bins, PerSphere add) {
+  constexpr std::size_t kChunk = 1024;
+  const std::size_t chunks = (spheres + kChunk - 1) / kChunk;
+  std::vector<std::vector<double>> partial(chunks, std::vector<double>(bins, 0.0));
+#pragma omp parallel for schedule(dynamic)
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t i = c * kChunk; i < std::min(spheres, (c + 1) * kChunk); ++i) add(i, partial[c]);
+  std::vector<double> total(bins, 0.0);
+  for (const auto& p : partial)
+    for (std::size_t b = 0; b < bins; ++b) total[b] += p[b];
+  return total;
+}
+
+}  // namespace
+
+double bed_height(const Bed& bed) {
+  double h = 0.0;
+  for (std::size_t i = 0; i < bed.size(); ++i) h = std::max(h, bed.centres[i].z() + 0.5 * bed.diameters[i]);
+  return h;
+}
+
+double void_fraction(const Bed& bed, double z1, double z2) {
+  const auto solid = accumulate_bins(bed.size(), 1, [&](std::size_t i, std::vector<double>& acc) {
+    acc[0] += sphere_slab_volume(0.5 * bed.diameters[i], bed.centres[i].z(), z1, z2);
+  });
+  return 1.0 - solid[0] / (bed.container->cross_section_area() * (z2 - z1));
+}
+
+Profile radial_void_fraction(const Bed& bed, const Cylinder& cyl, double bin, double z1, double z2) {
+  const double R = cyl.radius();
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(R / bin - 1e-9));
+  // Edge k is the cylinder of radius R - k bin (k = 0 the wall); the last edge is the axis.
+  auto edge = [&](std::size_t k) { return std::max(0.0, R - static_cast<double>(k) * bin); };
+  const auto solid = accumulate_bins(bed.size(), bins, [&](std::size_t i, std::vector<double>& acc) {
+    const double r = 0.5 * bed.diameters[i];
+    const auto& c = bed.centres[i];
+    const double s = std::hypot(c.x(), c.y());
+    if (c.z() + r <= z1 || c.z() - r >= z2) return;
+    // Cumulative volume inside each edge radius; shells are differences, so they add up to the
+    // sphere's slab volume exactly.
+    double outer = sphere_cylinder_volume(r, s, c.z(), edge(0), z1, z2);
+    for (std::size_t k = 0; k < bins; ++k) {
+      const double rho = edge(k + 1);
+      const double inner = rho <= s - r ? 0.0 : sphere_cylinder_volume(r, s, c.z(), rho, z1, z2);
+      acc[k] += outer - inner;
+      outer = inner;
+      if (outer == 0.0) break;
+    }
+  });
+  Profile p;
+  for (std::size_t k = 0; k < bins; ++k) {
+    const double ro = edge(k), ri = edge(k + 1);
+    const double shell = std::numbers::pi * (ro * ro - ri * ri) * (z2 - z1);
+    p.position.push_back(R - 0.5 * (ro + ri));
+    p.void_fraction.push_back(1.0 - solid[k] / shell);
+  }
+  return p;
+}
+
+Profile axial_void_fraction(const Bed& bed, double bin, double top) {
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin - 1e-9));
+  const auto solid = accumulate_bins(bed.size(), bins, [&](std::size_t i, std::vector<double>& acc) {
+    const double r = 0.5 * bed.diameters[i], z = bed.centres[i].z();
+    const std::size_t first = static_cast<std::size_t>(std::max(0.0, std::floor((z - r) / bin)));
+    for (std::size_t k = first; k < bins && static_cast<double>(k) * bin < z + r; ++k)
+      acc[k] += sphere_slab_volume(r, z, static_cast<double>(k) * bin, std::min(top, static_cast<double>(k + 1) * bin));
+  });
+  Profile p;
+  const double area = bed.container->cross_section_area();
+  for (std::size_t k = 0; k < bins; ++k) {
+    const double lo = static_cast<double>(k) * bin, hi = std::min(top, lo + bin);
+    p.position.push_back(0.5 * (lo + hi));
+    p.void_fraction.push_back(1.0 - solid[k] / (area * (hi - lo)));
+  }
+  return p;
+}
+
+CentreDistribution radial_centre_distribution(const Bed& bed, const Cylinder& cyl, double bin, double z1, double z2) {
+  const double R = cyl.radius();
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(R / bin - 1e-9));
+  std::vector<double> count(bins, 0.0);
+  double total = 0.0;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const auto& c = bed.centres[i];
+    if (c.z() < z1 || c.z() >= z2) continue;
+    const double x = R - std::hypot(c.x(), c.y());
+    const std::size_t k = std::min(bins - 1, static_cast<std::size_t>(std::max(0.0, x) / bin));
+    count[k] += 1.0;
+    total += 1.0;
+  }
+  CentreDistribution out;
+  // Mean density over the region centres can occupy (at least half the mean diameter from the wall).
+  double d_mean = 0.0;
+  for (double d : bed.diameters) d_mean += d / static_cast<double>(bed.size());
+  const double reach = std::max(0.0, R - 0.5 * d_mean);
+  const double mean_density = total / (std::numbers::pi * std::max(reach * reach, 1e-300));
+  for (std::size_t k = 0; k < bins; ++k) {
+    const double ro = std::max(0.0, R - static_cast<double>(k) * bin), ri = std::max(0.0, ro - bin);
+    const double area = std::numbers::pi * (ro * ro - ri * ri);
+    out.position.push_back(R - 0.5 * (ro + ri));
+    out.fraction.push_back(total > 0 ? count[k] / total : 0.0);
+    out.relative_density.push_back(total > 0 && area > 0 ? count[k] / area / mean_density : 0.0);
+  }
+  return out;
+}
+
+}  // namespace bedforge::analysis

@@ -1,0 +1,255 @@
+#include "app/commands.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
+#include "analysis/bed_analysis.hpp"
+#include "app/scene.hpp"
+#include "core/atomic_file.hpp"
+#include "core/bed_io.hpp"
+#include "core/error.hpp"
+#include "core/progress.hpp"
+#include "core/report.hpp"
+#include "core/version.hpp"
+#include "packer/soft_sphere.hpp"
+
+namespace bedforge {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Console {
+  bool progress = Progress::wanted_by_default();
+  bool quiet = false;
+  void line(const std::string& s) const {
+    if (!quiet) std::printf("%s\n", s.c_str());
+  }
+};
+
+// Files of one run, written together at the end so a failure leaves nothing half-made.
+struct Outputs {
+  std::vector<std::pair<std::string, std::string>> files;
+  void add(std::string name, std::string contents) { files.emplace_back(std::move(name), std::move(contents)); }
+  void write(const fs::path& dir) const {
+    for (const auto& [name, contents] : files) write_file_atomically(dir / name, contents);
+  }
+};
+
+// Packing stage: the packed (or imported) bed and its report entry.
+struct PackStage {
+  Bed bed;
+  nlohmann::json report;
+};
+
+PackStage pack_stage(const Scene& scene, const Console& console) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PackStage out;
+  if (scene.algorithm == "import") {
+    ImportedBed imported = read_bed_text(scene.import_file, scene.import_to_metres);
+    out.bed = std::move(imported.bed);
+    out.bed.container = scene.container;
+    out.report = {{"algorithm", "import"}, {"file", scene.import_file.string()}, {"to_metres", scene.import_to_metres},
+                  {"header", imported.header}};
+  } else {
+    Progress progress("pack", console.progress);
+    packer::PackResult r =
+        packer::pack_soft_sphere(scene.soft_sphere, scene.sizes, *scene.container, scene.count, scene.seed, progress);
+    out.bed = std::move(r.bed);
+    out.report = std::move(r.info);
+  }
+  out.report["spheres"] = out.bed.size();
+  out.report["container_m"] = out.bed.container->to_json();
+  out.report["void_fraction"] = analysis::void_fraction_summary(out.bed, scene.analysis);
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.report["time_s"] = time;
+  const auto& vf = out.report["void_fraction"];
+  std::string line;
+  if (scene.algorithm == "import") {
+    line = fmt::format("import: {} spheres from {}", out.bed.size(), scene.import_file.string());
+  } else {
+    line = fmt::format("pack ({} {}): {} spheres, {} iterations, max overlap {:.2g} d (tol {:.2g}), residual {:.2g}",
+                       out.report["algorithm"].get<std::string>(),
+                       out.report["parameters"]["mode"].get<std::string>(), out.bed.size(),
+                       out.report["iterations"].get<long>(), out.report["max_pair_overlap_d"].get<double>(),
+                       out.report["overlap_tolerance_d"].get<double>(), out.report["force_residual_rms"].get<double>());
+  }
+  line += fmt::format(", eps {:.4f} (central {}), {:.2f} s", vf["whole_bed"].get<double>(),
+                      vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()),
+                      time);
+  out.report["summary"] = line;
+  console.line(line);
+  return out;
+}
+
+void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report& report, Outputs& files,
+                  const Console& console) {
+  analysis::AnalysisResult a = analysis::analyse_bed(bed, params);
+  for (auto& [name, csv] : a.csv_files) files.add(name, csv);
+  report.set_stage("analysis", a.report);
+  console.line(a.summary);
+}
+
+Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, scene.to_json()}; }
+
+// `run` and `pack`: a scene (file plus overrides) into DIR. `all_outputs` is false for `pack`,
+// which writes the bed whatever the scene's outputs say and leaves the analysis to `analyse`.
+int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool write_positions, const Console& console) {
+  PackStage pack = pack_stage(scene, console);
+  Report report;  // a new bed makes every earlier result in DIR stale
+  report.set_provenance(kVersion, scene.to_json(), scene.seed);
+  report.set_stage("pack", pack.report);
+  Outputs files;
+  const Provenance prov = provenance_of(scene);
+  if (write_positions) files.add("bed.csv", bed_to_csv(pack.bed, prov));
+  if (scene.wants("vtp")) files.add("bed.vtp", bed_to_vtp(pack.bed, prov));
+  files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
+  if (run_analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
+  files.write(dir);
+  report.save(dir);
+  return 0;
+}
+
+// Scene overrides from the command line, applied in the order given.
+struct Overrides {
+  std::optional<double> aspect_ratio, container_diameter_m, diameter_m, eps0, stiffness_step, tolerance;
+  std::optional<long long> count, seed, max_iterations;
+  std::optional<std::string> mode;
+
+  void add_to(CLI::App& cmd) {
+    cmd.add_option("--aspect-ratio", aspect_ratio,
+                   "FLOAT, container diameter in particle diameters D/d (sets container.diameter_d); no default");
+    cmd.add_option("--container-diameter-m", container_diameter_m,
+                   "FLOAT, container diameter in metres (sets container.diameter_m); no default");
+    cmd.add_option("--count", count, "INT, number of spheres (sets particles.count); no default");
+    cmd.add_option("--diameter-m", diameter_m,
+                   "FLOAT, sphere diameter in metres, equal spheres (sets particles.diameter_m); default 0.001");
+    cmd.add_option("--seed", seed, "INT >= 0, random seed (sets packing.seed); default 1");
+    cmd.add_option("--mode", mode,
+                   "accelerated|faithful, soft-sphere schedule (sets packing.soft_sphere.mode); default accelerated");
+    cmd.add_option("--initial-void-fraction", eps0,
+                   "FLOAT in (0,1), eps_0 of the generation stage (sets packing.soft_sphere.initial_void_fraction); "
+                   "default 0.47");
+    cmd.add_option("--stiffness-step", stiffness_step,
+                   "FLOAT > 0, C_k of Eq. (4), faithful mode (sets packing.soft_sphere.stiffness_step); default 0.3");
+    cmd.add_option("--overlap-tolerance-d", tolerance,
+                   "FLOAT, final overlap tolerance in smallest diameters (sets "
+                   "packing.soft_sphere.overlap_tolerance_d); default 1e-4");
+    cmd.add_option("--max-iterations", max_iterations,
+                   "INT, iteration cap over all stages (sets packing.soft_sphere.max_iterations); default 5000000");
+  }
+  void apply(toml::table& t) const {
+    if (aspect_ratio) override_key(t, "container.diameter_d", *aspect_ratio);
+    if (container_diameter_m) override_key(t, "container.diameter_m", *container_diameter_m);
+    if (count) override_key(t, "particles.count", *count);
+    if (diameter_m) override_key(t, "particles.diameter_m", *diameter_m);
+    if (seed) override_key(t, "packing.seed", *seed);
+    if (mode) override_key(t, "packing.soft_sphere.mode", *mode);
+    if (eps0) override_key(t, "packing.soft_sphere.initial_void_fraction", *eps0);
+    if (stiffness_step) override_key(t, "packing.soft_sphere.stiffness_step", *stiffness_step);
+    if (tolerance) override_key(t, "packing.soft_sphere.overlap_tolerance_d", *tolerance);
+    if (max_iterations) override_key(t, "packing.soft_sphere.max_iterations", *max_iterations);
+  }
+};
+
+toml::table load_table(const std::string& scene_file) {
+  if (scene_file.empty()) return {};
+  return parse_scene_text(read_file(scene_file), scene_file);
+}
+
+}  // namespace
+
+int run_command_line(int argc, char** argv) {
+  CLI::App app{fmt::format("bedforge {}: packed beds of spheres, from a scene file to analysed positions.\n"
+                           "Exit status: 0 done, 2 bad input, 3 did not converge, 1 internal error.",
+                           kVersion),
+               "bedforge"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(kVersion));
+  Console console;
+  bool no_progress = false;
+  app.add_flag("--quiet", console.quiet, "print no summary lines");
+  app.add_flag("--no-progress", no_progress, "no progress line even on a terminal (default: shown on a terminal, "
+                                             "never when CI is set)");
+
+  std::string dir, scene_file;
+  Overrides overrides;
+
+  CLI::App* run = app.add_subcommand("run", "run the stages a scene's [outputs] need; writes into -o DIR");
+  run->add_option("scene", scene_file, "TOML scene file")->required();
+  run->add_option("-o,--output", dir, "output directory (created if missing)")->required();
+  overrides.add_to(*run);
+
+  CLI::App* pack = app.add_subcommand("pack", "pack spheres: writes DIR/bed.csv, bed.vtp, scene.toml, report.json");
+  pack->add_option("--scene", scene_file, "TOML scene file to start from; options below override it");
+  pack->add_option("-o,--output", dir, "output directory (created if missing)")->required();
+  overrides.add_to(*pack);
+
+  std::string import_file, units = "m";
+  CLI::App* imp = app.add_subcommand("import", "bring in a bed of x y z d rows (e.g. from a DEM code), like pack");
+  imp->add_option("file", import_file, "text/CSV file, one sphere per row: x y z d")->required();
+  imp->add_option("--units", units, "m|cm|mm|um, length unit of the file; default m");
+  imp->add_option("--scene", scene_file, "TOML scene file for [container] and [analysis]");
+  imp->add_option("-o,--output", dir, "output directory (created if missing)")->required();
+  overrides.add_to(*imp);
+
+  CLI::App* analyse = app.add_subcommand("analyse", "analyse DIR/bed.csv: profiles, contacts; adds to DIR/report.json");
+  analyse->alias("analyze");
+  analyse->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
+  std::optional<double> exclude_d, radial_bin_d, axial_bin_d, contact_tolerance_d;
+  analyse->add_option("--exclude-d", exclude_d,
+                      "FLOAT >= 0, diameters left out at floor and top for central values; default 2");
+  analyse->add_option("--radial-bin-d", radial_bin_d, "FLOAT > 0, radial bin width in diameters; default 0.05");
+  analyse->add_option("--axial-bin-d", axial_bin_d, "FLOAT > 0, axial bin height in diameters; default 0.05");
+  analyse->add_option("--contact-tolerance-d", contact_tolerance_d,
+                      "FLOAT >= 0, largest gap counted as a contact, in smallest diameters; default 1e-4");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (no_progress) console.progress = false;
+
+  if (*run || *pack || *imp) {
+    toml::table table = load_table(scene_file);
+    if (*imp) {
+      override_key(table, "packing.algorithm", std::string("import"));
+      override_key(table, "packing.file", import_file);
+      override_key(table, "packing.units", units);
+    }
+    overrides.apply(table);
+    const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file);
+    if (*run) return run_scene(scene, dir, scene.wants("analysis"), scene.wants("positions"), console);
+    return run_scene(scene, dir, false, true, console);
+  }
+
+  // analyse DIR
+  const fs::path d(dir);
+  ImportedBed in = read_bed_text(d / "bed.csv", 1.0);
+  if (!in.bed.container)
+    throw InputError(fmt::format("{}: the header names no container; write the bed with `bedforge import`",
+                                 (d / "bed.csv").string()));
+  toml::table table;
+  if (fs::exists(d / "scene.toml")) table = parse_scene_text(read_file(d / "scene.toml"), (d / "scene.toml").string());
+  if (exclude_d) override_key(table, "analysis.exclude_d", *exclude_d);
+  if (radial_bin_d) override_key(table, "analysis.radial_bin_d", *radial_bin_d);
+  if (axial_bin_d) override_key(table, "analysis.axial_bin_d", *axial_bin_d);
+  if (contact_tolerance_d) override_key(table, "analysis.contact_tolerance_d", *contact_tolerance_d);
+  SceneSection section(table["analysis"].as_table(), "analysis");
+  const analysis::AnalysisParams params = analysis::read_analysis_params(section);
+  section.finish();
+  Report report = Report::load_or_new(d);
+  Outputs files;
+  add_analysis(in.bed, params, report, files, console);
+  files.write(d);
+  report.save(d);
+  return 0;
+}
+
+}  // namespace bedforge

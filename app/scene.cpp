@@ -1,0 +1,125 @@
+#include "app/scene.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/bed_io.hpp"
+#include "core/error.hpp"
+
+namespace bedforge {
+
+namespace {
+
+const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis"};
+const std::vector<std::string> kSections = {"container", "particles", "packing", "analysis", "outputs"};
+
+double unit_to_metres(const std::string& unit) {
+  if (unit == "m") return 1.0;
+  if (unit == "cm") return 1e-2;
+  if (unit == "mm") return 1e-3;
+  return 1e-6;  // "um"
+}
+
+}  // namespace
+
+bool Scene::wants(const std::string& output) const {
+  return std::find(outputs.begin(), outputs.end(), output) != outputs.end();
+}
+
+nlohmann::json Scene::to_json() const {
+  std::ostringstream s;
+  s << toml::json_formatter{table};
+  return nlohmann::json::parse(s.str());
+}
+
+Scene read_scene(const toml::table& table, const std::string& source) {
+  Scene sc;
+  sc.table = table;
+  sc.source = source;
+  SceneSection root(&table, "scene");
+  for (const auto& [k, v] : table) {
+    const std::string key(k.str());
+    if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
+      throw InputError(fmt::format("unknown section [{}] in {}; allowed: [container], [particles], [packing], "
+                                   "[analysis], [outputs]",
+                                   key, source));
+  }
+
+  SceneSection packing = root.sub("packing");
+  sc.algorithm = packing.choice("algorithm", "soft-sphere", {"soft-sphere", "import"});
+  sc.seed = static_cast<std::uint64_t>(packing.integer("seed", 1, 0, std::numeric_limits<long long>::max()));
+  SceneSection soft = packing.sub("soft_sphere");
+  sc.soft_sphere = packer::read_soft_sphere_params(soft);
+  soft.finish();
+
+  double d_ref = 0.0, d_max = 0.0;
+  ImportedBed imported;
+  SceneSection particles = root.sub("particles");
+  if (sc.algorithm == "import") {
+    const auto file = packing.optional_string("file");
+    if (!file) throw InputError("packing.file is required when packing.algorithm = \"import\": a text file of x y z d rows");
+    sc.import_file = *file;
+    sc.import_to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
+    imported = read_bed_text(sc.import_file, sc.import_to_metres);
+    double s3 = 0, s2 = 0;
+    for (double d : imported.bed.diameters) s3 += d * d * d, s2 += d * d, d_max = std::max(d_max, d);
+    d_ref = s3 / s2;
+    sc.count = static_cast<long long>(imported.bed.size());
+  } else {
+    sc.count = particles.integer("count", 0, 1, 100'000'000);
+    if (!particles.has("count")) throw InputError("particles.count is required: the number of spheres, an integer >= 1");
+    sc.sizes = read_size_distribution(particles);
+    d_ref = sc.sizes.sauter_mean();
+    d_max = sc.sizes.largest();
+  }
+  particles.finish();
+  packing.finish();
+
+  SceneSection container = root.sub("container");
+  if (table.contains("container") || !imported.bed.container) {
+    sc.container = read_container(container, d_ref, d_max);
+  } else {
+    sc.container = imported.bed.container;
+  }
+  container.finish();
+
+  SceneSection analysis = root.sub("analysis");
+  sc.analysis = analysis::read_analysis_params(analysis);
+  analysis.finish();
+
+  SceneSection outputs = root.sub("outputs");
+  sc.outputs = outputs.strings("files", kOutputs, kOutputs);
+  outputs.finish();
+  return sc;
+}
+
+Scene read_scene_file(const std::filesystem::path& path) {
+  return read_scene(parse_scene_text(read_file(path), path.string()), path.string());
+}
+
+toml::table& table_for_override(toml::table& table, const std::string& dotted, std::string& leaf) {
+  toml::table* t = &table;
+  std::string rest = dotted;
+  for (std::size_t dot; (dot = rest.find('.')) != std::string::npos;) {
+    const std::string part = rest.substr(0, dot);
+    if (!t->contains(part) || !(*t)[part].is_table()) t->insert_or_assign(part, toml::table{});
+    t = (*t)[part].as_table();
+    rest = rest.substr(dot + 1);
+  }
+  if (rest.size() > 2 && (rest.ends_with("_m") || rest.ends_with("_d")))
+    t->erase(rest.substr(0, rest.size() - 1) + (rest.back() == 'm' ? "d" : "m"));
+  leaf = rest;
+  return *t;
+}
+
+std::string scene_to_toml(const toml::table& table) {
+  std::ostringstream s;
+  s << table;
+  return s.str() + "\n";
+}
+
+}  // namespace bedforge

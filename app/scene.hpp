@@ -1,0 +1,64 @@
+#pragma once
+#include <toml++/toml.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "analysis/bed_analysis.hpp"
+#include "core/container.hpp"
+#include "core/size_distribution.hpp"
+#include "packer/soft_sphere.hpp"
+
+namespace bedforge {
+
+// A scene: what to build and which outputs to write. Sections: [container], [particles],
+// [packing] (with [packing.soft_sphere]), [analysis], [outputs]. Lengths are given in metres
+// (keys ending in _m) or in particle diameters (keys ending in _d).
+struct Scene {
+  toml::table table;   // as run: the file plus command-line overrides
+  std::string source;  // file name, or "command line"
+
+  // [packing]
+  std::string algorithm = "soft-sphere";  // "soft-sphere" | "import"
+  std::uint64_t seed = 1;
+  packer::SoftSphereParams soft_sphere;
+  std::filesystem::path import_file;  // algorithm = "import": x y z d rows
+  double import_to_metres = 1.0;
+
+  // [particles] (not used by "import")
+  SizeDistribution sizes;
+  long long count = 0;
+
+  // [container], in metres; for "import" it may come from the bed file's header instead.
+  std::shared_ptr<const Container> container;
+  analysis::AnalysisParams analysis;
+  // [outputs] files: "positions" (bed.csv), "vtp" (bed.vtp), "analysis" (profiles, contacts).
+  std::vector<std::string> outputs;
+
+  bool wants(const std::string& output) const;
+  nlohmann::json to_json() const;  // the table as JSON, for headers and reports
+};
+
+// Checks and reads a whole scene; InputError names the first bad key.
+Scene read_scene(const toml::table& table, const std::string& source);
+Scene read_scene_file(const std::filesystem::path& path);
+
+// The table that holds `dotted.key` (created if missing); `leaf` receives the last part. For a
+// length key (ending in _m or _d) the key in the other unit is removed, so an override wins.
+toml::table& table_for_override(toml::table& table, const std::string& dotted_key, std::string& leaf);
+
+// Sets `dotted.key` = value in a scene table (command-line overrides).
+template <class T>
+void override_key(toml::table& table, const std::string& dotted_key, T value) {
+  std::string leaf;
+  table_for_override(table, dotted_key, leaf).insert_or_assign(leaf, std::move(value));
+}
+
+// The scene as TOML text, to store next to its outputs.
+std::string scene_to_toml(const toml::table& table);
+
+}  // namespace bedforge

@@ -1,0 +1,15 @@
+#pragma once
+#include <filesystem>
+#include <string>
+
+namespace bedforge {
+
+// Writes `contents` to `path` through a temporary file in the same directory and a rename, so a
+// reader never sees a half-written file and a failed run leaves the previous file intact.
+// Creates missing parent directories. Throws InputError when the directory cannot be written.
+void write_file_atomically(const std::filesystem::path& path, const std::string& contents);
+
+// Whole file as a string; InputError naming the path when it cannot be read.
+std::string read_file(const std::filesystem::path& path);
+
+}  // namespace bedforge

@@ -1,0 +1,25 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace bedforge {
+
+// The run's JSON report, DIR/report.json: what made the run (version, scene, seed) and one
+// entry per stage with its error measures, the thresholds they were held to, its time and a
+// one-line summary. Each stage adds itself to the report already in DIR, like an OpenFOAM
+// utility adds to a case.
+class Report {
+ public:
+  static Report load_or_new(const std::filesystem::path& dir);
+  void set_provenance(const std::string& version, const nlohmann::json& scene, unsigned long long seed);
+  // `stage` must hold "summary" (one line) and "time_s".
+  void set_stage(const std::string& name, nlohmann::json stage);
+  const nlohmann::json& data() const { return data_; }
+  void save(const std::filesystem::path& dir) const;
+
+ private:
+  nlohmann::json data_ = nlohmann::json::object();
+};
+
+}  // namespace bedforge

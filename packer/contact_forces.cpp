@@ -1,0 +1,105 @@
+#include "packer/contact_forces.hpp"
+
+#include <cmath>
+
+#include "core/parallel.hpp"
+
+namespace bedforge::packer {
+
+void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Container& c, Contacts& out) {
+  const std::size_t n = s.size();
+  out.push.resize(n);
+  std::vector<double> energy(n);
+  double max_pair = 0.0, max_wall = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall)
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d push = Eigen::Vector3d::Zero();
+    double e = 0.0;
+    const Eigen::Vector3d& xi = s.x[i];
+    for (int j : nl.of(i)) {
+      const Eigen::Vector3d d = xi - s.x[j];
+      const double reach = s.r[i] + s.r[j], dist2 = d.squaredNorm();
+      if (dist2 >= reach * reach) continue;  // most listed pairs do not touch: skip the sqrt
+      const double dist = std::sqrt(dist2);
+      const double overlap = reach - dist;
+      const Eigen::Vector3d n_ij =
+          dist > 0.0 ? Eigen::Vector3d(d / dist) : Eigen::Vector3d(0, 0, static_cast<std::size_t>(j) < i ? 1.0 : -1.0);
+      push += overlap * n_ij;
+      e += 0.25 * overlap * overlap;  // each pair is seen from both spheres
+      max_pair = std::max(max_pair, overlap);
+    }
+    WallContact walls[Container::kMaxWallContacts];
+    const int nw = c.wall_contacts(xi, s.r[i], walls);
+    for (int k = 0; k < nw; ++k) {
+      push += walls[k].overlap * walls[k].normal;
+      e += 0.5 * walls[k].overlap * walls[k].overlap;
+      max_wall = std::max(max_wall, walls[k].overlap);
+    }
+    out.push[i] = push;
+    energy[i] = e;
+  }
+  out.max_pair_overlap = max_pair;
+  out.max_wall_overlap = max_wall;
+  out.elastic_energy = deterministic_sum(n, [&](std::size_t i) { return energy[i]; });
+}
+
+double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, const Container& c, int iterations) {
+  const std::size_t n = s.size();
+  std::vector<Eigen::Vector3d> v(n), hv(n);
+  for (std::size_t i = 0; i < n; ++i)  // a fixed start with no symmetry to hide modes behind
+    v[i] = Eigen::Vector3d(std::sin(1.0 + 3.1 * i), std::cos(2.0 + 1.7 * i), std::sin(0.5 + 2.3 * i));
+  double lambda = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    const double norm = std::sqrt(deterministic_sum(n, [&](std::size_t i) { return v[i].squaredNorm(); }));
+    if (!(norm > 0.0)) return lambda;
+    for (auto& vi : v) vi /= norm;
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      Eigen::Vector3d h = Eigen::Vector3d::Zero();
+      for (int j : nl.of(i)) {
+        const Eigen::Vector3d d = s.x[i] - s.x[j];
+        const double reach = s.r[i] + s.r[j], dist2 = d.squaredNorm();
+        if (dist2 >= reach * reach || dist2 == 0.0) continue;
+        const Eigen::Vector3d nij = d / std::sqrt(dist2);
+        h += nij * nij.dot(v[i] - v[j]);
+      }
+      WallContact walls[Container::kMaxWallContacts];
+      const int nw = c.wall_contacts(s.x[i], s.r[i], walls);
+      for (int k = 0; k < nw; ++k) h += walls[k].normal * walls[k].normal.dot(v[i]);
+      hv[i] = h;
+    }
+    lambda = deterministic_sum(n, [&](std::size_t i) { return v[i].dot(hv[i]); });
+    std::swap(v, hv);
+  }
+  return lambda;
+}
+
+std::size_t lift_floor_spheres(Spheres& s, double height, std::uint64_t salt) {
+  std::size_t lifted = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (!on_floor(s, i)) continue;
+    std::uint64_t h = (static_cast<std::uint64_t>(i) + 1) * 0x9E3779B97F4A7C15ULL ^ (salt + 1) * 0xBF58476D1CE4E5B9ULL;
+    h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
+    s.x[i].z() += height * static_cast<double>(h >> 11) * 0x1.0p-53;
+    ++lifted;
+  }
+  return lifted;
+}
+
+std::pair<double, double> force_residual(const Spheres& s, const Contacts& c, double kappa) {
+  const std::size_t n = s.size();
+  std::vector<double> rel(n);
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d f = kappa * c.push[i];
+    f.z() -= s.w[i];
+    if (on_floor(s, i) && f.z() < 0.0) f.z() = 0.0;  // floor reaction
+    rel[i] = f.norm() / s.w[i];
+  }
+  double mx = 0.0;
+  for (double v : rel) mx = std::max(mx, v);
+  const double ms = deterministic_sum(n, [&](std::size_t i) { return rel[i] * rel[i]; });
+  return {n ? std::sqrt(ms / static_cast<double>(n)) : 0.0, mx};
+}
+
+}  // namespace bedforge::packer

@@ -1,0 +1,17 @@
+#pragma once
+#include "core/container.hpp"
+#include "core/random.hpp"
+#include "packer/contact_forces.hpp"
+
+namespace bedforge::packer {
+
+// Generation stage of Salvat et al. (2005), Sec. 3.1, for any container and size mix: the
+// initial bed height follows from the initial void fraction eps0 (Eq. 6 generalised:
+// L0 = total sphere volume / (cross-section area (1 - eps0))), and each centre is drawn
+// uniformly in the cross-section (container's sample_centre) and at z = L0 Rnd + r_i.
+// Overlaps are allowed; the packer removes them.
+// Inputs: s.r (radii, packing units), container in packing units, eps0 in (0, 1).
+// Output: s.x. Returns L0.
+double generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng);
+
+}  // namespace bedforge::packer

@@ -1,0 +1,178 @@
+#include "packer/soft_sphere_accelerated.hpp"
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "core/parallel.hpp"
+#include "packer/mass_centre_monitor.hpp"
+
+namespace bedforge::packer {
+
+namespace {
+
+struct Relaxed {
+  Contacts contacts;
+  bool settled = false;       // the mass-centre test passed at this iteration
+  double residual_rms = 0.0;  // net force / own weight, rms (window boundaries only)
+};
+
+class AcceleratedDescent {
+ public:
+  AcceleratedDescent(Spheres& s, const Container& c, const SoftSphereSettings& p, RunLog& log)
+      : s_(s), c_(c), p_(p), log_(log), nl_(p.skin), requested_(0.5 * p.given.stiffness_step), step_(requested_) {}
+
+  // Minimises C_k E_el + C_g sum w_i z_i (C_g = C_k / kappa, or 0 without gravity) until
+  // `done`; no sphere moves more than `max_step` in one iteration.
+  // Smallest C_k the stability limit allowed (C_k = 2 x the momentum step).
+  double smallest_stiffness_step() const { return 2.0 * smallest_; }
+
+  Relaxed relax(double kappa, bool gravity, double max_step, const std::function<bool(const Relaxed&)>& done) {
+    const std::size_t n = s_.size();
+    const double total_weight = deterministic_sum(n, [&](std::size_t i) { return s_.w[i]; });
+    MassCentreMonitor mass_centre(p_.given.mass_centre_samples, p_.given.mass_centre_tolerance);
+    std::vector<Eigen::Vector3d> x = s_.x, good = s_.x, next(n);  // iterate x_k; s_.x holds y_k
+    std::vector<double> uphill(n);
+    double t = 1.0;
+    Relaxed r;
+    for (long k = 0;; ++k) {
+      nl_.update(s_.x, s_.r, c_);
+      evaluate_contacts(s_, nl_, c_, r.contacts);
+      if (!std::isfinite(r.contacts.elastic_energy)) {
+        if (static_cast<int>(log_.recoveries()) >= p_.given.max_recoveries)
+          throw ConvergenceError(fmt::format("the accelerated packer diverged {} times in the {} stage; lower "
+                                             "packing.soft_sphere.stiffness_step",
+                                             log_.recoveries() + 1, log_.stage()));
+        log_.recovery({{"reason", "non-finite positions"}, {"C_k_before", step_}, {"C_k_after", step_ / 2}});
+        step_ /= 2;
+        x = s_.x = good;
+        t = 1.0;
+        mass_centre.clear();
+        continue;
+      }
+      r.settled = false;
+      if (k % kStabilityInterval == 0) limit_step();
+      if (k % p_.given.mass_centre_interval == 0) {
+        good = x;
+        mass_centre.add(deterministic_sum(n, [&](std::size_t i) { return s_.w[i] * x[i].z(); }) / total_weight);
+        r.settled = mass_centre.settled();
+        r.residual_rms = gravity ? force_residual(s_, r.contacts, kappa).first : 0.0;
+        log_.record({{"max_pair_overlap_d", r.contacts.max_pair_overlap / p_.d_min},
+                     {"max_wall_overlap_d", r.contacts.max_wall_overlap / p_.d_min},
+                     {"stiffness_ratio", kappa},
+                     {"force_residual_rms", r.residual_rms}});
+        log_.show(fmt::format("accelerated, {} stage, iteration {}, max overlap {:.2e} d", log_.stage(),
+                              log_.iterations(), r.contacts.max_pair_overlap / p_.d_min));
+        if (done(r)) {
+          s_.x = x;
+          return r;
+        }
+      }
+      log_.tick(fmt::format("the accelerated {} stage (max overlap {:.3g} d)", log_.stage(),
+                            r.contacts.max_pair_overlap / p_.d_min));
+
+      // Descent step from y (Eq. 4 with C_g = C_k / kappa), floor, cap; then momentum.
+      const double cg = gravity ? step_ / kappa : 0.0;  // C_g = C_k / kappa
+#pragma omp parallel for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        Eigen::Vector3d move = step_ * r.contacts.push[i];
+        move.z() -= cg * s_.w[i];
+        const double len = move.norm();
+        if (len > max_step) move *= max_step / len;
+        next[i] = s_.x[i] + move;
+        next[i].z() = std::max(next[i].z(), s_.r[i]);
+        uphill[i] = move.dot(next[i] - x[i]);
+      }
+      // Restart when the step from y disagrees with the direction travelled (gradient restart).
+      if (deterministic_sum(n, [&](std::size_t i) { return uphill[i]; }) < 0.0) t = 1.0;
+      const double t_next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t)), beta = (t - 1.0) / t_next;
+      t = t_next;
+#pragma omp parallel for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        Eigen::Vector3d y = next[i] + beta * (next[i] - x[i]);
+        y.z() = std::max(y.z(), s_.r[i]);
+        x[i] = next[i];
+        s_.x[i] = y;
+      }
+    }
+  }
+
+ private:
+  Spheres& s_;
+  const Container& c_;
+  const SoftSphereSettings& p_;
+  RunLog& log_;
+  NeighbourList nl_;
+  double requested_, step_, smallest_ = requested_;
+
+  // Momentum descent is stable for steps below 1 / lambda_max of the contact stiffness; the
+  // contact network changes as the bed moves, so the limit is re-measured every
+  // kStabilityInterval iterations and the step kept below it, whatever C_k was asked for.
+  static constexpr long kStabilityInterval = 500;
+  void limit_step() {
+    const double lambda = contact_stiffness_eigenvalue(s_, nl_, c_, 20);
+    const double limit = lambda > 0.0 ? 0.8 / lambda : requested_;
+    const double step = std::min(requested_, limit);
+    smallest_ = std::min(smallest_, step);
+    step_ = step;
+  }
+};
+
+}  // namespace
+
+nlohmann::json run_accelerated(Spheres& s, const Container& container, const SoftSphereSettings& p, RunLog& log) {
+  const double tol = p.tolerance;
+  AcceleratedDescent descent(s, container, p, log);
+  const double max_step = 0.5 * p.band_upper;
+
+  log.begin_stage("expansion");
+  for (std::uint64_t stalls = 0;; ++stalls) {
+    auto overlaps_ok = [&](const Relaxed& q) {
+      return q.contacts.max_pair_overlap < tol && q.contacts.max_wall_overlap < tol;
+    };
+    const Relaxed e = descent.relax(1.0, false, max_step, [&](const Relaxed& q) { return overlaps_ok(q) || q.settled; });
+    if (overlaps_ok(e)) break;
+    // Stalled with overlaps left: an unstable equilibrium (see lift_floor_spheres).
+    const std::size_t lifted = lift_floor_spheres(s, 0.01 * p.d_min, stalls);
+    log.recovery({{"reason", "stalled at an unstable equilibrium with overlaps: floor spheres lifted"}, {"spheres", lifted}});
+    if (stalls > 10 * static_cast<std::uint64_t>(p.given.max_recoveries))
+      throw ConvergenceError("the accelerated expansion stage keeps stalling with overlapping spheres");
+  }
+
+  // Compaction. The largest contact force of a settled frictionless bed grows with its height H
+  // (the column above a bottom sphere), so kappa ~ 5 H / delta starts close to the band; the
+  // measured overlap then corrects it.
+  log.begin_stage("compaction");
+  const double band_mid = 0.5 * (p.band_lower + p.band_upper);
+  double solid = 0.0;
+  for (double r : s.r) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  const double height = solid / (0.6 * container.cross_section_area());
+  double kappa = 5.0 * std::max(1.0, height) / band_mid;
+  Relaxed r;
+  for (int round = 0;; ++round) {
+    r = descent.relax(kappa, true, max_step,
+                      [&](const Relaxed& q) { return q.settled || q.residual_rms < p.given.force_tolerance; });
+    const double overlap = r.contacts.max_pair_overlap;
+    if ((overlap >= p.band_lower && overlap <= p.band_upper) || overlap == 0.0 || round == 8) break;
+    kappa *= overlap / band_mid;
+  }
+
+  // Final: stiffen so both overlaps fall below half the tolerance, settle, check.
+  log.begin_stage("final");
+  const double target = 0.5 * tol;
+  for (int round = 0;; ++round) {
+    const double overlap = std::max(r.contacts.max_pair_overlap, r.contacts.max_wall_overlap);
+    if (overlap > target) kappa *= overlap / target;
+    r = descent.relax(kappa, true, max_step,
+                      [&](const Relaxed& q) { return q.settled || q.residual_rms < p.given.force_tolerance; });
+    if (r.contacts.max_pair_overlap < tol && r.contacts.max_wall_overlap < tol) break;
+    if (round == 10)
+      throw ConvergenceError(fmt::format("the accelerated packer could not bring the overlaps below {} d "
+                                         "(pair {:.3g} d, wall {:.3g} d)",
+                                         p.given.overlap_tolerance_d, r.contacts.max_pair_overlap / p.d_min,
+                                         r.contacts.max_wall_overlap / p.d_min));
+  }
+  return {{"stiffness_ratio", kappa}, {"smallest_C_k", descent.smallest_stiffness_step()}};
+}
+
+}  // namespace bedforge::packer

@@ -1,0 +1,65 @@
+// A packed bed against the published structure of random sphere beds in tubes
+// (docs/reference.md, from the correlations and profile features collected there).
+#include "analysis/bed_analysis.hpp"
+
+#include <gtest/gtest.h>
+
+#include "packer/soft_sphere.hpp"
+
+using namespace bedforge;
+
+namespace {
+
+const analysis::AnalysisResult& packed_at_7_99() {
+  static const analysis::AnalysisResult result = [] {
+    SizeDistribution s;
+    s.diameters_m = {1.0};
+    s.number_fractions = {1.0};
+    Progress quiet("test", false);
+    const auto r = packer::pack_soft_sphere({}, s, Cylinder(0.5 * 7.99), 1200, 1, quiet);
+    return analysis::analyse_bed(r.bed, {});
+  }();
+  return result;
+}
+
+}  // namespace
+
+TEST(BedAnalysis, RadialProfileHasTheWallFeatures) {
+  const auto& j = packed_at_7_99().report["radial_profile"];
+  // Invariant: nothing can be closer to the wall than the wall itself.
+  EXPECT_NEAR(j["wall_value"].get<double>(), 1.0, 0.01);
+  // [A] first minimum at z ~ 0.5 d, value about 0.20-0.26 (wider band for one bed of 1200).
+  EXPECT_NEAR(j["first_minimum_at_d"].get<double>(), 0.5, 0.06);
+  EXPECT_GT(j["first_minimum"].get<double>(), 0.12);
+  EXPECT_LT(j["first_minimum"].get<double>(), 0.32);
+}
+
+TEST(BedAnalysis, ProfileDampsToTheBulkAndCentresPeakAtHalfADiameter) {
+  const auto& csv = packed_at_7_99().csv_files.at("centre_distribution.csv");
+  // The largest centre fraction sits in the bin holding 0.5 d: the wall-touching layer.
+  std::istringstream in(csv);
+  std::string line;
+  double best = -1, best_at = -1;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == 'w') continue;
+    double z, zm, f, rho;
+    char c;
+    std::istringstream row(line);
+    row >> z >> c >> zm >> c >> f >> c >> rho;
+    if (f > best) best = f, best_at = z;
+  }
+  EXPECT_NEAR(best_at, 0.525, 0.051);
+}
+
+TEST(BedAnalysis, VoidFractionAndCoordinationAreThoseOfARandomDenseBed) {
+  const auto& j = packed_at_7_99().report;
+  // Central slab at a = 7.99 between Zou & Yu dense (0.384) and loose (0.428) random packing,
+  // correlations of docs/reference.md; a frictionless packer sits on the dense side.
+  const double eps = j["void_fraction"]["central_slab"].get<double>();
+  EXPECT_GT(eps, 0.37);
+  EXPECT_LT(eps, 0.43);
+  // [A] frictionless jammed spheres: about 6 contacts away from walls, rattlers set apart.
+  EXPECT_NEAR(j["coordination"]["bulk_mean_without_rattlers"].get<double>(), 6.0, 0.6);
+  EXPECT_LT(j["overlaps"]["max_pair_overlap_d"].get<double>(), 1e-4);
+  EXPECT_GT(j["wall_contacts"]["spheres_touching_lateral_wall"].get<int>(), 100);
+}

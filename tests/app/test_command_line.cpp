@@ -1,0 +1,185 @@
+// The bedforge program as a user runs it: outputs, provenance, and bad input.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status;
+  std::string output;  // stdout and stderr
+};
+
+Result bedforge(const std::string& args) {
+  const std::string cmd = std::string("cd ") + BEDFORGE_SOURCE_DIR + " && " + BEDFORGE_BINARY + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("bedforge_cli_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  return d;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path scene(const std::string& name, const std::string& text) {
+  const fs::path p = fresh_dir("scenes") / name;
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+  return p;
+}
+
+// Bad input: exit status 2, a message naming `key`, and nothing written.
+void expect_rejected(const std::string& args, const std::string& key) {
+  const fs::path out = fresh_dir("rejected");
+  const Result r = bedforge(args + " -o " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(key), std::string::npos) << "message does not name " << key << ": " << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "output written for rejected input " << args;
+}
+
+}  // namespace
+
+TEST(CommandLine, PackWritesBedReportSceneAndRecordsProvenance) {
+  const fs::path out = fresh_dir("pack");
+  const Result r = bedforge("pack --aspect-ratio 3 --count 40 --seed 5 --diameter-m 0.002 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("pack (soft-sphere accelerated): 40 spheres"), std::string::npos) << r.output;
+  for (const char* f : {"bed.csv", "bed.vtp", "report.json", "scene.toml"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  const std::string csv = read(out / "bed.csv");
+  EXPECT_NE(csv.find("# version: "), std::string::npos);
+  EXPECT_NE(csv.find("# seed: 5"), std::string::npos);
+  EXPECT_NE(csv.find("\"diameter\":0.006"), std::string::npos) << "container not recorded in metres";
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  EXPECT_EQ(report["seed"], 5);
+  EXPECT_EQ(report["scene"]["particles"]["count"], 40);
+  EXPECT_FALSE(report["bedforge_version"].get<std::string>().empty());
+  const auto& pack = report["stages"]["pack"];
+  for (const char* k : {"iterations", "time_s", "max_pair_overlap_d", "force_residual_rms", "void_fraction", "summary"})
+    EXPECT_TRUE(pack.contains(k)) << k;
+  // The same command gives the same bed.
+  const fs::path again = fresh_dir("pack_again");
+  ASSERT_EQ(bedforge("pack --aspect-ratio 3 --count 40 --seed 5 --diameter-m 0.002 -o " + again.string()).status, 0);
+  EXPECT_EQ(read(again / "bed.csv"), csv);
+}
+
+TEST(CommandLine, AnalyseAddsItsStageToTheDirectory) {
+  const fs::path out = fresh_dir("analyse");
+  ASSERT_EQ(bedforge("pack --aspect-ratio 4 --count 120 -o " + out.string()).status, 0);
+  const Result r = bedforge("analyse " + out.string() + " --radial-bin-d 0.1");
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* f : {"radial_profile.csv", "axial_profile.csv", "centre_distribution.csv", "contacts.csv"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  EXPECT_TRUE(report["stages"].contains("pack"));
+  EXPECT_DOUBLE_EQ(report["stages"]["analysis"]["parameters"]["radial_bin_d"].get<double>(), 0.1);
+  EXPECT_TRUE(report["summary"].contains("analysis"));
+}
+
+TEST(CommandLine, RunFollowsTheScenesOutputs) {
+  const fs::path only_positions = fresh_dir("run_positions");
+  const auto s = scene("positions.toml",
+                       "[container]\ndiameter_d = 3\n[particles]\ncount = 30\n[outputs]\nfiles = [\"positions\"]\n");
+  ASSERT_EQ(bedforge("run " + s.string() + " -o " + only_positions.string()).status, 0);
+  EXPECT_TRUE(fs::exists(only_positions / "bed.csv"));
+  EXPECT_FALSE(fs::exists(only_positions / "bed.vtp"));
+  EXPECT_FALSE(fs::exists(only_positions / "radial_profile.csv"));
+  const auto report = nlohmann::json::parse(read(only_positions / "report.json"));
+  EXPECT_FALSE(report["stages"].contains("analysis"));
+}
+
+TEST(CommandLine, DefaultSceneRuns) {
+  const fs::path out = fresh_dir("default");
+  const Result r = bedforge("run scenes/default.toml -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("analysis: eps whole"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "radial_profile.csv"));
+}
+
+TEST(CommandLine, ImportedBedIsAnalysed) {
+  const fs::path packed = fresh_dir("to_import"), out = fresh_dir("imported");
+  ASSERT_EQ(bedforge("pack --aspect-ratio 4 --count 80 --diameter-m 0.001 -o " + packed.string()).status, 0);
+  // Rewrite as a DEM code would: millimetres, spaces, a column line, no container record.
+  std::ifstream in(packed / "bed.csv");
+  fs::create_directories(out.parent_path());
+  std::ofstream dem(out.parent_path() / "dem.txt");
+  dem << "x y z diameter\n";
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 'x') continue;
+    std::stringstream row(line);
+    double v[4];
+    char comma;
+    row >> v[0] >> comma >> v[1] >> comma >> v[2] >> comma >> v[3];
+    dem << v[0] * 1e3 << ' ' << v[1] * 1e3 << ' ' << v[2] * 1e3 << ' ' << v[3] * 1e3 << '\n';
+  }
+  dem.close();
+  const Result r = bedforge("import " + (out.parent_path() / "dem.txt").string() +
+                            " --units mm --container-diameter-m 0.004 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("import: 80 spheres"), std::string::npos) << r.output;
+  ASSERT_EQ(bedforge("analyse " + out.string()).status, 0);
+  const auto a = nlohmann::json::parse(read(out / "report.json"))["stages"]["analysis"];
+  EXPECT_LT(a["overlaps"]["max_pair_overlap_d"].get<double>(), 1e-3);  // printed with 6 digits
+}
+
+TEST(CommandLine, BadInputIsRejectedByName) {
+  expect_rejected("pack --aspect-ratio 3 --count 0", "particles.count");
+  expect_rejected("pack --aspect-ratio 3 --count -5", "particles.count");
+  expect_rejected("pack --aspect-ratio 0.8 --count 10", "container.diameter_d");
+  expect_rejected("pack --aspect-ratio 3 --count 10 --diameter-m 0", "particles.diameter_m");
+  expect_rejected("pack --count 10", "container.diameter_d");
+  expect_rejected("pack --aspect-ratio 3 --count 10 --initial-void-fraction 1.2",
+                  "packing.soft_sphere.initial_void_fraction");
+  expect_rejected("pack --aspect-ratio 3 --count 10 --mode fast", "packing.soft_sphere.mode");
+  expect_rejected("run " + scene("unknown.toml", "[container]\ndiameter_d = 3\ndiamter_d = 4\n[particles]\ncount = 5\n")
+                               .string(),
+                  "container.diamter_d");
+  expect_rejected("run " + scene("nan.toml", "[container]\ndiameter_d = nan\n[particles]\ncount = 5\n").string(),
+                  "container.diameter_d");
+  expect_rejected("run " + scene("type.toml", "[container]\ndiameter_d = \"wide\"\n[particles]\ncount = 5\n").string(),
+                  "container.diameter_d");
+  expect_rejected("run " +
+                      scene("fractions.toml",
+                            "[container]\ndiameter_d = 5\n[particles]\ncount = 5\ndistribution = \"discrete\"\n"
+                            "diameters_m = [0.001, 0.002]\nnumber_fractions = [0.5, 0.4]\n")
+                          .string(),
+                  "particles.number_fractions");
+  expect_rejected("run " + scene("section.toml", "[contianer]\ndiameter_d = 3\n").string(), "[contianer]");
+  expect_rejected("run " + scene("syntax.toml", "[container\n").string(), "syntax.toml:1");
+}
+
+TEST(CommandLine, DivergenceIsReportedWithStatusThree) {
+  const fs::path out = fresh_dir("cap");
+  const Result r = bedforge("pack --aspect-ratio 5 --count 200 --max-iterations 100 -o " + out.string());
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_NE(r.output.find("max_iterations"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "bed.csv"));
+}
+
+TEST(CommandLine, HelpStatesTypesUnitsAndDefaults) {
+  const Result r = bedforge("pack --help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* s : {"--aspect-ratio", "particle diameters", "--diameter-m", "metres", "default 0.001",
+                        "--seed", "default 1", "--mode", "default accelerated"})
+    EXPECT_NE(r.output.find(s), std::string::npos) << s;
+}

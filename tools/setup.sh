@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Sets bedforge up on Debian 12 and then runs what is asked:
+#   bash tools/setup.sh demo   install what is missing, build, pack and analyse scenes/default.toml
+#   bash tools/setup.sh test   install what is missing, build, run the whole test suite
+#   bash tools/setup.sh        install what is missing and build
+# apt-get runs only when a package is absent. Run as root, or as a user with sudo.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+          libgtest-dev python3-numpy python3-matplotlib)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo=""
+  [ "$(id -u)" = 0 ] || sudo=sudo
+  echo "setup: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+
+case "${1:-}" in
+  demo) ./build/bedforge run scenes/default.toml -o out/default ;;
+  test) ctest --test-dir build --output-on-failure -j"$(nproc)" ;;
+  "") ;;
+  *) echo "setup: unknown action '$1'; allowed: demo, test, or nothing" >&2; exit 2 ;;
+esac
