@@ -1,11 +1,13 @@
 #include "packer/generation.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <numbers>
+#include <numeric>
 
 namespace bedforge::packer {
 
-double generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng) {
+Generated generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng) {
   double volume = 0.0;
   for (double r : s.r) volume += 4.0 / 3.0 * std::numbers::pi * r * r * r;
   const double L0 = volume / (container.cross_section_area() * (1.0 - eps0));
@@ -14,7 +16,20 @@ double generate_initial_bed(Spheres& s, const Container& container, double eps0,
     const Eigen::Vector2d xy = container.sample_centre(rng, s.r[i]);
     s.x[i] = {xy.x(), xy.y(), L0 * rng.uniform() + s.r[i]};
   }
-  return L0;
+  // Number the spheres from the bottom up. Packing moves them by a small part of the bed height,
+  // so neighbours keep nearby indices and the force loop reads memory almost in order: for
+  // 1e5 spheres this alone makes an iteration several times faster.
+  std::vector<std::size_t> order(s.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.x[a].z() < s.x[b].z(); });
+  Spheres sorted;
+  for (std::size_t i : order) {
+    sorted.x.push_back(s.x[i]);
+    sorted.r.push_back(s.r[i]);
+    sorted.w.push_back(s.w[i]);
+  }
+  s = std::move(sorted);
+  return {L0, order};
 }
 
 }  // namespace bedforge::packer

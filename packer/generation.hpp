@@ -11,7 +11,12 @@ namespace bedforge::packer {
 // uniformly in the cross-section (container's sample_centre) and at z = L0 Rnd + r_i.
 // Overlaps are allowed; the packer removes them.
 // Inputs: s.r (radii, packing units), container in packing units, eps0 in (0, 1).
-// Output: s.x. Returns L0.
-double generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng);
+// Output: s.x, and s reordered by height (indices follow z). Returns L0 and the reordering:
+// sphere i of the output was sphere order[i] of the input.
+struct Generated {
+  double initial_height;
+  std::vector<std::size_t> order;
+};
+Generated generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng);
 
 }  // namespace bedforge::packer

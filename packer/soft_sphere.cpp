@@ -79,7 +79,7 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
     s.r.push_back(0.5 * di / d_ref);
     s.w.push_back(std::pow(di / d_ref, 3));
   }
-  const double L0 = generate_initial_bed(s, *box, params.initial_void_fraction, rng);
+  const Generated gen = generate_initial_bed(s, *box, params.initial_void_fraction, rng);
 
   RunLog log(params.max_iterations, progress);
   const nlohmann::json end = params.mode == SoftSphereParams::Mode::faithful ? run_faithful(s, *box, p, log)
@@ -108,14 +108,14 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
   out.bed.container = container.scaled(1.0);
   for (std::size_t i = 0; i < s.size(); ++i) {
     out.bed.centres.push_back(s.x[i] * d_ref);
-    out.bed.diameters.push_back(d[i]);
+    out.bed.diameters.push_back(d[gen.order[i]]);
   }
   nlohmann::json run = log.to_json();
   out.info = {{"algorithm", "soft-sphere"},
               {"parameters", to_json(params)},
               {"reference_diameter_m", d_ref},
               {"smallest_diameter_m", sizes.smallest()},
-              {"initial_height_d", L0},
+              {"initial_height_d", gen.initial_height},
               {"iterations", run["iterations"]},
               {"stages", run["stages"]},
               {"recoveries", run["recoveries"]},

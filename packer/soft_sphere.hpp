@@ -24,10 +24,10 @@ struct SoftSphereParams {
   long mass_centre_interval = 100;           // iterations between mass-centre samples
   int mass_centre_samples = 10;              // successive samples that must agree
   double mass_centre_tolerance = 1e-6;       // relative spread allowed among them (1e-4 %)
-  double force_tolerance = 0.1;              // accelerated: rms net force / own weight that ends a stage
+  double force_tolerance = 0.2;              // accelerated: rms net force / own weight that ends a stage
   long max_iterations = 5'000'000;           // all stages together
   int max_recoveries = 8;                    // step halvings allowed after detected divergence
-  double neighbour_skin_d = 0.3;             // Verlet skin
+  double neighbour_skin_d = 0.1;             // Verlet skin
 };
 
 // Reads [packing.soft_sphere]; unknown keys and out-of-range values are InputErrors.

@@ -11,10 +11,11 @@ namespace bedforge::packer {
 
 namespace {
 
+// State of the iterate at a window boundary, where the stopping tests are made.
 struct Relaxed {
   Contacts contacts;
-  bool settled = false;       // the mass-centre test passed at this iteration
-  double residual_rms = 0.0;  // net force / own weight, rms (window boundaries only)
+  bool settled = false;       // the mass-centre test passed
+  double residual_rms = 0.0;  // net force / own weight, rms
 };
 
 class AcceleratedDescent {
@@ -34,7 +35,7 @@ class AcceleratedDescent {
     std::vector<Eigen::Vector3d> x = s_.x, good = s_.x, next(n);  // iterate x_k; s_.x holds y_k
     std::vector<double> uphill(n);
     double t = 1.0;
-    Relaxed r;
+    Relaxed r;  // at y, every iteration
     for (long k = 0;; ++k) {
       nl_.update(s_.x, s_.r, c_);
       evaluate_contacts(s_, nl_, c_, r.contacts);
@@ -50,22 +51,28 @@ class AcceleratedDescent {
         mass_centre.clear();
         continue;
       }
-      r.settled = false;
       if (k % kStabilityInterval == 0) limit_step();
       if (k % p_.given.mass_centre_interval == 0) {
+        // Judge the iterate x, not the extrapolated y: at high stiffness the momentum step alone
+        // would show as force.
         good = x;
-        mass_centre.add(deterministic_sum(n, [&](std::size_t i) { return s_.w[i] * x[i].z(); }) / total_weight);
-        r.settled = mass_centre.settled();
-        r.residual_rms = gravity ? force_residual(s_, r.contacts, kappa).first : 0.0;
-        log_.record({{"max_pair_overlap_d", r.contacts.max_pair_overlap / p_.d_min},
-                     {"max_wall_overlap_d", r.contacts.max_wall_overlap / p_.d_min},
+        Relaxed at_x;
+        std::swap(s_.x, x);
+        nl_.update(s_.x, s_.r, c_);
+        evaluate_contacts(s_, nl_, c_, at_x.contacts);
+        mass_centre.add(deterministic_sum(n, [&](std::size_t i) { return s_.w[i] * s_.x[i].z(); }) / total_weight);
+        at_x.settled = mass_centre.settled();
+        at_x.residual_rms = gravity ? force_residual(s_, at_x.contacts, kappa).first : 0.0;
+        std::swap(s_.x, x);
+        log_.record({{"max_pair_overlap_d", at_x.contacts.max_pair_overlap / p_.d_min},
+                     {"max_wall_overlap_d", at_x.contacts.max_wall_overlap / p_.d_min},
                      {"stiffness_ratio", kappa},
-                     {"force_residual_rms", r.residual_rms}});
-        log_.show(fmt::format("accelerated, {} stage, iteration {}, max overlap {:.2e} d", log_.stage(),
-                              log_.iterations(), r.contacts.max_pair_overlap / p_.d_min));
-        if (done(r)) {
+                     {"force_residual_rms", at_x.residual_rms}});
+        log_.show(fmt::format("accelerated, {} stage, iteration {}, max overlap {:.2e} d, residual {:.2e}", log_.stage(),
+                              log_.iterations(), at_x.contacts.max_pair_overlap / p_.d_min, at_x.residual_rms));
+        if (done(at_x)) {
           s_.x = x;
-          return r;
+          return at_x;
         }
       }
       log_.tick(fmt::format("the accelerated {} stage (max overlap {:.3g} d)", log_.stage(),

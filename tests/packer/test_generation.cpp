@@ -14,7 +14,7 @@ TEST(Generation, InitialHeightFollowsEquation6) {
   s.r.assign(n, 0.5);
   s.w.assign(n, 1.0);
   Rng rng(1);
-  const double L0 = generate_initial_bed(s, c, eps0, rng);
+  const double L0 = generate_initial_bed(s, c, eps0, rng).initial_height;
   EXPECT_NEAR(L0, 2.0 / 3.0 * n / (a * a * (1 - eps0)), 1e-12);
   double zmin = 1e9, zmax = -1e9;
   for (const auto& x : s.x) {
@@ -24,4 +24,5 @@ TEST(Generation, InitialHeightFollowsEquation6) {
   EXPECT_GE(zmin, 0.5);
   EXPECT_LE(zmax, L0 + 0.5);
   EXPECT_GT(zmax - zmin, 0.9 * L0);  // the draws fill the height
+  for (size_t i = 1; i < s.x.size(); ++i) EXPECT_LE(s.x[i - 1].z(), s.x[i].z());  // numbered bottom-up
 }
