@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -17,9 +18,8 @@ struct Scales {
   double d_ref, d_min;
 };
 Scales scales_of(const Bed& bed) {
-  double s3 = 0, s2 = 0, d_min = bed.diameters.empty() ? 0 : bed.diameters[0];
-  for (double d : bed.diameters) s3 += d * d * d, s2 += d * d, d_min = std::min(d_min, d);
-  return {s2 > 0 ? s3 / s2 : 0.0, d_min};
+  const double d_min = bed.diameters.empty() ? 0.0 : *std::min_element(bed.diameters.begin(), bed.diameters.end());
+  return {sauter_mean(bed.diameters), d_min};
 }
 
 struct Slab {
@@ -97,11 +97,11 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
       csv += fmt::format("{:.6g},{:.9g},{:.9g},{:.9g}\n", centres.position[k] / d, centres.position[k],
                          centres.fraction[k], centres.relative_density[k]);
     out.csv_files["centre_distribution.csv"] = csv;
-    // Wall value and first minimum, the features the references quote.
+    // Value in the bin at the wall and the first minimum, features the references quote.
     double min_v = 2.0, min_at = 0.0;
     for (std::size_t k = 0; k < radial.position.size() && radial.position[k] < 1.0 * d; ++k)
       if (radial.void_fraction[k] < min_v) min_v = radial.void_fraction[k], min_at = radial.position[k] / d;
-    j["radial_profile"] = {{"wall_value", radial.void_fraction.front()},
+    j["radial_profile"] = {{"wall_bin", radial.void_fraction.front()},
                            {"first_minimum", min_v},
                            {"first_minimum_at_d", min_at},
                            {"bin_d", p.radial_bin_d}};

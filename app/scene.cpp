@@ -65,9 +65,8 @@ Scene read_scene(const toml::table& table, const std::string& source) {
     sc.import_file = *file;
     sc.import_to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
     imported = read_bed_text(sc.import_file, sc.import_to_metres);
-    double s3 = 0, s2 = 0;
-    for (double d : imported.bed.diameters) s3 += d * d * d, s2 += d * d, d_max = std::max(d_max, d);
-    d_ref = s3 / s2;
+    d_ref = sauter_mean(imported.bed.diameters);
+    d_max = *std::max_element(imported.bed.diameters.begin(), imported.bed.diameters.end());
     sc.count = static_cast<long long>(imported.bed.size());
   } else {
     sc.count = particles.integer("count", 0, 1, 100'000'000);

@@ -18,4 +18,11 @@ struct Bed {
   std::size_t size() const { return centres.size(); }
 };
 
+// Sauter mean diameter sum d^3 / sum d^2 of a set of spheres (the bed's reference diameter).
+inline double sauter_mean(const std::vector<double>& diameters) {
+  double s3 = 0.0, s2 = 0.0;
+  for (double d : diameters) s3 += d * d * d, s2 += d * d;
+  return s2 > 0.0 ? s3 / s2 : 0.0;
+}
+
 }  // namespace bedforge

@@ -27,6 +27,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from bedforge_files import read_csv  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
 DOCS = os.path.join(ROOT, "docs")
@@ -60,9 +62,9 @@ def run(case):
     if "analysis" in rep["stages"]:
         an = rep["stages"]["analysis"]
         res["z_bulk"] = an["coordination"]["bulk_mean_without_rattlers"]
-        prof = np.genfromtxt(os.path.join(out, "radial_profile.csv"), delimiter=",", comments="#", names=True)
+        prof = read_csv(os.path.join(out, "radial_profile.csv"))
         res["radial"] = [prof["wall_distance_d"].tolist(), prof["void_fraction"].tolist()]
-        cen = np.genfromtxt(os.path.join(out, "centre_distribution.csv"), delimiter=",", comments="#", names=True)
+        cen = read_csv(os.path.join(out, "centre_distribution.csv"))
         res["centres"] = [cen["wall_distance_d"].tolist(), cen["fraction"].tolist()]
     subprocess.run(["rm", "-rf", out])
     return res

@@ -4,21 +4,26 @@
 
 #include <gtest/gtest.h>
 
+#include "analysis/void_fraction.hpp"
 #include "packer/soft_sphere.hpp"
 
 using namespace bedforge;
 
 namespace {
 
-const analysis::AnalysisResult& packed_at_7_99() {
-  static const analysis::AnalysisResult result = [] {
+const Bed& bed_at_7_99() {
+  static const Bed bed = [] {
     SizeDistribution s;
     s.diameters_m = {1.0};
     s.number_fractions = {1.0};
     Progress quiet("test", false);
-    const auto r = packer::pack_soft_sphere({}, s, Cylinder(0.5 * 7.99), 1200, 1, quiet);
-    return analysis::analyse_bed(r.bed, {});
+    return packer::pack_soft_sphere({}, s, Cylinder(0.5 * 7.99), 1200, 1, quiet).bed;
   }();
+  return bed;
+}
+
+const analysis::AnalysisResult& packed_at_7_99() {
+  static const analysis::AnalysisResult result = analysis::analyse_bed(bed_at_7_99(), {});
   return result;
 }
 
@@ -26,8 +31,13 @@ const analysis::AnalysisResult& packed_at_7_99() {
 
 TEST(BedAnalysis, RadialProfileHasTheWallFeatures) {
   const auto& j = packed_at_7_99().report["radial_profile"];
-  // Invariant: nothing can be closer to the wall than the wall itself.
-  EXPECT_NEAR(j["wall_value"].get<double>(), 1.0, 0.01);
+  // [A] eps = 1 at the wall: a bin of width h next to it holds only caps of wall-touching
+  // spheres, about n pi h r of solid with n ~ 1 sphere per d^2, so eps -> 1 linearly in h.
+  const Bed& bed = bed_at_7_99();
+  const auto& cyl = dynamic_cast<const Cylinder&>(*bed.container);
+  const double thin = analysis::radial_void_fraction(bed, cyl, 0.002, 2.0, 14.0).void_fraction.front();
+  EXPECT_GT(thin, 0.99);
+  EXPECT_LT(j["wall_bin"].get<double>(), thin);  // the 0.05 d bin holds more of those caps
   // [A] first minimum at z ~ 0.5 d, value about 0.20-0.26 (wider band for one bed of 1200).
   EXPECT_NEAR(j["first_minimum_at_d"].get<double>(), 0.5, 0.06);
   EXPECT_GT(j["first_minimum"].get<double>(), 0.12);
