@@ -97,8 +97,8 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
 
 Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, scene.to_json()}; }
 
-// `run` and `pack`: a scene (file plus overrides) into DIR. `all_outputs` is false for `pack`,
-// which writes the bed whatever the scene's outputs say and leaves the analysis to `analyse`.
+// `run`, `pack` and `import`: a scene (file plus overrides) into DIR. `run` follows the scene's
+// outputs; `pack` and `import` always write the bed and leave the analysis to `analyse`.
 int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool write_positions, const Console& console) {
   PackStage pack = pack_stage(scene, console);
   Report report;  // a new bed makes every earlier result in DIR stale
@@ -220,11 +220,12 @@ int run_command_line(int argc, char** argv) {
     toml::table table = load_table(scene_file);
     if (*imp) {
       override_key(table, "packing.algorithm", std::string("import"));
-      override_key(table, "packing.file", import_file);
+      override_key(table, "packing.file", std::filesystem::absolute(import_file).string());
       override_key(table, "packing.units", units);
     }
     overrides.apply(table);
-    const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file);
+    const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file,
+                                   scene_file.empty() ? fs::path() : fs::path(scene_file).parent_path());
     if (*run) return run_scene(scene, dir, scene.wants("analysis"), scene.wants("positions"), console);
     return run_scene(scene, dir, false, true, console);
   }

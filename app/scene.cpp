@@ -36,11 +36,11 @@ nlohmann::json Scene::to_json() const {
   return nlohmann::json::parse(s.str());
 }
 
-Scene read_scene(const toml::table& table, const std::string& source) {
+Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir) {
   Scene sc;
   sc.table = table;
   sc.source = source;
-  SceneSection root(&table, "scene");
+  SceneSection root(&table, "");  // top level: keys are named from their section down
   for (const auto& [k, v] : table) {
     const std::string key(k.str());
     if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
@@ -62,7 +62,7 @@ Scene read_scene(const toml::table& table, const std::string& source) {
   if (sc.algorithm == "import") {
     const auto file = packing.optional_string("file");
     if (!file) throw InputError("packing.file is required when packing.algorithm = \"import\": a text file of x y z d rows");
-    sc.import_file = *file;
+    sc.import_file = std::filesystem::path(*file).is_relative() ? base_dir / *file : std::filesystem::path(*file);
     sc.import_to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
     imported = read_bed_text(sc.import_file, sc.import_to_metres);
     d_ref = sauter_mean(imported.bed.diameters);
@@ -97,7 +97,7 @@ Scene read_scene(const toml::table& table, const std::string& source) {
 }
 
 Scene read_scene_file(const std::filesystem::path& path) {
-  return read_scene(parse_scene_text(read_file(path), path.string()), path.string());
+  return read_scene(parse_scene_text(read_file(path), path.string()), path.string(), path.parent_path());
 }
 
 toml::table& table_for_override(toml::table& table, const std::string& dotted, std::string& leaf) {

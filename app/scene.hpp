@@ -43,8 +43,9 @@ struct Scene {
   nlohmann::json to_json() const;  // the table as JSON, for headers and reports
 };
 
-// Checks and reads a whole scene; InputError names the first bad key.
-Scene read_scene(const toml::table& table, const std::string& source);
+// Checks and reads a whole scene; InputError names the first bad key. A relative
+// `packing.file` is taken relative to `base_dir` (the scene file's folder).
+Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir = {});
 Scene read_scene_file(const std::filesystem::path& path);
 
 // The table that holds `dotted.key` (created if missing); `leaf` receives the last part. For a

@@ -42,7 +42,7 @@ class SceneSection {
 
   const std::string& name() const { return name_; }
   bool has(const std::string& key) const;
-  std::string key_path(const std::string& key) const { return name_ + "." + key; }
+  std::string key_path(const std::string& key) const { return name_.empty() ? key : name_ + "." + key; }
 
   double number(const std::string& key, double fallback, Range range);
   std::optional<double> optional_number(const std::string& key, Range range);

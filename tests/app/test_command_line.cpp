@@ -116,6 +116,16 @@ TEST(CommandLine, DefaultSceneRuns) {
   EXPECT_TRUE(fs::exists(out / "radial_profile.csv"));
 }
 
+TEST(CommandLine, EveryShippedSceneRuns) {
+  for (const auto& e : fs::recursive_directory_iterator(fs::path(BEDFORGE_SOURCE_DIR) / "scenes")) {
+    if (e.path().extension() != ".toml") continue;
+    const fs::path out = fresh_dir("scene_" + e.path().stem().string());
+    const Result r = bedforge("--quiet run " + e.path().string() + " -o " + out.string());
+    EXPECT_EQ(r.status, 0) << e.path() << ": " << r.output;
+    EXPECT_TRUE(fs::exists(out / "report.json")) << e.path();
+  }
+}
+
 TEST(CommandLine, ImportedBedIsAnalysed) {
   const fs::path packed = fresh_dir("to_import"), out = fresh_dir("imported");
   ASSERT_EQ(bedforge("pack --aspect-ratio 4 --count 80 --diameter-m 0.001 -o " + packed.string()).status, 0);

@@ -84,13 +84,3 @@ TEST(BedIo, VtpHasOneVertexAndDiameterPerSphere) {
   EXPECT_NE(vtp.find("Name=\"diameter\""), std::string::npos);
   EXPECT_EQ(vtp.find("--", vtp.find("<!--") + 4), vtp.find("-->"));  // no "--" inside the comment
 }
-
-TEST(AtomicFile, LeavesNoTemporaryBehind) {
-  const fs::path d = temp_dir() / "atomic";
-  write_file_atomically(d / "a.txt", "one");
-  write_file_atomically(d / "a.txt", "two");
-  EXPECT_EQ(read_file(d / "a.txt"), "two");
-  int files = 0;
-  for ([[maybe_unused]] const auto& e : fs::directory_iterator(d)) ++files;
-  EXPECT_EQ(files, 1);
-}

@@ -1,0 +1,57 @@
+#include "app/scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+
+using namespace bedforge;
+
+namespace {
+
+Scene read(const char* text, const std::filesystem::path& base = {}) {
+  return read_scene(parse_scene_text(text, "t.toml"), "t.toml", base);
+}
+
+}  // namespace
+
+TEST(Scene, DefaultsAndRequiredKeys) {
+  const Scene s = read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n");
+  EXPECT_EQ(s.algorithm, "soft-sphere");
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_TRUE(s.wants("positions") && s.wants("vtp") && s.wants("analysis"));
+  EXPECT_NEAR(dynamic_cast<const Cylinder&>(*s.container).radius(), 0.0025, 1e-15);  // 5 d of 1 mm
+  EXPECT_THROW(read("[container]\ndiameter_d = 5\n"), InputError);       // no count
+  EXPECT_THROW(read("[particles]\ncount = 10\n"), InputError);           // no container size
+}
+
+TEST(Scene, AspectRatioIsInSauterMeanDiameters) {
+  // d32 of equal numbers of 1 and 2 mm spheres is 1.8 mm.
+  const Scene s = read("[container]\ndiameter_d = 10\n[particles]\ncount = 10\ndistribution = \"discrete\"\n"
+                       "diameters_m = [0.001, 0.002]\nnumber_fractions = [0.5, 0.5]\n");
+  EXPECT_NEAR(dynamic_cast<const Cylinder&>(*s.container).radius(), 0.009, 1e-15);
+}
+
+TEST(Scene, OverrideReplacesTheLengthInTheOtherUnit) {
+  toml::table t = parse_scene_text("[container]\ndiameter_m = 0.02\n[particles]\ncount = 10\n", "t");
+  override_key(t, "container.diameter_d", 4.0);
+  override_key(t, "packing.soft_sphere.mode", std::string("faithful"));
+  const Scene s = read_scene(t, "t");
+  EXPECT_NEAR(dynamic_cast<const Cylinder&>(*s.container).radius(), 0.002, 1e-15);
+  EXPECT_EQ(s.soft_sphere.mode, packer::SoftSphereParams::Mode::faithful);
+  EXPECT_FALSE(t["container"].as_table()->contains("diameter_m"));
+}
+
+TEST(Scene, ImportPathIsRelativeToTheSceneFile) {
+  try {
+    read("[container]\ndiameter_d = 5\n[packing]\nalgorithm = \"import\"\nfile = \"bed.txt\"\n", "/nowhere/scenes");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nowhere/scenes/bed.txt"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
+  EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[mesh]\nsize_d = 1\n"), InputError);
+  EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[outputs]\nfiles = [\"stl\"]\n"),
+               InputError);
+}
