@@ -21,7 +21,7 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
                           const Container& container) {
   const std::size_t n = x.size();
   ++builds_;
-  built_at_ = x;
+  built_at_.assign(x.begin(), x.end());
   offsets_.assign(n + 1, 0);
   list_.clear();
   if (n == 0) return;
@@ -47,8 +47,10 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
 
   // Counting sort of spheres by cell (stable: spheres keep index order inside a cell).
   const long cells = nx * ny * nz;
-  std::vector<long> cell(n);
-  std::vector<std::size_t> start(static_cast<std::size_t>(cells) + 1, 0);
+  std::vector<long>& cell = cell_;
+  std::vector<std::size_t>& start = start_;
+  cell.resize(n);
+  start.assign(static_cast<std::size_t>(cells) + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     long cx, cy, cz;
     cell_of(x[i], cx, cy, cz);
@@ -56,9 +58,11 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
     ++start[static_cast<std::size_t>(cell[i]) + 1];
   }
   for (long c = 0; c < cells; ++c) start[c + 1] += start[c];
-  std::vector<int> sorted(n);
+  std::vector<int>& sorted = sorted_;
+  sorted.resize(n);
   {
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    std::vector<std::size_t>& fill = fill_;
+    fill.assign(start.begin(), start.end() - 1);
     for (std::size_t i = 0; i < n; ++i) sorted[fill[cell[i]]++] = static_cast<int>(i);
   }
 

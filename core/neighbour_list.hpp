@@ -32,6 +32,10 @@ class NeighbourList {
   std::vector<std::size_t> offsets_;
   std::vector<int> list_;
   std::vector<Eigen::Vector3d> built_at_;
+  // Work arrays of build(), kept so frequent rebuilds allocate nothing.
+  std::vector<long> cell_;
+  std::vector<std::size_t> start_, fill_;
+  std::vector<int> sorted_;
 };
 
 }  // namespace bedforge

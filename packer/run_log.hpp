@@ -21,12 +21,14 @@ class RunLog {
   double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
   long iterations() const { return iterations_; }
 
-  // Counts one iteration; ConvergenceError once the budget is spent.
-  void tick(const std::string& where_and_state) {
+  // Counts one iteration; ConvergenceError once the budget is spent. `where_and_state()` says
+  // where the run was; it is called only then, so the hot loop formats nothing.
+  template <class Describe>
+  void tick(Describe where_and_state) {
     if (++iterations_ > max_iterations_)
       throw ConvergenceError(fmt::format("the packer reached packing.soft_sphere.max_iterations = {} in {}; raise "
                                          "it if the bed was still progressing (see the history in the report)",
-                                         max_iterations_, where_and_state));
+                                         max_iterations_, where_and_state()));
   }
 
   void begin_stage(const std::string& name) {

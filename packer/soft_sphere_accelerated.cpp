@@ -75,8 +75,10 @@ class AcceleratedDescent {
           return at_x;
         }
       }
-      log_.tick(fmt::format("the accelerated {} stage (max overlap {:.3g} d)", log_.stage(),
-                            r.contacts.max_pair_overlap / p_.d_min));
+      log_.tick([&] {
+        return fmt::format("the accelerated {} stage (max overlap {:.3g} d)", log_.stage(),
+                           r.contacts.max_pair_overlap / p_.d_min);
+      });
 
       // Descent step from y (Eq. 4 with C_g = C_k / kappa), floor, cap; then momentum.
       const double cg = gravity ? step_ / kappa : 0.0;  // C_g = C_k / kappa
@@ -115,7 +117,7 @@ class AcceleratedDescent {
   // Momentum descent is stable for steps below 1 / lambda_max of the contact stiffness; the
   // contact network changes as the bed moves, so the limit is re-measured every
   // kStabilityInterval iterations and the step kept below it, whatever C_k was asked for.
-  static constexpr long kStabilityInterval = 500;
+  static constexpr long kStabilityInterval = 1000;
   void limit_step() {
     const double lambda = contact_stiffness_eigenvalue(s_, nl_, c_, 20);
     const double limit = lambda > 0.0 ? 0.8 / lambda : requested_;

@@ -16,7 +16,7 @@ namespace bedforge::packer {
 //     by about the square root of the stiffness-to-gravity ratio. Momentum methods are stable
 //     for steps up to 1 / L where plain descent allows 2 / L (L the largest contact stiffness
 //     eigenvalue), so the step is C_k / 2, and never more than 0.8 / lambda_max as measured on
-//     the current contacts by power iteration every 500 iterations: a C_k beyond the limit is
+//     the current contacts by power iteration every 1000 iterations: a C_k beyond the limit is
 //     reduced, not obeyed. Each sphere's step is capped at delta_U / 2 so the collapse stays
 //     quasi-static.
 //  2. Direct control of gravity. Instead of ramping C_g by Delta C_g per iteration (Eq. 7), the

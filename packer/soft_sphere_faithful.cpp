@@ -112,8 +112,10 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
     }
 
     // Eq. (4), Jacobi update, then the rigid floor.
-    log.tick(fmt::format("the faithful {} stage (max overlap {:.3g} d, C_g {:.3g})", name(st.stage),
-                         con.max_pair_overlap / p.d_min, st.cg));
+    log.tick([&] {
+      return fmt::format("the faithful {} stage (max overlap {:.3g} d, C_g {:.3g})", name(st.stage),
+                         con.max_pair_overlap / p.d_min, st.cg);
+    });
     const double cg = st.cg;
 #pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
