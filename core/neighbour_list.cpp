@@ -66,37 +66,46 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
     for (std::size_t i = 0; i < n; ++i) sorted[fill[cell[i]]++] = static_cast<int>(i);
   }
 
-  // Two passes over the 27 surrounding cells: count, then fill at the prefix-summed offsets.
-  auto visit = [&](std::size_t i, auto&& emit) {
-    long cx, cy, cz;
-    cell_of(x[i], cx, cy, cz);
-    for (long dz = -1; dz <= 1; ++dz)
-      for (long dy = -1; dy <= 1; ++dy)
-        for (long dx = -1; dx <= 1; ++dx) {
-          const long X = cx + dx, Y = cy + dy, Z = cz + dz;
-          if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
-          const long c = (Z * ny + Y) * nx + X;
-          for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
-            const int j = sorted[k];
-            if (static_cast<std::size_t>(j) == i) continue;
-            const double reach = r[i] + r[j] + skin_;
-            if ((x[j] - x[i]).squaredNorm() < reach * reach) emit(j);
+  // One pass over the 27 surrounding cells into rows of fixed capacity (grown and redone on
+  // overflow, which only wide size mixtures need), then packed into the compact list.
+  for (bool overflow = true; overflow;) {
+    overflow = false;
+    scratch_.resize(n * capacity_);
+#pragma omp parallel for schedule(dynamic, 256) reduction(|| : overflow)
+    for (std::size_t i = 0; i < n; ++i) {
+      long cx, cy, cz;
+      cell_of(x[i], cx, cy, cz);
+      std::size_t count = 0;
+      int* row = scratch_.data() + i * capacity_;
+      for (long dz = -1; dz <= 1; ++dz)
+        for (long dy = -1; dy <= 1; ++dy)
+          for (long dx = -1; dx <= 1; ++dx) {
+            const long X = cx + dx, Y = cy + dy, Z = cz + dz;
+            if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
+            const long c = (Z * ny + Y) * nx + X;
+            for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
+              const int j = sorted[k];
+              if (static_cast<std::size_t>(j) == i) continue;
+              const double reach = r[i] + r[j] + skin_;
+              if ((x[j] - x[i]).squaredNorm() >= reach * reach) continue;
+              if (count < capacity_) row[count] = j;
+              ++count;
+            }
           }
-        }
-  };
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t count = 0;
-    visit(i, [&](int) { ++count; });
-    offsets_[i + 1] = count;
+      offsets_[i + 1] = count;
+      overflow = overflow || count > capacity_;
+    }
+    if (overflow) {
+      std::size_t most = 0;
+      for (std::size_t i = 0; i < n; ++i) most = std::max(most, offsets_[i + 1]);
+      capacity_ = 2 * most;
+    }
   }
   for (std::size_t i = 0; i < n; ++i) offsets_[i + 1] += offsets_[i];
   list_.resize(offsets_[n]);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t at = offsets_[i];
-    visit(i, [&](int j) { list_[at++] = j; });
-  }
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i)
+    std::copy_n(scratch_.data() + i * capacity_, offsets_[i + 1] - offsets_[i], list_.data() + offsets_[i]);
 }
 
 }  // namespace bedforge

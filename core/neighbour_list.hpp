@@ -36,6 +36,8 @@ class NeighbourList {
   std::vector<long> cell_;
   std::vector<std::size_t> start_, fill_;
   std::vector<int> sorted_;
+  std::vector<int> scratch_;    // n rows of capacity_ neighbours
+  std::size_t capacity_ = 32;
 };
 
 }  // namespace bedforge

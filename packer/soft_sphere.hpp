@@ -27,7 +27,7 @@ struct SoftSphereParams {
   double force_tolerance = 0.2;              // accelerated: rms net force / own weight that ends a stage
   long max_iterations = 5'000'000;           // all stages together
   int max_recoveries = 8;                    // step halvings allowed after detected divergence
-  double neighbour_skin_d = 0.1;             // Verlet skin
+  double neighbour_skin_d = 0.2;             // Verlet skin
 };
 
 // Reads [packing.soft_sphere]; unknown keys and out-of-range values are InputErrors.
