@@ -32,7 +32,7 @@ struct Contacts {
 void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Container& c, Contacts& out);
 
 // Rigid floor z = 0 (Salvat et al.: it carries exactly the axial load of the spheres resting on
-// it). Projects centres to z >= r_i and returns whether sphere i rests on the floor.
+// it; the packers keep z_i >= r_i). Whether sphere i rests on the floor.
 inline bool on_floor(const Spheres& s, std::size_t i) { return s.x[i].z() <= s.r[i] * (1.0 + 1e-12); }
 
 // Largest eigenvalue of the contact stiffness matrix per unit k (the Hessian of the elastic

@@ -12,9 +12,9 @@ namespace {
 enum class Stage { initial, intermediate, final_ };
 const char* name(Stage s) { return s == Stage::initial ? "initial" : s == Stage::intermediate ? "intermediate" : "final"; }
 
-// Everything the iteration depends on, so a divergence can return to a known good state.
+// Everything the iteration depends on besides the positions, so a divergence can return to a
+// known good state (with the positions saved beside it).
 struct State {
-  std::vector<Eigen::Vector3d> x;
   Stage stage = Stage::initial;
   double cg = 0.0;
   long stage_iterations = 0;
@@ -31,15 +31,15 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
   Contacts con;
   double ck = g.stiffness_step;
 
-  State st{s.x, Stage::initial, 0.0, 0, MassCentreMonitor(g.mass_centre_samples, g.mass_centre_tolerance)};
+  State st{Stage::initial, 0.0, 0, MassCentreMonitor(g.mass_centre_samples, g.mass_centre_tolerance)};
   State checkpoint = st;
+  std::vector<Eigen::Vector3d> checkpoint_x = s.x;
   int rising = 0;  // iterations of the current window in which Phi rose
   double prev_energy = 0.0, prev_height = 0.0, prev_cg = 0.0;
   bool have_prev = false;
   log.begin_stage(name(st.stage));
 
   for (long window_pos = 0;; ++window_pos) {
-    s.x = st.x;
     nl.update(s.x, s.r, container);
     evaluate_contacts(s, nl, container, con);
     const double height = deterministic_sum(n, [&](std::size_t i) { return s.w[i] * s.x[i].z(); });
@@ -64,6 +64,7 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
                       {"C_k_after", ck / 2}});
         ck /= 2;
         st = checkpoint;
+        s.x = checkpoint_x;
         if (log.stage() != name(st.stage)) log.begin_stage(name(st.stage));
         rising = 0;
         have_prev = false;
@@ -71,6 +72,7 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
         continue;
       }
       checkpoint = st;
+      checkpoint_x = s.x;
       rising = 0;
     }
     if (st.stage_iterations % g.mass_centre_interval == 0) {
@@ -97,9 +99,7 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
       enter(Stage::intermediate, 0.0);
     } else if (st.stage == Stage::initial && settled) {
       // Stalled with overlaps left: an unstable equilibrium (see lift_floor_spheres).
-      s.x = st.x;
       const std::size_t lifted = lift_floor_spheres(s, 0.01 * p.d_min, log.iterations());
-      st.x = s.x;
       st.mass_centre.clear();
       log.recovery({{"reason", "stalled at an unstable equilibrium with overlaps: floor spheres lifted"}, {"spheres", lifted}});
       if (static_cast<int>(log.recoveries()) > 10 * g.max_recoveries)
@@ -119,7 +119,7 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
     const double cg = st.cg;
 #pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
-      Eigen::Vector3d& xi = st.x[i];
+      Eigen::Vector3d& xi = s.x[i];
       xi += ck * con.push[i];
       xi.z() -= cg * s.w[i];
       xi.z() = std::max(xi.z(), s.r[i]);
@@ -134,7 +134,6 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
       else if (con.max_pair_overlap > p.band_upper) st.cg = std::max(0.0, st.cg - g.gravity_step_increment);
     }
   }
-  s.x = st.x;
   const double kappa = st.cg > 0 ? ck / st.cg : 0.0;
   return {{"C_k", ck}, {"C_g", st.cg}, {"stiffness_ratio", kappa}};
 }
