@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "analysis/contact_statistics.hpp"
 #include "analysis/void_fraction.hpp"
@@ -15,11 +16,13 @@ namespace bedforge::analysis {
 namespace {
 
 struct Scales {
-  double d_ref, d_min;
+  double d_ref, d_min, d_mean;  // Sauter mean, smallest, arithmetic mean (m)
 };
 Scales scales_of(const Bed& bed) {
   const double d_min = bed.diameters.empty() ? 0.0 : *std::min_element(bed.diameters.begin(), bed.diameters.end());
-  return {sauter_mean(bed.diameters), d_min};
+  double d_mean = 0.0;
+  for (double d : bed.diameters) d_mean += d / static_cast<double>(bed.diameters.size());
+  return {sauter_mean(bed.diameters), d_min, d_mean};
 }
 
 struct Slab {
@@ -80,31 +83,49 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
   j["void_fraction"] = void_fraction_summary(bed, p);
   j["profiles_window_m"] = {z1, z2};
 
-  // Profiles.
-  const auto* cyl = dynamic_cast<const Cylinder*>(bed.container.get());
-  if (cyl) {
-    const Profile radial = radial_void_fraction(bed, *cyl, p.radial_bin_d * d, z1, z2);
+  // Radial profiles, from each curved wall towards the axis or the middle of the gap.
+  struct Wall {
+    std::string name;  // report key and CSV stem
+    double radius, end;
+  };
+  std::vector<Wall> walls;
+  double reachable = 0.0;  // cross-section area open to centres of mean-size spheres
+  if (const auto* cyl = dynamic_cast<const Cylinder*>(bed.container.get())) {
+    walls = {{"radial_profile", cyl->radius(), 0.0}};
+    reachable = std::numbers::pi * std::pow(std::max(0.0, cyl->radius() - 0.5 * sc.d_mean), 2);
+  } else if (const auto* ann = dynamic_cast<const Annulus*>(bed.container.get())) {
+    const double mid = 0.5 * (ann->outer_radius() + ann->inner_radius());
+    walls = {{"radial_profile_outer", ann->outer_radius(), mid}, {"radial_profile_inner", ann->inner_radius(), mid}};
+    const double ro = std::max(mid, ann->outer_radius() - 0.5 * sc.d_mean), ri = std::min(mid, ann->inner_radius() + 0.5 * sc.d_mean);
+    reachable = std::numbers::pi * (ro * ro - ri * ri);
+  }
+  for (const Wall& w : walls) {
+    const Profile radial = radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2);
     std::string csv = "# radial void fraction between z = " + fmt::format("{} and {} m", z1, z2) +
-                      "; wall distance (R - r) in reference diameters and metres\nwall_distance_d,wall_distance_m,"
+                      fmt::format(", from the wall at r = {} m", w.radius) +
+                      "; wall distance |r - R_wall| in reference diameters and metres\nwall_distance_d,wall_distance_m,"
                       "void_fraction\n";
     for (std::size_t k = 0; k < radial.position.size(); ++k)
       csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", radial.position[k] / d, radial.position[k], radial.void_fraction[k]);
-    out.csv_files["radial_profile.csv"] = csv;
-    const CentreDistribution centres = radial_centre_distribution(bed, *cyl, p.radial_bin_d * d, z1, z2);
+    out.csv_files[w.name + ".csv"] = csv;
+    const CentreDistribution centres = radial_centre_distribution(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, reachable);
     csv = "# radial distribution of sphere centres between z = " + fmt::format("{} and {} m", z1, z2) +
+          fmt::format(", from the wall at r = {} m", w.radius) +
           "\nwall_distance_d,wall_distance_m,fraction,relative_density\n";
     for (std::size_t k = 0; k < centres.position.size(); ++k)
       csv += fmt::format("{:.6g},{:.9g},{:.9g},{:.9g}\n", centres.position[k] / d, centres.position[k],
                          centres.fraction[k], centres.relative_density[k]);
-    out.csv_files["centre_distribution.csv"] = csv;
+    std::string stem = w.name;
+    stem.replace(0, std::string("radial_profile").size(), "centre_distribution");
+    out.csv_files[stem + ".csv"] = csv;
     // Value in the bin at the wall and the first minimum, features the references quote.
     double min_v = 2.0, min_at = 0.0;
     for (std::size_t k = 0; k < radial.position.size() && radial.position[k] < 1.0 * d; ++k)
       if (radial.void_fraction[k] < min_v) min_v = radial.void_fraction[k], min_at = radial.position[k] / d;
-    j["radial_profile"] = {{"wall_bin", radial.void_fraction.front()},
-                           {"first_minimum", min_v},
-                           {"first_minimum_at_d", min_at},
-                           {"bin_d", p.radial_bin_d}};
+    j[w.name] = {{"wall_bin", radial.void_fraction.front()},
+                 {"first_minimum", min_v},
+                 {"first_minimum_at_d", min_at},
+                 {"bin_d", p.radial_bin_d}};
   }
   const Profile axial = axial_void_fraction(bed, p.axial_bin_d * d, h);
   std::string csv = "# axial void fraction over the whole cross-section\nz_d,z_m,void_fraction\n";
@@ -146,7 +167,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
       {"bulk_rattlers", bulk_rattlers},
       {"rattler_definition", "fewer than 4 contacts with spheres, walls and floor"},
       {"gap_tolerance_d", p.contact_tolerance_d}};
-  if (!cyl || bulk_n == 0) j["coordination"]["bulk_mean_without_rattlers"] = nullptr;
+  if (bulk_n == 0) j["coordination"]["bulk_mean_without_rattlers"] = nullptr;
   j["wall_contacts"] = {{"spheres_touching_lateral_wall", wall}, {"spheres_touching_floor", floor}};
   j["overlaps"] = {{"max_pair_overlap_d", cs.max_pair_overlap / sc.d_min},
                    {"max_wall_overlap_d", cs.max_wall_overlap / sc.d_min},

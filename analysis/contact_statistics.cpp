@@ -24,12 +24,13 @@ ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance) {
   std::vector<Eigen::Vector3d> push(n);  // sum of overlap * outward normal, m
   std::vector<double> weight(n);
   double max_pair = 0, max_wall = 0, max_floor = 0;
+  const Periodicity per = bed.container->periodicity();
 #pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall, max_floor)
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& xi = bed.centres[i];
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (int j : nl.of(i)) {
-      const Eigen::Vector3d d = xi - bed.centres[j];
+      const Eigen::Vector3d d = per.separation(xi, bed.centres[j]);
       const double dist = d.norm(), gap = dist - r[i] - r[j];
       if (gap <= gap_tolerance) ++st.sphere_contacts[i];
       if (gap < 0.0) {

@@ -41,32 +41,41 @@ double void_fraction(const Bed& bed, double z1, double z2) {
   return 1.0 - solid[0] / (bed.container->cross_section_area() * (z2 - z1));
 }
 
-Profile radial_void_fraction(const Bed& bed, const Cylinder& cyl, double bin, double z1, double z2) {
-  const double R = cyl.radius();
-  const std::size_t bins = static_cast<std::size_t>(std::ceil(R / bin - 1e-9));
-  // Edge k is the cylinder of radius R - k bin (k = 0 the wall); the last edge is the axis.
-  auto edge = [&](std::size_t k) { return std::max(0.0, R - static_cast<double>(k) * bin); };
+Profile radial_void_fraction(const Bed& bed, double wall, double end, double bin, double z1, double z2) {
+  const double span = std::abs(end - wall), dir = end < wall ? -1.0 : 1.0;
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(span / bin - 1e-9));
+  // Edge k is the coaxial cylinder at distance k bin from the wall; the last edge is `end`.
+  auto edge = [&](std::size_t k) { return wall + dir * std::min(span, static_cast<double>(k) * bin); };
   const auto solid = accumulate_bins(bed.size(), bins, [&](std::size_t i, std::vector<double>& acc) {
     const double r = 0.5 * bed.diameters[i];
     const auto& c = bed.centres[i];
     const double s = std::hypot(c.x(), c.y());
     if (c.z() + r <= z1 || c.z() - r >= z2) return;
-    // Cumulative volume inside each edge radius; shells are differences, so they add up to the
-    // sphere's slab volume exactly.
-    double outer = sphere_cylinder_volume(r, s, c.z(), edge(0), z1, z2);
+    // Volume of the sphere's slab part inside the cylinder of radius rho; shells are differences
+    // of it, so they add up to the sphere's slab volume exactly.
+    const double whole = sphere_slab_volume(r, c.z(), z1, z2);
+    auto inside = [&](double rho) {
+      if (rho <= s - r) return 0.0;
+      if (rho >= s + r) return whole;
+      return sphere_cylinder_volume(r, s, c.z(), rho, z1, z2);
+    };
+    double prev = inside(edge(0));
     for (std::size_t k = 0; k < bins; ++k) {
-      const double rho = edge(k + 1);
-      const double inner = rho <= s - r ? 0.0 : sphere_cylinder_volume(r, s, c.z(), rho, z1, z2);
-      acc[k] += outer - inner;
-      outer = inner;
-      if (outer == 0.0) break;
+      const double lo = std::min(edge(k), edge(k + 1)), hi = std::max(edge(k), edge(k + 1));
+      if (hi <= s - r || lo >= s + r) {  // the shell misses the sphere
+        prev = inside(edge(k + 1));
+        continue;
+      }
+      const double next = inside(edge(k + 1));
+      acc[k] += std::abs(prev - next);
+      prev = next;
     }
   });
   Profile p;
   for (std::size_t k = 0; k < bins; ++k) {
-    const double ro = edge(k), ri = edge(k + 1);
-    const double shell = std::numbers::pi * (ro * ro - ri * ri) * (z2 - z1);
-    p.position.push_back(R - 0.5 * (ro + ri));
+    const double a = edge(k), b = edge(k + 1);
+    const double shell = std::numbers::pi * std::abs(a * a - b * b) * (z2 - z1);
+    p.position.push_back(0.5 * (a + b - 2.0 * wall) * dir);
     p.void_fraction.push_back(1.0 - solid[k] / shell);
   }
   return p;
@@ -90,29 +99,26 @@ Profile axial_void_fraction(const Bed& bed, double bin, double top) {
   return p;
 }
 
-CentreDistribution radial_centre_distribution(const Bed& bed, const Cylinder& cyl, double bin, double z1, double z2) {
-  const double R = cyl.radius();
-  const std::size_t bins = static_cast<std::size_t>(std::ceil(R / bin - 1e-9));
+CentreDistribution radial_centre_distribution(const Bed& bed, double wall, double end, double bin, double z1,
+                                              double z2, double reachable_area) {
+  const double span = std::abs(end - wall), dir = end < wall ? -1.0 : 1.0;
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(span / bin - 1e-9));
   std::vector<double> count(bins, 0.0);
   double total = 0.0;
   for (std::size_t i = 0; i < bed.size(); ++i) {
     const auto& c = bed.centres[i];
     if (c.z() < z1 || c.z() >= z2) continue;
-    const double x = R - std::hypot(c.x(), c.y());
-    const std::size_t k = std::min(bins - 1, static_cast<std::size_t>(std::max(0.0, x) / bin));
-    count[k] += 1.0;
     total += 1.0;
+    const double x = dir * (std::hypot(c.x(), c.y()) - wall);  // distance from this wall
+    if (x > span) continue;  // nearer the other wall: counted there
+    count[std::min(bins - 1, static_cast<std::size_t>(std::max(0.0, x) / bin))] += 1.0;
   }
   CentreDistribution out;
-  // Mean density over the region centres can occupy (at least half the mean diameter from the wall).
-  double d_mean = 0.0;
-  for (double d : bed.diameters) d_mean += d / static_cast<double>(bed.size());
-  const double reach = std::max(0.0, R - 0.5 * d_mean);
-  const double mean_density = total / (std::numbers::pi * std::max(reach * reach, 1e-300));
+  const double mean_density = total / std::max(reachable_area, 1e-300);
   for (std::size_t k = 0; k < bins; ++k) {
-    const double ro = std::max(0.0, R - static_cast<double>(k) * bin), ri = std::max(0.0, ro - bin);
-    const double area = std::numbers::pi * (ro * ro - ri * ri);
-    out.position.push_back(R - 0.5 * (ro + ri));
+    const double a = wall + dir * static_cast<double>(k) * bin, b = wall + dir * std::min(span, (k + 1.0) * bin);
+    const double area = std::numbers::pi * std::abs(a * a - b * b);
+    out.position.push_back(0.5 * (a + b - 2.0 * wall) * dir);
     out.fraction.push_back(total > 0 ? count[k] / total : 0.0);
     out.relative_density.push_back(total > 0 && area > 0 ? count[k] / area / mean_density : 0.0);
   }

@@ -19,22 +19,26 @@ struct Profile {
   std::vector<double> void_fraction; // per bin
 };
 
-// Radial profile of a cylinder bed between heights z1 and z2: bins of width `bin` (m) measured
-// from the wall inward, void fraction of each cylindrical shell from exact sphere-shell volumes
-// (the volume-intersection method of Abreu et al. 1999). The innermost bin ends at the axis.
-Profile radial_void_fraction(const Bed& bed, const Cylinder& cylinder, double bin, double z1, double z2);
+// Radial profile between heights z1 and z2 over coaxial shells of width `bin` (m), measured from
+// a wall at radius `wall` towards radius `end` (m; inward from a cylinder wall to the axis, or
+// outward from an annulus' inner wall), void fraction of each shell from exact sphere-shell
+// volumes (the volume-intersection method of Abreu et al. 1999). Positions are distances from
+// the wall; the last bin ends at `end`.
+Profile radial_void_fraction(const Bed& bed, double wall, double end, double bin, double z1, double z2);
 
 // Axial profile: slabs of height `bin` (m) from the floor to `top` (m).
 Profile axial_void_fraction(const Bed& bed, double bin, double top);
 
-// Radial distribution of sphere centres with z1 <= z < z2 over wall distance bins of width `bin`
-// (m): the fraction of those centres per bin and their number density per unit annulus volume
-// relative to the mean number density of centres in the whole annulus region they can reach.
+// Radial distribution of sphere centres with z1 <= z < z2 over bins of width `bin` (m) from the
+// wall at radius `wall` towards `end` (as radial_void_fraction): the fraction of all those
+// centres per bin, and their number density per unit area relative to the mean over
+// `reachable_area` (m^2, the cross-section centres can reach).
 struct CentreDistribution {
   std::vector<double> position;  // bin centre, distance from the wall (m)
   std::vector<double> fraction;
   std::vector<double> relative_density;
 };
-CentreDistribution radial_centre_distribution(const Bed& bed, const Cylinder& cylinder, double bin, double z1, double z2);
+CentreDistribution radial_centre_distribution(const Bed& bed, double wall, double end, double bin, double z1,
+                                              double z2, double reachable_area);
 
 }  // namespace bedforge::analysis

@@ -33,25 +33,129 @@ std::unique_ptr<Container> Cylinder::scaled(double factor) const { return std::m
 
 nlohmann::json Cylinder::to_json() const { return {{"type", "cylinder"}, {"diameter", 2.0 * radius_}}; }
 
+double Annulus::cross_section_area() const { return std::numbers::pi * (outer_ * outer_ - inner_ * inner_); }
+
+int Annulus::wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const {
+  const double rho = std::sqrt(c.x() * c.x() + c.y() * c.y());
+  // Outward radial unit vector; on the axis (deep inside the inner wall) any direction will do.
+  const Eigen::Vector3d e = rho > 0.0 ? Eigen::Vector3d(c.x() / rho, c.y() / rho, 0.0) : Eigen::Vector3d(1, 0, 0);
+  int n = 0;
+  if (const double o = rho + r - outer_; o > 0.0) out[n++] = {o, -e};
+  if (const double o = inner_ + r - rho; o > 0.0) out[n++] = {o, e};
+  return n;
+}
+
+Eigen::Vector2d Annulus::sample_centre(Rng& rng, double r) const {
+  // Uniform over the ring of allowed centres: rho^2 uniform between its bounds.
+  const double lo = inner_ + r, hi = std::max(outer_ - r, lo);
+  const double rho = std::sqrt(lo * lo + (hi * hi - lo * lo) * rng.uniform());
+  const double theta = 2.0 * std::numbers::pi * rng.uniform();
+  return {rho * std::cos(theta), rho * std::sin(theta)};
+}
+
+std::unique_ptr<Container> Annulus::scaled(double factor) const {
+  return std::make_unique<Annulus>(outer_ * factor, inner_ * factor);
+}
+
+nlohmann::json Annulus::to_json() const {
+  return {{"type", "annulus"}, {"diameter", 2.0 * outer_}, {"inner_diameter", 2.0 * inner_}};
+}
+
+int Box::wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const {
+  int n = 0;
+  if (!px_) {
+    if (const double o = r - (c.x() + 0.5 * lx_); o > 0.0) out[n++] = {o, {1, 0, 0}};
+    if (const double o = c.x() + r - 0.5 * lx_; o > 0.0) out[n++] = {o, {-1, 0, 0}};
+  }
+  if (!py_) {
+    if (const double o = r - (c.y() + 0.5 * ly_); o > 0.0) out[n++] = {o, {0, 1, 0}};
+    if (const double o = c.y() + r - 0.5 * ly_; o > 0.0) out[n++] = {o, {0, -1, 0}};
+  }
+  return n;
+}
+
+Eigen::Vector2d Box::sample_centre(Rng& rng, double r) const {
+  const double hx = px_ ? 0.5 * lx_ : std::max(0.5 * lx_ - r, 0.0), hy = py_ ? 0.5 * ly_ : std::max(0.5 * ly_ - r, 0.0);
+  const double x = hx * (2.0 * rng.uniform() - 1.0);
+  return {x, hy * (2.0 * rng.uniform() - 1.0)};
+}
+
+double Box::max_radius() const {
+  // A periodic period of 3 largest diameters keeps every pair within one minimum image with
+  // room for a neighbour-list skin.
+  return std::min(px_ ? lx_ / 6.0 : 0.5 * lx_, py_ ? ly_ / 6.0 : 0.5 * ly_);
+}
+
+std::unique_ptr<Container> Box::scaled(double factor) const {
+  return std::make_unique<Box>(lx_ * factor, ly_ * factor, px_, py_);
+}
+
+nlohmann::json Box::to_json() const {
+  return {{"type", "box"}, {"size_x", lx_}, {"size_y", ly_}, {"periodic_x", px_}, {"periodic_y", py_}};
+}
+
+namespace {
+
+// A required length of [container] in metres.
+double required_length(SceneSection& s, const std::string& name, double d_ref_m, const std::string& what) {
+  const auto l = s.optional_length(name, Range::positive());
+  if (!l) throw InputError(fmt::format("{0}.{1}_d or {0}.{1}_m is required: {2}", s.name(), name, what));
+  return l->metres(d_ref_m);
+}
+
+std::string length_key(SceneSection& s, const std::string& name) {
+  return s.key_path(name + (s.has(name + "_m") ? "_m" : "_d"));
+}
+
+}  // namespace
+
 std::unique_ptr<Container> read_container(SceneSection& s, double d_ref_m, double d_max_m) {
-  const std::string type = s.choice("type", "cylinder", {"cylinder"});
-  const auto diameter = s.optional_length("diameter", Range::positive());
-  if (!diameter)
-    throw InputError(fmt::format("{0}.diameter_d (aspect ratio D/d) or {0}.diameter_m is required", s.name()));
-  const double D = diameter->metres(d_ref_m);
-  if (D < d_max_m * (1.0 - 1e-12))
-    throw InputError(fmt::format("{}: the container ({} m, D/d = {}) is narrower than the largest particle ({} m); "
-                                 "allowed: D >= largest diameter",
-                                 s.key_path(diameter->unit == Length::Unit::metres ? "diameter_m" : "diameter_d"), D,
-                                 D / d_ref_m, d_max_m));
-  return std::make_unique<Cylinder>(0.5 * D);
+  const std::string type = s.choice("type", "cylinder", {"cylinder", "annulus", "box"});
+  std::unique_ptr<Container> c;
+  std::string fit_key;
+  if (type == "box") {
+    const double lx = required_length(s, "size_x", d_ref_m, "the box width along x");
+    const double ly = required_length(s, "size_y", d_ref_m, "the box width along y");
+    c = std::make_unique<Box>(lx, ly, s.boolean("periodic_x", false), s.boolean("periodic_y", false));
+    fit_key = length_key(s, lx <= ly ? "size_x" : "size_y");
+  } else {
+    const double D = required_length(s, "diameter", d_ref_m, "the (outer) container diameter; D/d is the aspect ratio");
+    fit_key = length_key(s, "diameter");
+    if (type == "annulus") {
+      const double Di = required_length(s, "inner_diameter", d_ref_m, "the diameter of the inner cylinder");
+      if (Di >= D)
+        throw InputError(fmt::format("{}: the inner diameter ({} m) is not below the outer one ({} m); allowed: "
+                                     "inner_diameter < diameter",
+                                     length_key(s, "inner_diameter"), Di, D));
+      c = std::make_unique<Annulus>(0.5 * D, 0.5 * Di);
+    } else {
+      c = std::make_unique<Cylinder>(0.5 * D);
+    }
+  }
+  if (2.0 * c->max_radius() < d_max_m * (1.0 - 1e-12))
+    throw InputError(fmt::format("{}: the largest particle ({} m, {:.4g} d) does not fit in the {} ({}); allowed: "
+                                 "a {} of at least that width{}",
+                                 fit_key, d_max_m, d_max_m / d_ref_m, type, c->to_json().dump(),
+                                 type == "annulus" ? "gap" : type == "box" ? "side" : "diameter",
+                                 c->periodicity().any() ? " (3 diameters for a periodic side)" : ""));
+  return c;
 }
 
 std::unique_ptr<Container> container_from_json(const nlohmann::json& j) {
-  const std::string type = j.value("type", "");
-  if (type == "cylinder" && j.contains("diameter") && j["diameter"].is_number() && j["diameter"].get<double>() > 0)
-    return std::make_unique<Cylinder>(0.5 * j["diameter"].get<double>());
-  throw InputError(fmt::format("unrecognised container record {}; allowed: {{\"type\":\"cylinder\",\"diameter\":D>0}}",
+  auto positive = [&](const char* key) {
+    return j.contains(key) && j[key].is_number() && j[key].get<double>() > 0 ? j[key].get<double>() : -1.0;
+  };
+  const std::string type = j.is_object() ? j.value("type", "") : "";
+  if (type == "cylinder" && positive("diameter") > 0) return std::make_unique<Cylinder>(0.5 * positive("diameter"));
+  if (type == "annulus" && positive("diameter") > positive("inner_diameter") && positive("inner_diameter") > 0)
+    return std::make_unique<Annulus>(0.5 * positive("diameter"), 0.5 * positive("inner_diameter"));
+  if (type == "box" && positive("size_x") > 0 && positive("size_y") > 0)
+    return std::make_unique<Box>(positive("size_x"), positive("size_y"), j.value("periodic_x", false),
+                                 j.value("periodic_y", false));
+  throw InputError(fmt::format("unrecognised container record {}; allowed: {{\"type\":\"cylinder\",\"diameter\":D}}, "
+                               "{{\"type\":\"annulus\",\"diameter\":D,\"inner_diameter\":Di<D}}, "
+                               "{{\"type\":\"box\",\"size_x\":Lx,\"size_y\":Ly,\"periodic_x\":bool,"
+                               "\"periodic_y\":bool}}, lengths > 0",
                                j.dump()));
 }
 

@@ -2,6 +2,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -16,8 +17,30 @@ struct WallContact {
   Eigen::Vector3d normal;  // unit vector from the wall into the container: the direction of the wall force
 };
 
-// The vessel a bed is packed in. Its axis is z, the rigid floor is z = 0, the top is open, and
-// the lateral walls are deformable (they push overlapping spheres back with a linear force).
+// Periodic sides of a container: period along x and y, 0 where the side is a wall. Periodic
+// images are taken by the minimum-image rule, so a period must exceed twice the interaction
+// reach (Box enforces 3 largest diameters).
+struct Periodicity {
+  double lx = 0.0, ly = 0.0;
+  bool any() const { return lx > 0.0 || ly > 0.0; }
+  // a - b, shortest over periodic images.
+  Eigen::Vector3d separation(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+    Eigen::Vector3d d = a - b;
+    if (lx > 0.0) d.x() -= lx * std::nearbyint(d.x() / lx);
+    if (ly > 0.0) d.y() -= ly * std::nearbyint(d.y() / ly);
+    return d;
+  }
+  // The image of p in the central cell [-L/2, L/2) of each periodic direction.
+  Eigen::Vector3d wrapped(Eigen::Vector3d p) const {
+    if (lx > 0.0) p.x() -= lx * std::floor(p.x() / lx + 0.5);
+    if (ly > 0.0) p.y() -= ly * std::floor(p.y() / ly + 0.5);
+    return p;
+  }
+};
+
+// The vessel a bed is packed in. Its axis is z, the rigid floor is z = 0, the top is open. The
+// soft-sphere packer treats lateral walls as deformable (a linear force pushes overlapping
+// spheres back); the Monte Carlo packer as hard (wall_contacts must return none).
 // The packers and the analysis see containers only through this interface.
 class Container {
  public:
@@ -27,11 +50,15 @@ class Container {
   virtual std::string kind() const = 0;
   // Cross-section area (length^2).
   virtual double cross_section_area() const = 0;
-  // Walls overlapped by the sphere (centre c, radius r): writes up to kMaxWallContacts, returns count.
+  // Walls overlapped by the sphere (centre c, radius r): writes up to kMaxWallContacts, returns
+  // count. Periodic sides have no walls.
   virtual int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const = 0;
   // Uniformly random (x, y) of a centre whose sphere of radius r lies inside the walls.
   virtual Eigen::Vector2d sample_centre(Rng& rng, double r) const = 0;
-  // Largest radius of a sphere that fits between the walls.
+  // Periodic sides (none by default).
+  virtual Periodicity periodicity() const { return {}; }
+  // Largest radius of a sphere that fits between the walls (and, for periodic sides, the
+  // largest the minimum-image rule allows).
   virtual double max_radius() const = 0;
   // Bounding box of the cross-section as (xmin, ymin, xmax, ymax).
   virtual Eigen::Vector4d lateral_bounds() const = 0;
@@ -60,8 +87,55 @@ class Cylinder final : public Container {
   double radius_;
 };
 
-// Reads [container] (`type`, `diameter_m` | `diameter_d`) into a container in metres;
-// `d_ref_m` converts lengths given in diameters. InputError when a sphere of `d_max_m` cannot fit.
+// Annular gap between two coaxial cylinders (radii R_inner < R_outer); Abreu et al. (1999)
+// use it to compare a concave outer wall with a convex inner one.
+class Annulus final : public Container {
+ public:
+  Annulus(double outer_radius, double inner_radius) : outer_(outer_radius), inner_(inner_radius) {}
+  double outer_radius() const { return outer_; }
+  double inner_radius() const { return inner_; }
+
+  std::string kind() const override { return "annulus"; }
+  double cross_section_area() const override;
+  int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const override;
+  Eigen::Vector2d sample_centre(Rng& rng, double r) const override;
+  double max_radius() const override { return 0.5 * (outer_ - inner_); }
+  Eigen::Vector4d lateral_bounds() const override { return {-outer_, -outer_, outer_, outer_}; }
+  std::unique_ptr<Container> scaled(double factor) const override;
+  nlohmann::json to_json() const override;
+
+ private:
+  double outer_, inner_;
+};
+
+// Rectangular box [-Lx/2, Lx/2] x [-Ly/2, Ly/2]; each pair of opposite sides is either a pair
+// of walls or periodic (a box periodic on both sides stands for an unbounded bed).
+class Box final : public Container {
+ public:
+  Box(double size_x, double size_y, bool periodic_x, bool periodic_y)
+      : lx_(size_x), ly_(size_y), px_(periodic_x), py_(periodic_y) {}
+  double size_x() const { return lx_; }
+  double size_y() const { return ly_; }
+
+  std::string kind() const override { return "box"; }
+  double cross_section_area() const override { return lx_ * ly_; }
+  int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const override;
+  Eigen::Vector2d sample_centre(Rng& rng, double r) const override;
+  Periodicity periodicity() const override { return {px_ ? lx_ : 0.0, py_ ? ly_ : 0.0}; }
+  double max_radius() const override;
+  Eigen::Vector4d lateral_bounds() const override { return {-0.5 * lx_, -0.5 * ly_, 0.5 * lx_, 0.5 * ly_}; }
+  std::unique_ptr<Container> scaled(double factor) const override;
+  nlohmann::json to_json() const override;
+
+ private:
+  double lx_, ly_;
+  bool px_, py_;
+};
+
+// Reads [container] into a container in metres: `type` = cylinder (`diameter`), annulus
+// (`diameter`, `inner_diameter`) or box (`size_x`, `size_y`, `periodic_x`, `periodic_y`), each
+// length as `_m` or `_d`; `d_ref_m` converts lengths given in diameters. InputError when a
+// sphere of `d_max_m` cannot fit.
 std::unique_ptr<Container> read_container(SceneSection& section, double d_ref_m, double d_max_m);
 
 // The container recorded by `to_json()` (metres), e.g. from a bed file's header.

@@ -39,7 +39,9 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
   const long nz = std::clamp(static_cast<long>((z_hi - z_lo) / h) + 1, 1L, max_nz);
   const double hz = std::max(h, (z_hi - z_lo) / static_cast<double>(nz) * (1.0 + 1e-12));
   auto clampi = [](double v, long hi) { return std::clamp(static_cast<long>(std::floor(v)), 0L, hi - 1); };
-  auto cell_of = [&](const Eigen::Vector3d& p, long& cx, long& cy, long& cz) {
+  const Periodicity per = container.periodicity();
+  auto cell_of = [&](const Eigen::Vector3d& q, long& cx, long& cy, long& cz) {
+    const Eigen::Vector3d p = per.wrapped(q);
     cx = clampi((p.x() - b[0]) / hx, nx);
     cy = clampi((p.y() - b[1]) / hy, ny);
     cz = clampi((p.z() - z_lo) / hz, nz);
@@ -80,14 +82,25 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
       for (long dz = -1; dz <= 1; ++dz)
         for (long dy = -1; dy <= 1; ++dy)
           for (long dx = -1; dx <= 1; ++dx) {
-            const long X = cx + dx, Y = cy + dy, Z = cz + dz;
+            long X = cx + dx, Y = cy + dy;
+            const long Z = cz + dz;
+            // Periodic sides wrap around; with fewer than 3 cells across, a wrapped cell would
+            // be visited twice, so only the first visit counts.
+            if (per.lx > 0.0) {
+              X = (X + nx) % nx;
+              if (nx < 3 && dx != -1 && (X == (cx - 1 + nx) % nx || (dx == 1 && X == cx))) continue;
+            }
+            if (per.ly > 0.0) {
+              Y = (Y + ny) % ny;
+              if (ny < 3 && dy != -1 && (Y == (cy - 1 + ny) % ny || (dy == 1 && Y == cy))) continue;
+            }
             if (X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
             const long c = (Z * ny + Y) * nx + X;
             for (std::size_t k = start[c]; k < start[c + 1]; ++k) {
               const int j = sorted[k];
               if (static_cast<std::size_t>(j) == i) continue;
               const double reach = r[i] + r[j] + skin_;
-              if ((x[j] - x[i]).squaredNorm() >= reach * reach) continue;
+              if (per.separation(x[j], x[i]).squaredNorm() >= reach * reach) continue;
               if (count < capacity_) row[count] = j;
               ++count;
             }

@@ -11,13 +11,14 @@ void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Containe
   out.push.resize(n);
   std::vector<double> energy(n);
   double max_pair = 0.0, max_wall = 0.0;
+  const Periodicity per = c.periodicity();
 #pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall)
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector3d push = Eigen::Vector3d::Zero();
     double e = 0.0;
     const Eigen::Vector3d& xi = s.x[i];
     for (int j : nl.of(i)) {
-      const Eigen::Vector3d d = xi - s.x[j];
+      const Eigen::Vector3d d = per.separation(xi, s.x[j]);
       const double reach = s.r[i] + s.r[j], dist2 = d.squaredNorm();
       if (dist2 >= reach * reach) continue;  // most listed pairs do not touch: skip the sqrt
       const double dist = std::sqrt(dist2);
@@ -49,6 +50,7 @@ double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, c
   for (std::size_t i = 0; i < n; ++i)  // a fixed start with no symmetry to hide modes behind
     v[i] = Eigen::Vector3d(std::sin(1.0 + 3.1 * i), std::cos(2.0 + 1.7 * i), std::sin(0.5 + 2.3 * i));
   double lambda = 0.0;
+  const Periodicity per = c.periodicity();
   for (int it = 0; it < iterations; ++it) {
     const double norm = std::sqrt(deterministic_sum(n, [&](std::size_t i) { return v[i].squaredNorm(); }));
     if (!(norm > 0.0)) return lambda;
@@ -57,7 +59,7 @@ double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, c
     for (std::size_t i = 0; i < n; ++i) {
       Eigen::Vector3d h = Eigen::Vector3d::Zero();
       for (int j : nl.of(i)) {
-        const Eigen::Vector3d d = s.x[i] - s.x[j];
+        const Eigen::Vector3d d = per.separation(s.x[i], s.x[j]);
         const double reach = s.r[i] + s.r[j], dist2 = d.squaredNorm();
         if (dist2 >= reach * reach || dist2 == 0.0) continue;
         const Eigen::Vector3d nij = d / std::sqrt(dist2);

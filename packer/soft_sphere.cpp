@@ -30,7 +30,8 @@ SoftSphereParams read_soft_sphere_params(SceneSection& s) {
   p.force_tolerance = s.number("force_tolerance", p.force_tolerance, positive);
   p.max_iterations = s.integer("max_iterations", p.max_iterations, 1, 1'000'000'000'000);
   p.max_recoveries = static_cast<int>(s.integer("max_recoveries", p.max_recoveries, 0, 60));
-  p.neighbour_skin_d = s.number("neighbour_skin_d", p.neighbour_skin_d, Range::open(0.0, 10.0));
+  // At most half a diameter, so a periodic side of 3 diameters holds each pair once.
+  p.neighbour_skin_d = s.number("neighbour_skin_d", p.neighbour_skin_d, Range{0.0, 0.5, true, false});
   if (p.overlap_band_lower_d >= p.overlap_band_upper_d)
     throw InputError(fmt::format("{}: overlap_band_lower_d = {} is not below overlap_band_upper_d = {}; allowed: "
                                  "lower < upper",
@@ -107,7 +108,7 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
   PackResult out;
   out.bed.container = container.scaled(1.0);
   for (std::size_t i = 0; i < s.size(); ++i) {
-    out.bed.centres.push_back(s.x[i] * d_ref);
+    out.bed.centres.push_back(box->periodicity().wrapped(s.x[i]) * d_ref);
     out.bed.diameters.push_back(d[gen.order[i]]);
   }
   nlohmann::json run = log.to_json();

@@ -35,7 +35,7 @@ TEST(BedAnalysis, RadialProfileHasTheWallFeatures) {
   // spheres, about n pi h r of solid with n ~ 1 sphere per d^2, so eps -> 1 linearly in h.
   const Bed& bed = bed_at_7_99();
   const auto& cyl = dynamic_cast<const Cylinder&>(*bed.container);
-  const double thin = analysis::radial_void_fraction(bed, cyl, 0.002, 2.0, 14.0).void_fraction.front();
+  const double thin = analysis::radial_void_fraction(bed, cyl.radius(), 0.0, 0.002, 2.0, 14.0).void_fraction.front();
   EXPECT_GT(thin, 0.99);
   EXPECT_LT(j["wall_bin"].get<double>(), thin);  // the 0.05 d bin holds more of those caps
   // [A] first minimum at z ~ 0.5 d, value about 0.20-0.26 (wider band for one bed of 1200).

@@ -51,8 +51,7 @@ TEST(VoidFraction, RadialProfileOfOneSphereOnTheAxis) {
   b.container = std::make_shared<Cylinder>(1.0);
   b.centres = {{0, 0, 0.5}};
   b.diameters = {1.0};
-  const Cylinder& c = dynamic_cast<const Cylinder&>(*b.container);
-  const Profile p = radial_void_fraction(b, c, 0.1, 0.0, 1.0);
+  const Profile p = radial_void_fraction(b, 1.0, 0.0, 0.1, 0.0, 1.0);
   ASSERT_EQ(p.position.size(), 10u);
   for (size_t k = 0; k < p.position.size(); ++k) {
     const double ro = 1.0 - 0.1 * k, ri = ro - 0.1;
@@ -69,8 +68,7 @@ TEST(VoidFraction, RadialProfileOfOneSphereOnTheAxis) {
 
 TEST(VoidFraction, RadialProfileVolumeWeightedMeanIsTheSlabValue) {
   const Bed b = lattice_column(5, 4);
-  const Cylinder& c = dynamic_cast<const Cylinder&>(*b.container);
-  const Profile p = radial_void_fraction(b, c, 0.07, 0.3, 3.3);
+  const Profile p = radial_void_fraction(b, 10.0, 0.0, 0.07, 0.3, 3.3);
   double solid = 0.0;
   for (size_t k = 0; k < p.position.size(); ++k) {
     const double ro = std::max(0.0, 10.0 - 0.07 * k), ri = std::max(0.0, ro - 0.07);
@@ -88,6 +86,32 @@ TEST(VoidFraction, CentreDistributionOfAWallLayer) {
     b.centres.emplace_back(2.0 * std::cos(t), 2.0 * std::sin(t), 0.5 + i);
     b.diameters.push_back(1.0);
   }
-  const CentreDistribution d = radial_centre_distribution(b, dynamic_cast<const Cylinder&>(*b.container), 0.05, 0, 100);
+  const CentreDistribution d = radial_centre_distribution(b, 2.5, 0.0, 0.05, 0, 100, kPi * 2.0 * 2.0);
   EXPECT_NEAR(d.fraction[10], 1.0, 1e-12);  // bin [0.5, 0.55)
+}
+
+TEST(VoidFraction, AnnulusProfilesFromBothWallsAddUpToTheSlabValue) {
+  // Spheres scattered through an annulus (R_in = 2, R_out = 6): the shells of the two profiles
+  // (outer wall to mid-gap, inner wall to mid-gap) tile the gap, so their solid adds up to the
+  // slab's exactly.
+  Bed b;
+  b.container = std::make_shared<Annulus>(6.0, 2.0);
+  for (int i = 0; i < 40; ++i) {
+    const double t = 0.7 * i, rho = 2.5 + 3.0 * (0.5 + 0.5 * std::sin(1.3 * i));
+    b.centres.emplace_back(rho * std::cos(t), rho * std::sin(t), 0.5 + 0.37 * i);
+    b.diameters.push_back(1.0);
+  }
+  const double z1 = 1.0, z2 = 12.0;
+  const Profile outer = radial_void_fraction(b, 6.0, 4.0, 0.1, z1, z2);
+  const Profile inner = radial_void_fraction(b, 2.0, 4.0, 0.1, z1, z2);
+  ASSERT_EQ(outer.position.size(), 20u);
+  ASSERT_EQ(inner.position.size(), 20u);
+  EXPECT_NEAR(inner.position.front(), 0.05, 1e-12);  // distances from the inner wall, outward
+  double solid = 0.0;
+  for (size_t k = 0; k < 20; ++k) {
+    const double a = 6.0 - 0.1 * k, bo = a - 0.1, c = 2.0 + 0.1 * k, ci = c + 0.1;
+    solid += (1 - outer.void_fraction[k]) * kPi * (a * a - bo * bo) * (z2 - z1);
+    solid += (1 - inner.void_fraction[k]) * kPi * (ci * ci - c * c) * (z2 - z1);
+  }
+  EXPECT_NEAR(1 - solid / (kPi * (36.0 - 4.0) * (z2 - z1)), void_fraction(b, z1, z2), 1e-10);
 }

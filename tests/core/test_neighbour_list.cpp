@@ -9,11 +9,11 @@ using namespace bedforge;
 namespace {
 
 std::set<std::pair<int, int>> brute_force(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& r,
-                                          double skin) {
+                                          double skin, Periodicity per = {}) {
   std::set<std::pair<int, int>> pairs;
   for (size_t i = 0; i < x.size(); ++i)
     for (size_t j = 0; j < x.size(); ++j)
-      if (i != j && (x[i] - x[j]).norm() < r[i] + r[j] + skin) pairs.insert({int(i), int(j)});
+      if (i != j && per.separation(x[i], x[j]).norm() < r[i] + r[j] + skin) pairs.insert({int(i), int(j)});
   return pairs;
 }
 
@@ -64,4 +64,23 @@ TEST(NeighbourList, SurvivesSpheresThrownFarApart) {
   NeighbourList nl(0.1);
   nl.build(x, r, c);
   EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.1));
+}
+
+TEST(NeighbourList, FindsPairsAcrossPeriodicSides) {
+  // Periodic along x with only 2 and 3 cells across (the cases where a wrapped cell repeats),
+  // walls along y; positions given outside the central cell must be wrapped too.
+  for (double lx : {3.0, 3.7, 5.0}) {
+    Box box(lx, 4.0, true, false);
+    Rng rng(3);
+    std::vector<Eigen::Vector3d> x;
+    std::vector<double> r;
+    for (int i = 0; i < 300; ++i) {
+      const auto p = box.sample_centre(rng, 0.5);
+      x.emplace_back(p.x() + lx * (i % 3 - 1), p.y(), 20.0 * rng.uniform());
+      r.push_back(i % 4 == 0 ? 0.5 : 0.35);
+    }
+    NeighbourList nl(0.2);
+    nl.build(x, r, box);
+    EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.2, box.periodicity())) << "Lx = " << lx;
+  }
 }
