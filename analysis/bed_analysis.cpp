@@ -8,6 +8,8 @@
 #include <numbers>
 
 #include "analysis/contact_statistics.hpp"
+#include "analysis/line_intersection.hpp"
+#include "analysis/segregation.hpp"
 #include "analysis/void_fraction.hpp"
 #include "core/error.hpp"
 
@@ -42,6 +44,8 @@ AnalysisParams read_analysis_params(SceneSection& s) {
   p.radial_bin_d = s.number("radial_bin_d", p.radial_bin_d, Range::open(0.0, 10.0));
   p.axial_bin_d = s.number("axial_bin_d", p.axial_bin_d, Range::open(0.0, 10.0));
   p.contact_tolerance_d = s.number("contact_tolerance_d", p.contact_tolerance_d, Range::closed(0.0, 0.5));
+  p.line_intersection = s.boolean("line_intersection", p.line_intersection);
+  p.line_step_d = s.number("line_step_d", p.line_step_d, Range::open(0.0, 1.0));
   return p;
 }
 
@@ -49,7 +53,9 @@ nlohmann::json to_json(const AnalysisParams& p) {
   return {{"exclude_d", p.exclude_d},
           {"radial_bin_d", p.radial_bin_d},
           {"axial_bin_d", p.axial_bin_d},
-          {"contact_tolerance_d", p.contact_tolerance_d}};
+          {"contact_tolerance_d", p.contact_tolerance_d},
+          {"line_intersection", p.line_intersection},
+          {"line_step_d", p.line_step_d}};
 }
 
 nlohmann::json void_fraction_summary(const Bed& bed, const AnalysisParams& p) {
@@ -126,12 +132,46 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
                  {"first_minimum", min_v},
                  {"first_minimum_at_d", min_at},
                  {"bin_d", p.radial_bin_d}};
+    if (p.line_intersection) {
+      // The same bins by line intersection, and how far the two methods differ.
+      const Profile line = line_radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, p.line_step_d * d);
+      csv = "# radial void fraction by line intersection (circle at the bin's middle radius), z from " +
+            fmt::format("{} to {} m", z1, z2) + "\nwall_distance_d,wall_distance_m,void_fraction\n";
+      double worst = 0.0, mean = 0.0;
+      for (std::size_t k = 0; k < line.position.size(); ++k) {
+        csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", line.position[k] / d, line.position[k], line.void_fraction[k]);
+        worst = std::max(worst, std::abs(line.void_fraction[k] - radial.void_fraction[k]));
+        mean += std::abs(line.void_fraction[k] - radial.void_fraction[k]) / static_cast<double>(line.position.size());
+      }
+      out.csv_files[w.name + "_line.csv"] = csv;
+      j[w.name]["line_intersection"] = {{"max_abs_difference_to_volume", worst}, {"mean_abs_difference_to_volume", mean}};
+    }
   }
   const Profile axial = axial_void_fraction(bed, p.axial_bin_d * d, h);
   std::string csv = "# axial void fraction over the whole cross-section\nz_d,z_m,void_fraction\n";
   for (std::size_t k = 0; k < axial.position.size(); ++k)
     csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", axial.position[k] / d, axial.position[k], axial.void_fraction[k]);
   out.csv_files["axial_profile.csv"] = csv;
+
+  // Segregation of a mixture of a few sizes: per-species axial profiles and an index.
+  const double d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
+  const Segregation seg = axial_segregation(bed, d_max, h);
+  if (!seg.diameters.empty()) {
+    csv = "# solid volume fraction of each species per layer of one largest diameter\nz_d,z_m";
+    for (double ds : seg.diameters) csv += fmt::format(",species_d_{:.6g}_m", ds);
+    csv += "\n";
+    for (std::size_t k = 0; k < seg.z.size(); ++k) {
+      csv += fmt::format("{:.6g},{:.9g}", seg.z[k] / d, seg.z[k]);
+      for (const auto& f : seg.volume_fraction) csv += fmt::format(",{:.9g}", f[k]);
+      csv += "\n";
+    }
+    out.csv_files["species_profile.csv"] = csv;
+    j["segregation"] = {{"species_diameters_m", seg.diameters},
+                        {"mean_height_m", seg.mean_height},
+                        {"intensity", seg.intensity},
+                        {"index", "Danckwerts (1952) intensity of segregation of the largest species over layers "
+                                  "one largest diameter high: 0 mixed, 1 fully segregated"}};
+  }
 
   // Contacts and balance.
   const ContactStatistics cs = contact_statistics(bed, p.contact_tolerance_d * sc.d_min);

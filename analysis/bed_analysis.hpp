@@ -15,6 +15,8 @@ struct AnalysisParams {
   double radial_bin_d = 0.05;          // radial profile and centre distribution bin width
   double axial_bin_d = 0.05;           // axial profile bin height
   double contact_tolerance_d = 1e-4;   // largest surface gap still counted as a contact
+  bool line_intersection = false;      // also radial profiles by line intersection (Reyes & Iglesia)
+  double line_step_d = 0.02;           // height step of the line-intersection z-average
 };
 AnalysisParams read_analysis_params(SceneSection& section);
 nlohmann::json to_json(const AnalysisParams& p);

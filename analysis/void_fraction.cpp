@@ -5,28 +5,9 @@
 #include <numbers>
 
 #include "analysis/intersection_volumes.hpp"
+#include "core/parallel.hpp"
 
 namespace bedforge::analysis {
-
-namespace {
-
-// Adds, for every sphere, its contribution to every bin, in parallel but summed in an order
-// fixed by the bed alone (chunks of spheres in index order), so reruns give identical numbers.
-template <class PerSphere>
-std::vector<double> accumulate_bins(std::size_t spheres, std::size_t bins, PerSphere add) {
-  constexpr std::size_t kChunk = 1024;
-  const std::size_t chunks = (spheres + kChunk - 1) / kChunk;
-  std::vector<std::vector<double>> partial(chunks, std::vector<double>(bins, 0.0));
-#pragma omp parallel for schedule(dynamic)
-  for (std::size_t c = 0; c < chunks; ++c)
-    for (std::size_t i = c * kChunk; i < std::min(spheres, (c + 1) * kChunk); ++i) add(i, partial[c]);
-  std::vector<double> total(bins, 0.0);
-  for (const auto& p : partial)
-    for (std::size_t b = 0; b < bins; ++b) total[b] += p[b];
-  return total;
-}
-
-}  // namespace
 
 double bed_height(const Bed& bed) {
   double h = 0.0;

@@ -59,7 +59,9 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   } else {
     Progress progress("pack", console.progress);
     packer::PackResult r =
-        packer::pack_soft_sphere(scene.soft_sphere, scene.sizes, *scene.container, scene.count, scene.seed, progress);
+        scene.algorithm == "monte-carlo"
+            ? packer::pack_monte_carlo(scene.monte_carlo, scene.sizes, *scene.container, scene.count, scene.seed, progress)
+            : packer::pack_soft_sphere(scene.soft_sphere, scene.sizes, *scene.container, scene.count, scene.seed, progress);
     out.bed = std::move(r.bed);
     out.report = std::move(r.info);
   }
@@ -72,6 +74,13 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   std::string line;
   if (scene.algorithm == "import") {
     line = fmt::format("import: {} spheres from {}", out.bed.size(), scene.import_file.string());
+  } else if (scene.algorithm == "monte-carlo") {
+    line = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {} of {} "
+                       "shakes settled, no overlap",
+                       out.bed.size(), out.bed.container->kind(), out.report["cycles"].get<long>(),
+                       out.report["cycles_per_second"].get<double>(), out.report["mean_acceptance"].get<double>(),
+                       out.report["shakes"].size() - out.report["unsettled_shakes"].get<std::size_t>(),
+                       out.report["shakes"].size());
   } else {
     line = fmt::format("pack ({} {}): {} spheres, {} iterations, max overlap {:.2g} d (tol {:.2g}), residual {:.2g}",
                        out.report["algorithm"].get<std::string>(),
@@ -117,11 +126,30 @@ int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool w
 
 // Scene overrides from the command line, applied in the order given.
 struct Overrides {
-  std::optional<double> aspect_ratio, container_diameter_m, diameter_m, eps0, stiffness_step, tolerance;
-  std::optional<long long> count, seed, max_iterations;
-  std::optional<std::string> mode;
+  std::optional<double> aspect_ratio, container_diameter_m, inner_aspect_ratio, box_size_d, diameter_m, eps0,
+      stiffness_step, tolerance, temperature;
+  std::optional<long long> count, seed, max_iterations, shakes, settling_cycles, mixing_cycles;
+  std::optional<std::string> mode, algorithm, container;
+  bool periodic = false;
 
   void add_to(CLI::App& cmd) {
+    cmd.add_option("--algorithm", algorithm,
+                   "soft-sphere|monte-carlo, packing algorithm (sets packing.algorithm); default soft-sphere");
+    cmd.add_option("--container", container, "cylinder|annulus|box (sets container.type); default cylinder");
+    cmd.add_option("--inner-aspect-ratio", inner_aspect_ratio,
+                   "FLOAT, annulus inner diameter in particle diameters (sets container.inner_diameter_d); no default");
+    cmd.add_option("--box-size-d", box_size_d,
+                   "FLOAT, box side in particle diameters, both sides (sets container.size_x_d and size_y_d); no "
+                   "default");
+    cmd.add_flag("--periodic", periodic, "box with periodic sides (sets container.periodic_x and periodic_y)");
+    cmd.add_option("--temperature", temperature,
+                   "FLOAT > 0, Monte Carlo kT / (m* g d) (sets packing.monte_carlo.temperature); default 0.01");
+    cmd.add_option("--shakes", shakes, "INT >= 0, Monte Carlo shakes (sets packing.monte_carlo.shakes); default 10");
+    cmd.add_option("--mixing-cycles", mixing_cycles,
+                   "INT >= 0, Monte Carlo cycles without gravity (sets packing.monte_carlo.mixing_cycles); default 10000");
+    cmd.add_option("--settling-cycles", settling_cycles,
+                   "INT >= 0, Monte Carlo cycles after the shakes (sets packing.monte_carlo.settling_cycles); default "
+                   "100000");
     cmd.add_option("--aspect-ratio", aspect_ratio,
                    "FLOAT, container diameter in particle diameters D/d (sets container.diameter_d); no default");
     cmd.add_option("--container-diameter-m", container_diameter_m,
@@ -144,6 +172,21 @@ struct Overrides {
                    "INT, iteration cap over all stages (sets packing.soft_sphere.max_iterations); default 5000000");
   }
   void apply(toml::table& t) const {
+    if (algorithm) override_key(t, "packing.algorithm", *algorithm);
+    if (container) override_key(t, "container.type", *container);
+    if (inner_aspect_ratio) override_key(t, "container.inner_diameter_d", *inner_aspect_ratio);
+    if (box_size_d) {
+      override_key(t, "container.size_x_d", *box_size_d);
+      override_key(t, "container.size_y_d", *box_size_d);
+    }
+    if (periodic) {
+      override_key(t, "container.periodic_x", true);
+      override_key(t, "container.periodic_y", true);
+    }
+    if (temperature) override_key(t, "packing.monte_carlo.temperature", *temperature);
+    if (shakes) override_key(t, "packing.monte_carlo.shakes", *shakes);
+    if (mixing_cycles) override_key(t, "packing.monte_carlo.mixing_cycles", *mixing_cycles);
+    if (settling_cycles) override_key(t, "packing.monte_carlo.settling_cycles", *settling_cycles);
     if (aspect_ratio) override_key(t, "container.diameter_d", *aspect_ratio);
     if (container_diameter_m) override_key(t, "container.diameter_m", *container_diameter_m);
     if (count) override_key(t, "particles.count", *count);

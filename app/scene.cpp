@@ -50,11 +50,14 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   }
 
   SceneSection packing = root.sub("packing");
-  sc.algorithm = packing.choice("algorithm", "soft-sphere", {"soft-sphere", "import"});
+  sc.algorithm = packing.choice("algorithm", "soft-sphere", {"soft-sphere", "monte-carlo", "import"});
   sc.seed = static_cast<std::uint64_t>(packing.integer("seed", 1, 0, std::numeric_limits<long long>::max()));
   SceneSection soft = packing.sub("soft_sphere");
   sc.soft_sphere = packer::read_soft_sphere_params(soft);
   soft.finish();
+  SceneSection mc = packing.sub("monte_carlo");
+  sc.monte_carlo = packer::read_monte_carlo_params(mc);
+  mc.finish();
 
   double d_ref = 0.0, d_max = 0.0;
   ImportedBed imported;

@@ -11,21 +11,23 @@
 #include "analysis/bed_analysis.hpp"
 #include "core/container.hpp"
 #include "core/size_distribution.hpp"
+#include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
 
 namespace bedforge {
 
 // A scene: what to build and which outputs to write. Sections: [container], [particles],
-// [packing] (with [packing.soft_sphere]), [analysis], [outputs]. Lengths are given in metres
+// [packing] (with [packing.soft_sphere] and [packing.monte_carlo]), [analysis], [outputs]. Lengths are given in metres
 // (keys ending in _m) or in particle diameters (keys ending in _d).
 struct Scene {
   toml::table table;   // as run: the file plus command-line overrides
   std::string source;  // file name, or "command line"
 
   // [packing]
-  std::string algorithm = "soft-sphere";  // "soft-sphere" | "import"
+  std::string algorithm = "soft-sphere";  // "soft-sphere" | "monte-carlo" | "import"
   std::uint64_t seed = 1;
   packer::SoftSphereParams soft_sphere;
+  packer::MonteCarloParams monte_carlo;
   std::filesystem::path import_file;  // algorithm = "import": x y z d rows
   double import_to_metres = 1.0;
 

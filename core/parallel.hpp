@@ -25,4 +25,21 @@ double deterministic_sum(std::size_t n, F f) {
   return total;
 }
 
+// Per-bin totals of `add(i, acc)` over items i in [0, n) (add accumulates item i's share of
+// each bin into acc, `bins` long), in parallel but summed in an order fixed by n alone (chunks
+// of items in index order), so reruns on any thread count give identical numbers.
+template <class PerItem>
+std::vector<double> accumulate_bins(std::size_t n, std::size_t bins, PerItem add) {
+  constexpr std::size_t kChunk = 1024;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<double>> partial(chunks, std::vector<double>(bins, 0.0));
+#pragma omp parallel for schedule(dynamic)
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) add(i, partial[c]);
+  std::vector<double> total(bins, 0.0);
+  for (const auto& p : partial)
+    for (std::size_t b = 0; b < bins; ++b) total[b] += p[b];
+  return total;
+}
+
 }  // namespace bedforge

@@ -6,6 +6,7 @@
 #include "core/progress.hpp"
 #include "core/scene_section.hpp"
 #include "core/size_distribution.hpp"
+#include "packer/pack_result.hpp"
 
 namespace bedforge::packer {
 
@@ -40,11 +41,6 @@ struct SoftSphereSettings {
   double band_lower, band_upper, tolerance, skin, d_min;
 };
 SoftSphereSettings resolve(const SoftSphereParams& p, double d_ref_m, double d_min_m);
-
-struct PackResult {
-  Bed bed;              // metres
-  nlohmann::json info;  // iterations, time per stage, overlaps, residual, recoveries, history
-};
 
 // Packs `count` spheres drawn from `sizes` into `container` (metres) with `seed`.
 // Throws ConvergenceError when the tolerances cannot be reached within the iteration cap or

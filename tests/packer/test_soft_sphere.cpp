@@ -39,16 +39,18 @@ packer::PackResult pack(double a, long n, std::uint64_t seed, const SoftSpherePa
 // the tolerance (relative to the smallest diameter), checked independently of the packer.
 void expect_valid(const packer::PackResult& r, double tol_d = 1e-4) {
   const Bed& b = r.bed;
-  const double R = dynamic_cast<const Cylinder&>(*b.container).radius();
   const double d_min = *std::min_element(b.diameters.begin(), b.diameters.end());
+  const Periodicity per = b.container->periodicity();
   for (size_t i = 0; i < b.size(); ++i) {
     const auto& c = b.centres[i];
     const double ri = 0.5 * b.diameters[i];
     ASSERT_TRUE(c.allFinite()) << "sphere " << i;
-    EXPECT_LE(std::hypot(c.x(), c.y()) + ri - R, tol_d * d_min) << "sphere " << i << " crosses the wall";
+    WallContact w[Container::kMaxWallContacts];
+    const int nw = b.container->wall_contacts(c, ri, w);
+    for (int k = 0; k < nw; ++k) EXPECT_LE(w[k].overlap, tol_d * d_min) << "sphere " << i << " crosses a wall";
     EXPECT_GE(c.z() - ri, -tol_d * d_min) << "sphere " << i << " below the floor";
     for (size_t j = i + 1; j < b.size(); ++j) {
-      const double overlap = 0.5 * (b.diameters[i] + b.diameters[j]) - (c - b.centres[j]).norm();
+      const double overlap = 0.5 * (b.diameters[i] + b.diameters[j]) - per.separation(c, b.centres[j]).norm();
       EXPECT_LT(overlap, tol_d * d_min) << "spheres " << i << " and " << j;
     }
   }
@@ -98,6 +100,24 @@ TEST_P(BothModes, TwoSpheresInANarrowTube) {
   EXPECT_NEAR(lo.z(), 0.5, 1e-9);
   EXPECT_NEAR(hi.z() - lo.z(), std::sqrt(0.75), 2e-4);
   EXPECT_NEAR(std::hypot(hi.x() - lo.x(), hi.y() - lo.y()), 0.5, 2e-4);
+}
+
+TEST_P(BothModes, AnnulusAndPeriodicBox) {
+  // The containers of the Monte Carlo issue: a narrow annulus (gap 2.5 d) and a box periodic
+  // on both sides, where pairs act across the sides.
+  Progress quiet("test", false);
+  SoftSphereParams p = mode(GetParam());
+  const auto ann = packer::pack_soft_sphere(p, equal_spheres(), Annulus(4.0, 1.5), 150, 2, quiet);
+  expect_valid(ann);
+  const auto box = packer::pack_soft_sphere(p, equal_spheres(), Box(4.0, 4.0, true, true), 150, 2, quiet);
+  expect_valid(box);
+  int across = 0;  // pairs in contact only through a periodic side
+  const Periodicity per = box.bed.container->periodicity();
+  for (size_t i = 0; i < box.bed.size(); ++i)
+    for (size_t j = i + 1; j < box.bed.size(); ++j)
+      across += (box.bed.centres[i] - box.bed.centres[j]).norm() > 1.01 &&
+                per.separation(box.bed.centres[i], box.bed.centres[j]).norm() < 1.0001;
+  EXPECT_GT(across, 5);
 }
 
 TEST(SoftSphere, ZigZagColumnAndAWideShallowBed) {

@@ -1,0 +1,133 @@
+// The Monte Carlo packer's schedule end to end on small beds: validity, containers, errors.
+#include "packer/monte_carlo.hpp"
+
+#include <gtest/gtest.h>
+
+#include "analysis/contact_statistics.hpp"
+#include "analysis/void_fraction.hpp"
+#include "core/error.hpp"
+
+using namespace bedforge;
+using packer::MonteCarloParams;
+
+namespace {
+
+SizeDistribution spheres(std::vector<double> d, std::vector<double> fractions = {1.0}) {
+  SizeDistribution s;
+  s.kind = d.size() > 1 ? SizeDistribution::Kind::discrete : SizeDistribution::Kind::monodisperse;
+  s.diameters_m = std::move(d);
+  s.number_fractions = std::move(fractions);
+  return s;
+}
+
+MonteCarloParams short_schedule() {
+  MonteCarloParams p;
+  p.mixing_cycles = 200;
+  p.shakes = 2;  // the first shake's settling is the fall from the mixing height
+  p.settling_cycles = 1000;
+  return p;
+}
+
+packer::PackResult pack(const Container& c, long long n, std::uint64_t seed = 1, MonteCarloParams p = short_schedule(),
+                        const SizeDistribution& s = spheres({0.001})) {
+  Progress quiet("test", false);
+  return packer::pack_monte_carlo(p, s, c, n, seed, quiet);
+}
+
+void expect_valid(const Bed& bed) {
+  const auto st = analysis::contact_statistics(bed, 0.0);
+  EXPECT_EQ(st.max_pair_overlap, 0.0);
+  EXPECT_EQ(st.max_wall_overlap, 0.0);
+  EXPECT_EQ(st.max_floor_penetration, 0.0);
+}
+
+}  // namespace
+
+TEST(MonteCarlo, SettledCylinderBedIsValidAndDense) {
+  const Cylinder c(0.0025);  // a = 5
+  const auto r = pack(c, 200);
+  ASSERT_EQ(r.bed.size(), 200u);
+  expect_valid(r.bed);
+  // Below its rough top (2 d) the settled bed lies between random close packing (0.36) and
+  // loose random packing at a = 5 (Zou & Yu, loose: 0.475); it fell from a void fraction of 0.88.
+  const double eps = analysis::void_fraction(r.bed, 0.0, analysis::bed_height(r.bed) - 0.002);
+  EXPECT_GT(eps, 0.36);
+  EXPECT_LT(eps, 0.475);
+  for (const auto& s : r.info["shakes"]) EXPECT_TRUE(s["settled"].get<bool>());
+  EXPECT_GT(r.info["cycles_per_second"].get<double>(), 0.0);
+  EXPECT_EQ(r.info["shakes"].size(), 2u);
+}
+
+TEST(MonteCarlo, AnnulusAndPeriodicBoxBeds) {
+  const Annulus annulus(0.005, 0.002);
+  const Box box(0.004, 0.004, true, true);
+  for (const Container* c : {static_cast<const Container*>(&annulus), static_cast<const Container*>(&box)}) {
+    const auto r = pack(*c, 150);
+    expect_valid(r.bed);
+    for (const auto& x : r.bed.centres) {  // stored in the central periodic cell
+      EXPECT_LE(std::abs(x.x()), 0.005);
+      EXPECT_LE(std::abs(x.y()), 0.005);
+    }
+  }
+}
+
+TEST(MonteCarlo, ReproducibleBySeed) {
+  const Cylinder c(0.002);
+  MonteCarloParams p = short_schedule();
+  p.settling_cycles = 100;
+  const auto a = pack(c, 60, 7, p), b = pack(c, 60, 7, p), other = pack(c, 60, 8, p);
+  EXPECT_EQ(a.bed.centres, b.bed.centres);
+  EXPECT_NE(a.bed.centres, other.bed.centres);
+}
+
+TEST(MonteCarlo, ImpossibleInputsAreClearErrors) {
+  const Cylinder c(0.002);
+  auto message = [&](MonteCarloParams p, const SizeDistribution& s = spheres({0.001})) {
+    try {
+      pack(c, 100, 1, p, s);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  MonteCarloParams low = short_schedule();
+  low.mixing_height_d = 5.0;  // 100 spheres below 5 d in a = 4: solid fraction 0.83
+  EXPECT_NE(message(low).find("mixing_height_d"), std::string::npos);
+  MonteCarloParams three = short_schedule();
+  three.particle_density = {1000, 2000, 3000};
+  EXPECT_NE(message(three, spheres({0.001, 0.0012}, {0.5, 0.5})).find("particle_densities"), std::string::npos);
+
+  auto read = [](const std::string& text) {
+    const toml::table t = toml::parse(text);
+    SceneSection s(t["mc"].as_table(), "packing.monte_carlo");
+    return packer::read_monte_carlo_params(s);
+  };
+  auto read_message = [&](const std::string& text) {
+    try {
+      read(text);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(read_message("[mc]\ntemperature = 0").find("temperature"), std::string::npos);
+  EXPECT_NE(read_message("[mc]\nparticle_density = 0.5").find("particle_density"), std::string::npos);
+  EXPECT_NE(read_message("[mc]\nparticle_densities = [1000, 1.0]").find("particle_densities[1]"), std::string::npos);
+  EXPECT_NE(read_message("[mc]\ninitial_void_fraction = 0.5").find("initial_void_fraction"), std::string::npos);
+}
+
+TEST(MonteCarlo, DenserSpeciesSinks) {
+  // Equal sizes, densities 1000 and 3000 kg/m3: at a temperature where the light species is
+  // mobile, the heavy one gathers lower (the effective masses differ threefold).
+  const Cylinder c(0.003);
+  MonteCarloParams p = short_schedule();
+  p.particle_density = {1000.0, 3000.0};
+  p.temperature = 0.5;
+  p.settling_cycles = 3000;
+  Progress quiet("test", false);
+  const auto r = packer::pack_monte_carlo(p, spheres({0.001, 0.0010001}, {0.5, 0.5}), c, 120, 3, quiet);
+  double z_light = 0, z_heavy = 0;
+  for (size_t i = 0; i < r.bed.size(); ++i)
+    (r.bed.diameters[i] > 0.00100005 ? z_heavy : z_light) += r.bed.centres[i].z() / 60.0;
+  EXPECT_LT(z_heavy, z_light);
+}
