@@ -1,0 +1,245 @@
+#!/usr/bin/python3
+"""Validation and speed benchmark of the Monte Carlo packer (Abreu et al. 1999); writes
+docs/monte_carlo_validation.md, .json and PNG figures beside them.
+
+    /usr/bin/python3 tools/validate_monte_carlo.py               # everything, 5 runs per case
+    /usr/bin/python3 tools/validate_monte_carlo.py --runs 2      # fewer replicate runs
+    /usr/bin/python3 tools/validate_monte_carlo.py --only speed  # some sections (others kept)
+
+Every case is a real `build/bedforge run` of a scene in scenes/examples (overridden on the
+command line), single-threaded, two at a time on two cores. Sections:
+  fig3        the paper's Fig. 3 case (D = 14.1 d, 70.5 d mixing height, N = 2500, 200 shells):
+              line against volume intersection; averaged radial profile against the features of
+              docs/reference.md; soft-sphere packer on the same container side by side
+  annulus     D/d = 20.3, D_int/d = 6.25, N = 4000: profiles from the concave and convex walls
+  segregation diameter ratio 1.2, 100 shakes, in a cylinder and in a periodic box
+  speed       cycles per second against N
+"""
+import argparse
+import concurrent.futures as cf
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bedforge_files import read_csv  # noqa: E402
+from references import de_klerk  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
+DOCS = os.path.join(ROOT, "docs")
+SCENES = os.path.join(ROOT, "scenes", "examples")
+SECTIONS = ["fig3", "annulus", "segregation", "speed"]
+
+
+def run(case):
+    """bedforge run SCENE with options; returns the case with the report and output folder."""
+    out = tempfile.mkdtemp(prefix="bedforge_mc_")
+    cmd = [BEDFORGE, "--quiet", "run", os.path.join(SCENES, case["scene"]), "-o", out,
+           "--seed", str(case["seed"])] + case.get("args", [])
+    t0 = time.time()
+    p = subprocess.run(cmd, env=dict(os.environ, OMP_NUM_THREADS="1"), capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
+    rep = json.load(open(os.path.join(out, "report.json")))
+    return dict(case, wall_s=time.time() - t0, dir=out, pack=rep["stages"]["pack"], analysis=rep["stages"]["analysis"])
+
+
+def run_all(cases):
+    with cf.ThreadPoolExecutor(2) as ex:
+        return list(ex.map(run, cases))
+
+
+def mean_profile(results, name):
+    """Radial profile averaged over runs: (wall distance in d, eps)."""
+    ps = [read_csv(os.path.join(r["dir"], name)) for r in results]
+    return ps[0]["wall_distance_d"], np.mean([p["void_fraction"] for p in ps], axis=0)
+
+
+def ordering_depth(z, eps, bulk, band=0.02):
+    """Wall distance (d) beyond which the profile stays within +-band of the bulk value."""
+    outside = np.nonzero(np.abs(eps - bulk) > band)[0]
+    return float(z[outside[-1] + 1]) if len(outside) and outside[-1] + 1 < len(z) else float(z[-1])
+
+
+def fig3(runs):
+    mc = run_all([{"scene": "abreu1999_fig3.toml", "seed": s} for s in range(1, runs + 1)] +
+                 [{"scene": "abreu1999_fig3.toml", "seed": s, "args": ["--algorithm", "soft-sphere"]}
+                  for s in range(1, runs + 1)])
+    mcr = [r for r in mc if "args" not in r]
+    ssr = [r for r in mc if "args" in r]
+    z, vol = mean_profile(mcr, "radial_profile.csv")
+    _, line = mean_profile(mcr, "radial_profile_line.csv")
+    _, soft = mean_profile(ssr, "radial_profile.csv")
+    bulk = float(np.mean(vol[z > 4.5]))
+    out = {
+        "runs": runs,
+        "eps_central_mc": [r["pack"]["void_fraction"]["central_slab"] for r in mcr],
+        "eps_central_soft": [r["pack"]["void_fraction"]["central_slab"] for r in ssr],
+        "time_mc_s": [r["pack"]["time_s"] for r in mcr],
+        "time_soft_s": [r["pack"]["time_s"] for r in ssr],
+        "cycles": [r["pack"]["cycles"] for r in mcr],
+        "unsettled_shakes": [r["pack"]["unsettled_shakes"] for r in mcr],
+        "line_vs_volume_max": float(np.max(np.abs(line - vol))),
+        "line_vs_volume_mean": float(np.mean(np.abs(line - vol))),
+        "first_minimum": float(vol[z < 1].min()), "first_minimum_at_d": float(z[z < 1][np.argmin(vol[z < 1])]),
+        "wall_bin": float(vol[0]), "bulk": bulk, "ordering_depth_d": ordering_depth(z, vol, bulk),
+        "soft_first_minimum": float(soft[z < 1].min()),
+    }
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    ax[0].plot(z, vol, "b-", lw=1, label="volume intersection")
+    ax[0].plot(z, line, "r--", lw=1, label="line intersection")
+    ax[0].set(xlabel="distance from the wall (R - r)/d", ylabel="void fraction",
+              title=f"Abreu et al. Fig. 3 case, {runs} runs, 200 shells")
+    ax[0].legend()
+    ax[1].plot(z, vol, "b-", lw=1, label="Monte Carlo")
+    ax[1].plot(z, soft, "g-", lw=1, label="soft sphere (accelerated)")
+    ax[1].plot(z, de_klerk(z, bulk), "k:", label="de Klerk (2003) [C]")
+    ax[1].set(xlabel="(R - r)/d", ylabel="void fraction", title="Monte Carlo and soft sphere, same tube", ylim=(0, 1))
+    ax[1].legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "monte_carlo_fig3.png"), dpi=110)
+    return out
+
+
+def annulus(runs):
+    rs = run_all([{"scene": "abreu1999_annulus.toml", "seed": s} for s in range(1, runs + 1)])
+    zo, outer = mean_profile(rs, "radial_profile_outer.csv")
+    zi, inner = mean_profile(rs, "radial_profile_inner.csv")
+    n = min(len(zo), len(zi))
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(zo, outer, "b-", lw=1, label="from the outer (concave) wall")
+    ax.plot(zi, inner, "r--", lw=1, label="from the inner (convex) wall")
+    ax.set(xlabel="distance from the wall / d", ylabel="void fraction",
+           title=f"annulus D/d = 20.3, Dint/d = 6.25, N = 4000, {runs} runs")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "monte_carlo_annulus.png"), dpi=110)
+    m = (zo[:n] < 3.0)
+    return {"runs": runs, "time_s": [r["pack"]["time_s"] for r in rs],
+            "eps_central": [r["pack"]["void_fraction"]["central_slab"] for r in rs],
+            "outer_first_minimum": float(outer[zo < 1].min()), "inner_first_minimum": float(inner[zi < 1].min()),
+            "mean_abs_difference_first_3d": float(np.mean(np.abs(outer[:n][m] - inner[:n][m])))}
+
+
+def segregation(runs):
+    cases = [{"scene": "abreu1999_segregation.toml", "seed": s, "where": "cylinder"} for s in range(1, runs + 1)]
+    cases += [{"scene": "abreu1999_segregation.toml", "seed": s, "where": "periodic box",
+               "args": ["--container", "box", "--box-size-d", "8.9", "--periodic"]} for s in range(1, runs + 1)]
+    cases += [{"scene": "abreu1999_segregation.toml", "seed": 1, "where": "cylinder, no shakes",
+               "args": ["--shakes", "1"]}]
+    rs = run_all(cases)
+    out = {}
+    for where in ["cylinder", "periodic box", "cylinder, no shakes"]:
+        g = [r for r in rs if r["where"] == where]
+        out[where] = {"intensity": [r["analysis"]["segregation"]["intensity"] for r in g],
+                      "mean_height_large_small_d": [[h / r["analysis"]["reference_diameter_m"]
+                                                     for h in r["analysis"]["segregation"]["mean_height_m"]] for r in g],
+                      "time_s": [r["pack"]["time_s"] for r in g]}
+    r0 = [r for r in rs if r["where"] == "cylinder"][0]
+    bed = read_csv(os.path.join(r0["dir"], "bed.csv"))
+    sp = read_csv(os.path.join(r0["dir"], "species_profile.csv"))
+    fig, ax = plt.subplots(1, 2, figsize=(9, 5), gridspec_kw={"width_ratios": [1, 1.3]})
+    large = bed["d_m"] > np.min(bed["d_m"]) * 1.1
+    for sel, col in [(~large, "tab:blue"), (large, "tab:red")]:
+        ax[0].scatter(bed["x_m"][sel] * 1e3, bed["z_m"][sel] * 1e3, s=4, c=col)
+    ax[0].set(xlabel="x (mm)", ylabel="z (mm)", title="side view (red: large)", aspect="equal")
+    names = [k for k in sp if k.startswith("species")]
+    for k, col in zip(names, ["tab:red", "tab:blue"]):
+        ax[1].plot(sp[k], sp["z_d"], color=col, label=k)
+    ax[1].set(xlabel="solid volume fraction", ylabel="z / d", title="species profiles, cylinder, 100 shakes")
+    ax[1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "monte_carlo_segregation.png"), dpi=110)
+    return out
+
+
+def speed():
+    res = []
+    for n, a in [(500, 8), (2500, 14.1), (10000, 28)]:
+        r = run({"scene": "abreu1999_fig3.toml", "seed": 1,
+                 "args": ["--count", str(n), "--aspect-ratio", str(a), "--mixing-cycles", "500", "--shakes", "0",
+                          "--settling-cycles", "2000"]})
+        res.append({"n": n, "a": a, "cycles_per_s": r["pack"]["cycles_per_second"],
+                    "moves_per_s": r["pack"]["moves_per_second"], "time_s": r["pack"]["time_s"]})
+    return res
+
+
+def ms(v):
+    return f"{statistics.mean(v):.4f} ± {statistics.stdev(v):.4f}" if len(v) > 1 else f"{v[0]:.4f}"
+
+
+def write(R):
+    json.dump(R, open(os.path.join(DOCS, "monte_carlo_validation.json"), "w"), indent=1)
+    L = ["# Monte Carlo packer: validation", "",
+         "Regenerate with `/usr/bin/python3 tools/validate_monte_carlo.py` (see its header). Scenes in",
+         "`scenes/examples/abreu1999_*.toml`; method and reading of the paper in docs/monte_carlo.md.", ""]
+    if "fig3" in R:
+        f = R["fig3"]
+        L += ["## Fig. 3 case: D = 14.1 d, N = 2500, 200 shells", "",
+              f"{f['runs']} runs of the paper's full schedule. ![](monte_carlo_fig3.png)", "",
+              "| measure | value |", "|---|---|",
+              f"| central void fraction, Monte Carlo | {ms(f['eps_central_mc'])} |",
+              f"| central void fraction, soft sphere (same tube, N) | {ms(f['eps_central_soft'])} |",
+              f"| time per run, Monte Carlo / soft sphere (s, 1 thread) | {statistics.mean(f['time_mc_s']):.1f} / "
+              f"{statistics.mean(f['time_soft_s']):.2f} |",
+              f"| cycles per run | {statistics.mean(f['cycles']):.0f} |",
+              f"| shakes that hit max_settle_cycles | {sum(f['unsettled_shakes'])} |",
+              f"| line vs volume intersection, max / mean abs difference | {f['line_vs_volume_max']:.4f} / "
+              f"{f['line_vs_volume_mean']:.4f} |",
+              f"| wall bin (0.035 d) | {f['wall_bin']:.3f} |",
+              f"| first minimum (at d) | {f['first_minimum']:.3f} ({f['first_minimum_at_d']:.3f}); soft sphere "
+              f"{f['soft_first_minimum']:.3f} |",
+              f"| ordering depth: beyond it within ±0.02 of the bulk {f['bulk']:.3f} | {f['ordering_depth_d']:.2f} d |",
+              ""]
+    if "annulus" in R:
+        a = R["annulus"]
+        L += ["## Annulus: D/d = 20.3, D_int/d = 6.25, N = 4000", "",
+              f"{a['runs']} runs. ![](monte_carlo_annulus.png)", "",
+              f"- central void fraction {ms(a['eps_central'])}; time per run {statistics.mean(a['time_s']):.0f} s",
+              f"- first minimum: outer (concave) wall {a['outer_first_minimum']:.3f}, inner (convex) wall "
+              f"{a['inner_first_minimum']:.3f}",
+              f"- mean absolute difference of the two profiles within 3 d of the walls: "
+              f"{a['mean_abs_difference_first_3d']:.3f}", ""]
+    if "segregation" in R:
+        L += ["## Segregation: diameter ratio 1.2, equal numbers, N = 1000", "",
+              "![](monte_carlo_segregation.png)", "",
+              "| container | Danckwerts intensity | mass-centre height large / small (d) | time (s) |", "|---|---|---|---|"]
+        for where, s in R["segregation"].items():
+            hs = "; ".join(f"{h[0]:.2f} / {h[1]:.2f}" for h in s["mean_height_large_small_d"])
+            L.append(f"| {where} | {ms(s['intensity'])} | {hs} | {statistics.mean(s['time_s']):.0f} |")
+        L.append("")
+    if "speed" in R:
+        L += ["## Speed (1 thread)", "", "| N | a | cycles/s | moves/s |", "|---|---|---|---|"]
+        for s in R["speed"]:
+            L.append(f"| {s['n']} | {s['a']} | {s['cycles_per_s']:.0f} | {s['moves_per_s']:.3g} |")
+        L.append("")
+    open(os.path.join(DOCS, "monte_carlo_validation.md"), "w").write("\n".join(L))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--runs", type=int, default=5, help="replicate runs per case (the paper averages 5)")
+    ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS)
+    args = ap.parse_args()
+    path = os.path.join(DOCS, "monte_carlo_validation.json")
+    R = json.load(open(path)) if os.path.exists(path) else {}
+    for s in args.only:
+        t0 = time.time()
+        R[s] = speed() if s == "speed" else globals()[s](args.runs)
+        print(f"{s}: {time.time() - t0:.0f} s", flush=True)
+        write(R)
+
+
+if __name__ == "__main__":
+    main()
