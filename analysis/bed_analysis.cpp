@@ -105,33 +105,47 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
     const double ro = std::max(mid, ann->outer_radius() - 0.5 * sc.d_mean), ri = std::min(mid, ann->inner_radius() + 0.5 * sc.d_mean);
     reachable = std::numbers::pi * (ro * ro - ri * ri);
   }
+  // Writes a wall profile's CSV and its features in the report: the value in the bin at the
+  // wall and the first minimum, which the references quote.
+  auto add_wall_profile = [&](const std::string& name, const Profile& prof, const std::string& where) {
+    std::string text = "# void fraction between z = " + fmt::format("{} and {} m", z1, z2) + ", " + where +
+                       "; wall distance in reference diameters and metres\nwall_distance_d,wall_distance_m,"
+                       "void_fraction\n";
+    for (std::size_t k = 0; k < prof.position.size(); ++k)
+      text += fmt::format("{:.6g},{:.9g},{:.9g}\n", prof.position[k] / d, prof.position[k], prof.void_fraction[k]);
+    out.csv_files[name + ".csv"] = text;
+    double min_v = 2.0, min_at = 0.0;
+    for (std::size_t k = 0; k < prof.position.size() && prof.position[k] < 1.0 * d; ++k)
+      if (prof.void_fraction[k] < min_v) min_v = prof.void_fraction[k], min_at = prof.position[k] / d;
+    j[name] = {{"wall_bin", prof.void_fraction.front()},
+               {"first_minimum", min_v},
+               {"first_minimum_at_d", min_at},
+               {"bin_d", p.radial_bin_d}};
+  };
+  if (const auto* box = dynamic_cast<const Box*>(bed.container.get())) {
+    const Periodicity per = box->periodicity();
+    if (per.lx == 0.0)
+      add_wall_profile("wall_profile_x",
+                       wall_void_fraction(bed, 0, 0.5 * box->size_x(), box->size_y(), p.radial_bin_d * d, z1, z2),
+                       "from the walls at x = +-size_x/2, both folded together");
+    if (per.ly == 0.0)
+      add_wall_profile("wall_profile_y",
+                       wall_void_fraction(bed, 1, 0.5 * box->size_y(), box->size_x(), p.radial_bin_d * d, z1, z2),
+                       "from the walls at y = +-size_y/2, both folded together");
+  }
   for (const Wall& w : walls) {
     const Profile radial = radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2);
-    std::string csv = "# radial void fraction between z = " + fmt::format("{} and {} m", z1, z2) +
-                      fmt::format(", from the wall at r = {} m", w.radius) +
-                      "; wall distance |r - R_wall| in reference diameters and metres\nwall_distance_d,wall_distance_m,"
-                      "void_fraction\n";
-    for (std::size_t k = 0; k < radial.position.size(); ++k)
-      csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", radial.position[k] / d, radial.position[k], radial.void_fraction[k]);
-    out.csv_files[w.name + ".csv"] = csv;
+    add_wall_profile(w.name, radial, fmt::format("radial, from the wall at r = {} m", w.radius));
     const CentreDistribution centres = radial_centre_distribution(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, reachable);
-    csv = "# radial distribution of sphere centres between z = " + fmt::format("{} and {} m", z1, z2) +
-          fmt::format(", from the wall at r = {} m", w.radius) +
-          "\nwall_distance_d,wall_distance_m,fraction,relative_density\n";
+    std::string csv = "# radial distribution of sphere centres between z = " + fmt::format("{} and {} m", z1, z2) +
+                      fmt::format(", from the wall at r = {} m", w.radius) +
+                      "\nwall_distance_d,wall_distance_m,fraction,relative_density\n";
     for (std::size_t k = 0; k < centres.position.size(); ++k)
       csv += fmt::format("{:.6g},{:.9g},{:.9g},{:.9g}\n", centres.position[k] / d, centres.position[k],
                          centres.fraction[k], centres.relative_density[k]);
     std::string stem = w.name;
     stem.replace(0, std::string("radial_profile").size(), "centre_distribution");
     out.csv_files[stem + ".csv"] = csv;
-    // Value in the bin at the wall and the first minimum, features the references quote.
-    double min_v = 2.0, min_at = 0.0;
-    for (std::size_t k = 0; k < radial.position.size() && radial.position[k] < 1.0 * d; ++k)
-      if (radial.void_fraction[k] < min_v) min_v = radial.void_fraction[k], min_at = radial.position[k] / d;
-    j[w.name] = {{"wall_bin", radial.void_fraction.front()},
-                 {"first_minimum", min_v},
-                 {"first_minimum_at_d", min_at},
-                 {"bin_d", p.radial_bin_d}};
     if (p.line_intersection) {
       // The same bins by line intersection, and how far the two methods differ.
       const Profile line = line_radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, p.line_step_d * d);

@@ -94,4 +94,34 @@ double sphere_cylinder_volume(double r, double s, double zc, double rho, double 
   return v;
 }
 
+double sphere_halfspace_volume(double r, double xc, double zc, double x_max, double z1, double z2) {
+  const double lo = std::max(z1, zc - r), hi = std::min(z2, zc + r);
+  if (hi <= lo) return 0.0;
+  const double t0 = x_max - xc;
+  if (t0 >= r) return sphere_slab_volume(r, zc, lo, hi);  // wholly on the kept side
+  if (t0 <= -r) return 0.0;
+  static const GaussLegendre gl;
+  // The segment of the section disk (radius a) left of the line vanishes or fills the disk
+  // where a = |x_max - xc|; split there and at the equator.
+  std::vector<double> cuts = {lo, hi};
+  const double h = std::sqrt(r * r - t0 * t0);
+  for (double z : {zc - h, zc + h, zc})
+    if (z > lo && z < hi) cuts.push_back(z);
+  std::sort(cuts.begin(), cuts.end());
+  double v = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double mid = 0.5 * (cuts[k] + cuts[k + 1]), half = 0.5 * (cuts[k + 1] - cuts[k]);
+    if (half <= 0.0) continue;
+    for (int q = 0; q < GaussLegendre::n; ++q) {
+      const double z = mid + half * gl.x[q];
+      const double a2 = std::max(0.0, r * r - (z - zc) * (z - zc)), a = std::sqrt(a2);
+      if (a <= 0.0) continue;
+      const double t = std::clamp(t0 / a, -1.0, 1.0);
+      // Disk minus the cap beyond the line x = x_max.
+      v += half * gl.w[q] * a2 * (std::numbers::pi - std::acos(t) + t * std::sqrt(1.0 - t * t));
+    }
+  }
+  return v;
+}
+
 }  // namespace bedforge::analysis

@@ -62,6 +62,34 @@ Profile radial_void_fraction(const Bed& bed, double wall, double end, double bin
   return p;
 }
 
+Profile wall_void_fraction(const Bed& bed, int axis, double half_width, double other_width, double bin, double z1,
+                           double z2) {
+  const std::size_t bins = static_cast<std::size_t>(std::ceil(half_width / bin - 1e-9));
+  auto edge = [&](std::size_t k) { return std::min(half_width, static_cast<double>(k) * bin); };
+  const auto solid = accumulate_bins(bed.size(), bins, [&](std::size_t i, std::vector<double>& acc) {
+    const double r = 0.5 * bed.diameters[i], zc = bed.centres[i].z();
+    if (zc + r <= z1 || zc - r >= z2) return;
+    // Distance of the centre from each wall; by symmetry both walls are the wall at 0.
+    const double x = bed.centres[i][axis];
+    for (double from_wall : {half_width + x, half_width - x}) {
+      if (from_wall - r >= half_width) continue;
+      double prev = 0.0;  // volume within distance edge(k) of this wall
+      for (std::size_t k = 0; k < bins; ++k) {
+        if (edge(k) >= from_wall + r) break;
+        const double next = sphere_halfspace_volume(r, from_wall, zc, edge(k + 1), z1, z2);
+        acc[k] += next - prev;
+        prev = next;
+      }
+    }
+  });
+  Profile p;
+  for (std::size_t k = 0; k < bins; ++k) {
+    p.position.push_back(0.5 * (edge(k) + edge(k + 1)));
+    p.void_fraction.push_back(1.0 - solid[k] / (2.0 * (edge(k + 1) - edge(k)) * other_width * (z2 - z1)));
+  }
+  return p;
+}
+
 Profile axial_void_fraction(const Bed& bed, double bin, double top) {
   const std::size_t bins = static_cast<std::size_t>(std::ceil(top / bin - 1e-9));
   const auto solid = accumulate_bins(bed.size(), bins, [&](std::size_t i, std::vector<double>& acc) {

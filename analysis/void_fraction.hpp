@@ -26,6 +26,13 @@ struct Profile {
 // the wall; the last bin ends at `end`.
 Profile radial_void_fraction(const Bed& bed, double wall, double end, double bin, double z1, double z2);
 
+// Profile next to the two flat walls of a box at +-half_width along `axis` (0 = x, 1 = y),
+// folded together: bins of width `bin` (m) from the walls to the mid-plane, between heights z1
+// and z2, over the box's full extent `other_width` (m) along the other axis; exact volumes
+// (sphere_halfspace_volume). Positions are distances from the walls.
+Profile wall_void_fraction(const Bed& bed, int axis, double half_width, double other_width, double bin, double z1,
+                           double z2);
+
 // Axial profile: slabs of height `bin` (m) from the floor to `top` (m).
 Profile axial_void_fraction(const Bed& bed, double bin, double top);
 

@@ -83,3 +83,17 @@ TEST(SphereCylinder, NearlyFlatWallCutsAwayTheSagitta) {
   const double expected = 2.0 / 3.0 * kPi * r * r * r - kPi * std::pow(r, 4) / (8 * s);
   EXPECT_NEAR(sphere_cylinder_volume(r, s, 0, s, -1, 1), expected, 1e-8);
 }
+
+TEST(SphereHalfspace, CapClosedFormsAndSplitByHeight) {
+  // Sphere r = 1 at the origin cut by the plane x = t, all heights: V = 4/3 pi - cap(1 - t),
+  // cap(h) = pi h^2 (3 r - h) / 3; the parts above and below z = 0.3 add up to it.
+  const double pi = std::acos(-1.0);
+  for (double t : {-0.9, -0.3, 0.0, 0.45, 0.99}) {
+    const double h = 1.0 - t, expected = 4.0 / 3.0 * pi - pi * h * h * (3.0 - h) / 3.0;
+    EXPECT_NEAR(sphere_halfspace_volume(1.0, 0.0, 0.0, t, -2.0, 2.0), expected, 1e-7 * expected) << t;
+    EXPECT_NEAR(sphere_halfspace_volume(1.0, 0.0, 0.0, t, -2.0, 0.3) +
+                    sphere_halfspace_volume(1.0, 0.0, 0.0, t, 0.3, 2.0),
+                expected, 1e-7 * expected);
+  }
+  EXPECT_NEAR(sphere_halfspace_volume(0.5, 2.0, 1.0, 1.0, 0.0, 3.0), 0.0, 1e-15);  // beyond the plane
+}

@@ -115,3 +115,24 @@ TEST(VoidFraction, AnnulusProfilesFromBothWallsAddUpToTheSlabValue) {
   }
   EXPECT_NEAR(1 - solid / (kPi * (36.0 - 4.0) * (z2 - z1)), void_fraction(b, z1, z2), 1e-10);
 }
+
+TEST(VoidFraction, BoxWallProfileAddsUpToTheSlabValue) {
+  // Spheres scattered in a 6 x 4 box with walls: the folded profile from the x walls tiles
+  // the box, so its solid adds up to the slab's.
+  Bed b;
+  b.container = std::make_shared<Box>(6.0, 4.0, false, false);
+  for (int i = 0; i < 30; ++i) {
+    b.centres.emplace_back(2.4 * std::sin(1.7 * i), 1.4 * std::cos(0.9 * i), 0.5 + 0.41 * i);
+    b.diameters.push_back(1.0);
+  }
+  const double z1 = 1.0, z2 = 10.0;
+  const Profile p = wall_void_fraction(b, 0, 3.0, 4.0, 0.07, z1, z2);
+  ASSERT_EQ(p.position.size(), 43u);
+  double solid = 0.0;
+  for (size_t k = 0; k < p.position.size(); ++k) {
+    const double w = std::min(3.0, 0.07 * (k + 1)) - 0.07 * k;
+    solid += (1 - p.void_fraction[k]) * 2 * w * 4.0 * (z2 - z1);
+  }
+  EXPECT_NEAR(1 - solid / (24.0 * (z2 - z1)), void_fraction(b, z1, z2), 1e-9);
+  EXPECT_NEAR(p.void_fraction[0], 1.0, 1e-3);  // no sphere touches the x walls (|x| <= 2.4)
+}
