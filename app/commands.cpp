@@ -17,6 +17,11 @@
 #include "core/report.hpp"
 #include "core/version.hpp"
 #include "packer/soft_sphere.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
+#include "meshing/fluid_surface.hpp"
+#include "meshing/stl_io.hpp"
+#include "meshing/surface_checks.hpp"
+#endif
 
 namespace bedforge {
 
@@ -104,6 +109,43 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
   console.line(a.summary);
 }
 
+#ifdef BEDFORGE_HAVE_CGAL
+// Surface stage: treated contacts, the fluid-domain surface checked by CGAL, STL files.
+void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::string& version, Report& report,
+                 Outputs& files, const Console& console) {
+  const auto t0 = std::chrono::steady_clock::now();
+  meshing::FluidSurface fs = meshing::build_fluid_surface(bed, p);
+  const meshing::SurfaceCheck check = meshing::check_surface(fs.fluid, p.self_intersection_limit);
+  nlohmann::json& j = fs.report;
+  j["check"] = check.to_json();
+  const double exact = j["fluid_volume_exact_m3"].get<double>();
+  j["fluid_volume_mesh_m3"] = check.volume;
+  if (!check.manifold || !check.closed || check.self_intersecting)
+    throw std::runtime_error(fmt::format("internal error: the fluid surface is not valid ({}); please report it with "
+                                         "the bed",
+                                         check.to_json().dump()));
+  j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
+  files.add("fluid.stl", meshing::stl_ascii_by_patch(fs.fluid));
+  for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
+    files.add("fluid_" + fs.fluid.patches[k] + ".stl",
+              meshing::stl_binary(fs.fluid, static_cast<int>(k), "bedforge " + version + " " + fs.fluid.patches[k]));
+  files.add("bed.stl", meshing::stl_binary(fs.bed, -1, "bedforge " + version + " bed solid"));
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  j["time_s"] = time;
+  j["summary"] = fmt::format(
+      "surface ({}): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, min angle {:.1f} deg, "
+      "smallest gap {:.3g} d, {:.2f} s",
+      j["parameters"]["treatment"].get<std::string>(), j["triangles"].get<std::size_t>(),
+      check.self_intersections_checked ? "no self-intersection" : "self-intersections not checked",
+      j["fluid_volume_relative_error"].get<double>(), j["chordal_deviation_d"].get<double>(),
+      j["min_angle_deg"].get<double>(),
+      std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()),
+      time);
+  console.line(j["summary"].get<std::string>());
+  report.set_stage("surface", j);
+}
+#endif
+
 Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, scene.to_json()}; }
 
 // `run`, `pack` and `import`: a scene (file plus overrides) into DIR. `run` follows the scene's
@@ -119,6 +161,9 @@ int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool w
   if (scene.wants("vtp")) files.add("bed.vtp", bed_to_vtp(pack.bed, prov));
   files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
   if (run_analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
+#ifdef BEDFORGE_HAVE_CGAL
+  if (scene.wants("stl")) add_surface(pack.bed, scene.surface, kVersion, report, files, console);
+#endif
   files.write(dir);
   report.save(dir);
   return 0;
@@ -252,6 +297,23 @@ int run_command_line(int argc, char** argv) {
   analyse->add_option("--contact-tolerance-d", contact_tolerance_d,
                       "FLOAT >= 0, largest gap counted as a contact, in smallest diameters; default 1e-4");
 
+#ifdef BEDFORGE_HAVE_CGAL
+  CLI::App* surface = app.add_subcommand("surface", "treat contacts and build the fluid-domain surface of DIR/bed.csv: "
+                                                    "writes fluid.stl (a named solid per patch), fluid_PATCH.stl, bed.stl");
+  surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
+  std::optional<std::string> treatment;
+  std::optional<double> shrink_factor, edge_length_d, inlet_length_d, outlet_length_d;
+  surface->add_option("--contacts", treatment, "shrink|none, contact treatment (sets contacts.treatment); default shrink");
+  surface->add_option("--shrink-factor", shrink_factor,
+                      "FLOAT in [0.5,1), sphere scale for shrink (sets contacts.shrink_factor); default 0.99");
+  surface->add_option("--edge-length-d", edge_length_d,
+                      "FLOAT in [0.001,1], target triangle edge in diameters (sets surface.edge_length_d); default 0.1");
+  surface->add_option("--inlet-length-d", inlet_length_d,
+                      "FLOAT >= 0, empty section below the bed in diameters (sets surface.inlet_length_d); default 1");
+  surface->add_option("--outlet-length-d", outlet_length_d,
+                      "FLOAT >= 0, empty section above the bed in diameters (sets surface.outlet_length_d); default 1");
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -273,7 +335,7 @@ int run_command_line(int argc, char** argv) {
     return run_scene(scene, dir, false, true, console);
   }
 
-  // analyse DIR
+  // analyse DIR or surface DIR
   const fs::path d(dir);
   ImportedBed in = read_bed_text(d / "bed.csv", 1.0);
   if (!in.bed.container)
@@ -285,11 +347,28 @@ int run_command_line(int argc, char** argv) {
   if (radial_bin_d) override_key(table, "analysis.radial_bin_d", *radial_bin_d);
   if (axial_bin_d) override_key(table, "analysis.axial_bin_d", *axial_bin_d);
   if (contact_tolerance_d) override_key(table, "analysis.contact_tolerance_d", *contact_tolerance_d);
+  Report report = Report::load_or_new(d);
+  Outputs files;
+#ifdef BEDFORGE_HAVE_CGAL
+  if (*surface) {
+    if (treatment) override_key(table, "contacts.treatment", *treatment);
+    if (shrink_factor) override_key(table, "contacts.shrink_factor", *shrink_factor);
+    if (edge_length_d) override_key(table, "surface.edge_length_d", *edge_length_d);
+    if (inlet_length_d) override_key(table, "surface.inlet_length_d", *inlet_length_d);
+    if (outlet_length_d) override_key(table, "surface.outlet_length_d", *outlet_length_d);
+    SceneSection contacts(table["contacts"].as_table(), "contacts"), surf(table["surface"].as_table(), "surface");
+    const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
+    contacts.finish();
+    surf.finish();
+    add_surface(in.bed, params, kVersion, report, files, console);
+    files.write(d);
+    report.save(d);
+    return 0;
+  }
+#endif
   SceneSection section(table["analysis"].as_table(), "analysis");
   const analysis::AnalysisParams params = analysis::read_analysis_params(section);
   section.finish();
-  Report report = Report::load_or_new(d);
-  Outputs files;
   add_analysis(in.bed, params, report, files, console);
   files.write(d);
   report.save(d);

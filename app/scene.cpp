@@ -14,8 +14,10 @@ namespace bedforge {
 
 namespace {
 
-const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis"};
-const std::vector<std::string> kSections = {"container", "particles", "packing", "analysis", "outputs"};
+const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis", "stl"};
+const std::vector<std::string> kDefaultOutputs = {"positions", "vtp", "analysis"};
+const std::vector<std::string> kSections = {"container", "particles", "packing", "analysis",
+                                            "contacts",  "surface",   "outputs"};
 
 double unit_to_metres(const std::string& unit) {
   if (unit == "m") return 1.0;
@@ -45,7 +47,7 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
     const std::string key(k.str());
     if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
       throw InputError(fmt::format("unknown section [{}] in {}; allowed: [container], [particles], [packing], "
-                                   "[analysis], [outputs]",
+                                   "[analysis], [contacts], [surface], [outputs]",
                                    key, source));
   }
 
@@ -94,8 +96,19 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   analysis.finish();
 
   SceneSection outputs = root.sub("outputs");
-  sc.outputs = outputs.strings("files", kOutputs, kOutputs);
+  sc.outputs = outputs.strings("files", kDefaultOutputs, kOutputs);
   outputs.finish();
+
+  SceneSection contacts = root.sub("contacts"), surface = root.sub("surface");
+#ifdef BEDFORGE_HAVE_CGAL
+  sc.surface = meshing::read_surface_params(contacts, surface);
+#else
+  if (sc.wants("stl") || table.contains("contacts") || table.contains("surface"))
+    throw InputError("this bedforge was built without CGAL, so it has no surface stage ([contacts], [surface], "
+                     "outputs.files \"stl\"); install libcgal-dev and rebuild");
+#endif
+  contacts.finish();
+  surface.finish();
   return sc;
 }
 

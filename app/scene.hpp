@@ -13,11 +13,15 @@
 #include "core/size_distribution.hpp"
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
+#include "meshing/fluid_surface.hpp"
+#endif
 
 namespace bedforge {
 
 // A scene: what to build and which outputs to write. Sections: [container], [particles],
-// [packing] (with [packing.soft_sphere] and [packing.monte_carlo]), [analysis], [outputs]. Lengths are given in metres
+// [packing] (with [packing.soft_sphere] and [packing.monte_carlo]), [analysis], [contacts],
+// [surface], [outputs]. Lengths are given in metres
 // (keys ending in _m) or in particle diameters (keys ending in _d).
 struct Scene {
   toml::table table;   // as run: the file plus command-line overrides
@@ -38,7 +42,11 @@ struct Scene {
   // [container], in metres; for "import" it may come from the bed file's header instead.
   std::shared_ptr<const Container> container;
   analysis::AnalysisParams analysis;
-  // [outputs] files: "positions" (bed.csv), "vtp" (bed.vtp), "analysis" (profiles, contacts).
+#ifdef BEDFORGE_HAVE_CGAL
+  meshing::SurfaceParams surface;  // [contacts] and [surface]
+#endif
+  // [outputs] files: "positions" (bed.csv), "vtp" (bed.vtp), "analysis" (profiles, contacts),
+  // "stl" (the fluid-domain surface and the bed solid; needs a build with CGAL).
   std::vector<std::string> outputs;
 
   bool wants(const std::string& output) const;

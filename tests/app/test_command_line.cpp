@@ -196,3 +196,24 @@ TEST(CommandLine, HelpStatesTypesUnitsAndDefaults) {
                         "--seed", "default 1", "--mode", "default accelerated"})
     EXPECT_NE(r.output.find(s), std::string::npos) << s;
 }
+
+#ifdef BEDFORGE_HAVE_CGAL
+TEST(CommandLine, SurfaceStageOnAPackedBed) {
+  const fs::path dir = fresh_dir("surface");
+  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 4 --count 30 -o " + dir.string()).status, 0);
+  const Result r = bedforge("surface " + dir.string() + " --contacts shrink --edge-length-d 0.15");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("closed, no self-intersection"), std::string::npos) << r.output;
+  for (const char* f : {"fluid.stl", "fluid_inlet.stl", "fluid_outlet.stl", "fluid_wall.stl", "fluid_particles.stl",
+                        "bed.stl"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  std::ifstream report(dir / "report.json");
+  const auto j = nlohmann::json::parse(report);
+  EXPECT_TRUE(j["stages"].contains("pack"));  // the stage is added, the bed's report kept
+  EXPECT_EQ(j["stages"]["surface"]["check"]["closed"], true);
+  // Bad input: exit 2, message names the key and what is allowed, nothing written.
+  const Result bad = bedforge("surface " + dir.string() + " --contacts glue");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.output.find("contacts.treatment"), std::string::npos) << bad.output;
+}
+#endif

@@ -1,0 +1,16 @@
+#pragma once
+#include <string>
+
+#include "meshing/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// ASCII STL with one named solid per patch (`solid inlet ... endsolid inlet`), the layout
+// snappyHexMesh and surfaceFeatureExtract read as separate regions. Coordinates in metres.
+std::string stl_ascii_by_patch(const TriangleMesh& mesh);
+
+// Binary STL of the triangles of one patch (all triangles when `patch` < 0); `header` goes
+// into the 80-byte header (truncated).
+std::string stl_binary(const TriangleMesh& mesh, int patch, const std::string& header);
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,44 @@
+#include "meshing/triangle_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace bedforge::meshing {
+
+int TriangleMesh::patch_index(const std::string& name) {
+  const auto it = std::find(patches.begin(), patches.end(), name);
+  if (it != patches.end()) return static_cast<int>(it - patches.begin());
+  patches.push_back(name);
+  return static_cast<int>(patches.size()) - 1;
+}
+
+void TriangleMesh::append(const TriangleMesh& other) {
+  const int offset = static_cast<int>(points.size());
+  points.insert(points.end(), other.points.begin(), other.points.end());
+  for (std::size_t t = 0; t < other.triangles.size(); ++t) {
+    const auto& tri = other.triangles[t];
+    triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
+    patch.push_back(patch_index(other.patches[other.patch[t]]));
+  }
+}
+
+MeshQuality mesh_quality(const TriangleMesh& m) {
+  MeshQuality q;
+  q.min_edge = std::numeric_limits<double>::infinity();
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& a = m.points[t[k]];
+      const Eigen::Vector3d u = m.points[t[(k + 1) % 3]] - a, v = m.points[t[(k + 2) % 3]] - a;
+      const double lu = u.norm();
+      q.min_edge = std::min(q.min_edge, lu), q.max_edge = std::max(q.max_edge, lu);
+      const double c = u.dot(v) / std::max(lu * v.norm(), 1e-300);
+      q.min_angle_deg = std::min(q.min_angle_deg, std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+    }
+  }
+  if (m.triangles.empty()) q.min_edge = 0.0;
+  return q;
+}
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,31 @@
+#pragma once
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace bedforge::meshing {
+
+// A triangle soup with shared vertices and a patch label per triangle (index into `patches`).
+// Triangles are oriented with their normal (right-hand rule) pointing out of the region the
+// mesh bounds: out of the fluid for the fluid-domain surface, out of the spheres for the bed.
+struct TriangleMesh {
+  std::vector<Eigen::Vector3d> points;      // m
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> patch;                   // per triangle
+  std::vector<std::string> patches;         // names, e.g. inlet, outlet, wall, inner_wall, particles
+
+  int patch_index(const std::string& name);  // adds the name when new
+  // Appends `other`, renumbering its vertices and patches.
+  void append(const TriangleMesh& other);
+};
+
+// Quality of a mesh: smallest interior angle (degrees), shortest and longest edge (m).
+struct MeshQuality {
+  double min_angle_deg = 180.0, min_edge = 0.0, max_edge = 0.0;
+};
+MeshQuality mesh_quality(const TriangleMesh& mesh);
+
+}  // namespace bedforge::meshing
