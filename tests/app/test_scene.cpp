@@ -52,6 +52,6 @@ TEST(Scene, ImportPathIsRelativeToTheSceneFile) {
 
 TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
   EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[mesh]\nsize_d = 1\n"), InputError);
-  EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[outputs]\nfiles = [\"stl\"]\n"),
+  EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[outputs]\nfiles = [\"openfoam\"]\n"),
                InputError);
 }
