@@ -66,10 +66,16 @@ def mean_profile(results, name):
     return ps[0]["wall_distance_d"], np.mean([p["void_fraction"] for p in ps], axis=0)
 
 
-def ordering_depth(z, eps, bulk, band=0.02):
-    """Wall distance (d) beyond which the profile stays within +-band of the bulk value."""
-    outside = np.nonzero(np.abs(eps - bulk) > band)[0]
-    return float(z[outside[-1] + 1]) if len(outside) and outside[-1] + 1 < len(z) else float(z[-1])
+def ordering_depth(z, eps, bulk, band=0.02, window=0.5, axis_margin=1.0):
+    """Wall distance (d) beyond which the profile, averaged over `window` d, stays within +-band
+    of the bulk value; the last `axis_margin` d before the axis are left out (their shells are
+    too thin for a stable value)."""
+    step = z[1] - z[0]
+    k = max(1, int(round(window / step)))
+    smooth = np.convolve(eps, np.ones(k) / k, mode="same")
+    keep = z <= z[-1] - axis_margin
+    outside = np.nonzero(np.abs(smooth[keep] - bulk) > band)[0]
+    return float(z[keep][outside[-1] + 1]) if len(outside) and outside[-1] + 1 < keep.sum() else float(z[keep][-1])
 
 
 def fig3(runs):
