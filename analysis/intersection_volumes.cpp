@@ -43,6 +43,21 @@ struct GaussLegendre {
   }
 };
 
+// Integral over [cuts.front(), cuts.back()] of f(z), by 24-point Gauss-Legendre on each piece
+// between consecutive cuts (sorted here); the callers cut where f is not smooth.
+template <class F>
+double integrate_pieces(std::vector<double> cuts, F f) {
+  static const GaussLegendre gl;
+  std::sort(cuts.begin(), cuts.end());
+  double v = 0.0;
+  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double mid = 0.5 * (cuts[k] + cuts[k + 1]), half = 0.5 * (cuts[k + 1] - cuts[k]);
+    if (half <= 0.0) continue;
+    for (int q = 0; q < GaussLegendre::n; ++q) v += half * gl.w[q] * f(mid + half * gl.x[q]);
+  }
+  return v;
+}
+
 }  // namespace
 
 double sphere_slab_volume(double r, double zc, double z1, double z2) {
@@ -69,7 +84,6 @@ double sphere_cylinder_volume(double r, double s, double zc, double rho, double 
   if (hi <= lo || rho <= 0.0) return 0.0;
   if (s + r <= rho) return sphere_slab_volume(r, zc, lo, hi);  // wholly inside
   if (s >= r + rho) return 0.0;                                 // wholly outside
-  static const GaussLegendre gl;
   // The lens changes form where the section radius a(z) = sqrt(r^2 - (z - zc)^2) equals
   // |rho - s| or rho + s; split there.
   std::vector<double> cuts = {lo, hi};
@@ -80,18 +94,9 @@ double sphere_cylinder_volume(double r, double s, double zc, double rho, double 
         if (z > lo && z < hi) cuts.push_back(z);
     }
   if (zc > lo && zc < hi) cuts.push_back(zc);
-  std::sort(cuts.begin(), cuts.end());
-  double v = 0.0;
-  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
-    const double mid = 0.5 * (cuts[k] + cuts[k + 1]), half = 0.5 * (cuts[k + 1] - cuts[k]);
-    if (half <= 0.0) continue;
-    for (int q = 0; q < GaussLegendre::n; ++q) {
-      const double z = mid + half * gl.x[q];
-      const double a = std::sqrt(std::max(0.0, r * r - (z - zc) * (z - zc)));
-      v += half * gl.w[q] * disk_lens_area(a, s, rho);
-    }
-  }
-  return v;
+  return integrate_pieces(std::move(cuts), [&](double z) {
+    return disk_lens_area(std::sqrt(std::max(0.0, r * r - (z - zc) * (z - zc))), s, rho);
+  });
 }
 
 double sphere_halfspace_volume(double r, double xc, double zc, double x_max, double z1, double z2) {
@@ -100,28 +105,18 @@ double sphere_halfspace_volume(double r, double xc, double zc, double x_max, dou
   const double t0 = x_max - xc;
   if (t0 >= r) return sphere_slab_volume(r, zc, lo, hi);  // wholly on the kept side
   if (t0 <= -r) return 0.0;
-  static const GaussLegendre gl;
   // The segment of the section disk (radius a) left of the line vanishes or fills the disk
   // where a = |x_max - xc|; split there and at the equator.
   std::vector<double> cuts = {lo, hi};
   const double h = std::sqrt(r * r - t0 * t0);
   for (double z : {zc - h, zc + h, zc})
     if (z > lo && z < hi) cuts.push_back(z);
-  std::sort(cuts.begin(), cuts.end());
-  double v = 0.0;
-  for (size_t k = 0; k + 1 < cuts.size(); ++k) {
-    const double mid = 0.5 * (cuts[k] + cuts[k + 1]), half = 0.5 * (cuts[k + 1] - cuts[k]);
-    if (half <= 0.0) continue;
-    for (int q = 0; q < GaussLegendre::n; ++q) {
-      const double z = mid + half * gl.x[q];
-      const double a2 = std::max(0.0, r * r - (z - zc) * (z - zc)), a = std::sqrt(a2);
-      if (a <= 0.0) continue;
-      const double t = std::clamp(t0 / a, -1.0, 1.0);
-      // Disk minus the cap beyond the line x = x_max.
-      v += half * gl.w[q] * a2 * (std::numbers::pi - std::acos(t) + t * std::sqrt(1.0 - t * t));
-    }
-  }
-  return v;
+  return integrate_pieces(std::move(cuts), [&](double z) {
+    const double a2 = std::max(0.0, r * r - (z - zc) * (z - zc)), a = std::sqrt(a2);
+    if (a <= 0.0) return 0.0;
+    const double t = std::clamp(t0 / a, -1.0, 1.0);
+    return a2 * (std::numbers::pi - std::acos(t) + t * std::sqrt(1.0 - t * t));  // disk minus the cap beyond x_max
+  });
 }
 
 }  // namespace bedforge::analysis

@@ -4,9 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numbers>
-#include <tuple>
 
 #include "analysis/void_fraction.hpp"
 #include "core/error.hpp"
@@ -37,23 +35,6 @@ nlohmann::json to_json(const SurfaceParams& p) {
 }
 
 namespace {
-
-// Merges vertices with identical coordinates: the container's parts are meshed on their own
-// with bit-identical seam vertices, and welding them makes the surface one closed mesh.
-void weld(TriangleMesh& m) {
-  std::map<std::tuple<double, double, double>, int> index;
-  std::vector<int> to(m.points.size());
-  std::vector<Eigen::Vector3d> kept;
-  for (std::size_t i = 0; i < m.points.size(); ++i) {
-    const auto key = std::make_tuple(m.points[i].x(), m.points[i].y(), m.points[i].z());
-    const auto [it, fresh] = index.emplace(key, static_cast<int>(kept.size()));
-    if (fresh) kept.push_back(m.points[i]);
-    to[i] = it->second;
-  }
-  m.points = std::move(kept);
-  for (auto& t : m.triangles)
-    for (int& v : t) v = to[v];
-}
 
 // Largest distance a polygon of n sides inscribed in a circle of radius R lies inside it.
 double sagitta(double R, int n) { return R * (1.0 - std::cos(std::numbers::pi / n)); }
@@ -130,7 +111,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   f.append(ring_mesh(r_in, R, z0, edge, false, false, false, "inlet"));
   f.append(ring_mesh(r_in, R, z1, edge, true, stagger_top, stagger_top, "outlet"));
   if (ann) f.append(tube_mesh(r_in, z0, z1, edge, false, "inner_wall"));
-  weld(f);
+  f.weld();  // the container parts share bit-identical seam vertices
   double chordal = 0.0, solid = 0.0, solid0 = 0.0, area0 = 0.0;
   for (std::size_t i = 0; i < bed.size(); ++i) {
     const double ri = s * r[i];

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <tuple>
 
 namespace bedforge::meshing {
 
@@ -22,6 +24,21 @@ void TriangleMesh::append(const TriangleMesh& other) {
     triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
     patch.push_back(patch_index(other.patches[other.patch[t]]));
   }
+}
+
+void TriangleMesh::weld() {
+  std::map<std::tuple<double, double, double>, int> index;
+  std::vector<int> to(points.size());
+  std::vector<Eigen::Vector3d> kept;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto [it, fresh] = index.emplace(std::make_tuple(points[i].x(), points[i].y(), points[i].z()),
+                                           static_cast<int>(kept.size()));
+    if (fresh) kept.push_back(points[i]);
+    to[i] = it->second;
+  }
+  points = std::move(kept);
+  for (auto& t : triangles)
+    for (int& v : t) v = to[v];
 }
 
 MeshQuality mesh_quality(const TriangleMesh& m) {

@@ -20,6 +20,9 @@ struct TriangleMesh {
   int patch_index(const std::string& name);  // adds the name when new
   // Appends `other`, renumbering its vertices and patches.
   void append(const TriangleMesh& other);
+  // Merges vertices with bit-identical coordinates: parts meshed on their own with shared seam
+  // vertices become one connected mesh.
+  void weld();
 };
 
 // Quality of a mesh: smallest interior angle (degrees), shortest and longest edge (m).

@@ -13,6 +13,7 @@
 #include "core/neighbour_list.hpp"
 #include "core/random.hpp"
 #include "packer/hard_sphere_chain.hpp"
+#include "packer/run_log.hpp"
 
 namespace bedforge::packer {
 
@@ -222,11 +223,6 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
     out.bed.diameters.push_back(d[i]);
   }
   const double time = elapsed();
-  // Keep at most ~300 history points in the report.
-  nlohmann::json thinned = nlohmann::json::array();
-  const std::size_t stride = std::max<std::size_t>(1, (history.size() + 299) / 300);
-  for (std::size_t k = 0; k < history.size(); ++k)
-    if (k % stride == 0 || k + 1 == history.size()) thinned.push_back(history[k]);
   out.info = {{"algorithm", "monte-carlo"},
               {"parameters", to_json(params)},
               {"reference_diameter_m", d_ref},
@@ -240,7 +236,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
               {"stages", stages},
               {"shakes", shakes},
               {"unsettled_shakes", unsettled},
-              {"history", thinned},
+              {"history", thin_history(history)},
               {"max_overlap_d", std::max(0.0, worst) / d_min},
               {"time_s", time}};
   return out;

@@ -10,6 +10,16 @@
 
 namespace bedforge::packer {
 
+// `history` thinned to at most `max_points` evenly spaced points (the last one kept), so a
+// report stays small however long the run.
+inline nlohmann::json thin_history(const nlohmann::json& history, std::size_t max_points = 300) {
+  nlohmann::json h = nlohmann::json::array();
+  const std::size_t n = history.size(), stride = n > max_points ? (n + max_points - 1) / max_points : 1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (i % stride == 0 || i + 1 == n) h.push_back(history[i]);
+  return h;
+}
+
 // Book-keeping shared by the packing modes: the iteration budget, per-stage iterations and
 // time, the convergence history (error measure against elapsed time) and recovery events.
 class RunLog {
@@ -63,14 +73,12 @@ class RunLog {
   std::size_t recoveries() const { return recoveries_.size(); }
   void show(const std::string& status, double fraction = -1.0) { progress_.update(status, fraction); }
 
-  // History thinned to at most `max_points` evenly spaced points (the last one kept).
   nlohmann::json to_json(std::size_t max_points = 300) {
     end_stage();
-    nlohmann::json h = nlohmann::json::array();
-    const std::size_t n = history_.size(), stride = n > max_points ? (n + max_points - 1) / max_points : 1;
-    for (std::size_t i = 0; i < n; ++i)
-      if (i % stride == 0 || i + 1 == n) h.push_back(history_[i]);
-    return {{"iterations", iterations_}, {"stages", stages_}, {"recoveries", recoveries_}, {"history", h}};
+    return {{"iterations", iterations_},
+            {"stages", stages_},
+            {"recoveries", recoveries_},
+            {"history", thin_history(history_, max_points)}};
   }
 
  private:

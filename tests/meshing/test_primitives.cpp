@@ -3,9 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <map>
 #include <numbers>
-#include <tuple>
 
 #include "meshing/surface_checks.hpp"
 
@@ -56,18 +54,7 @@ TEST(Primitives, TubeAndCapsWeldIntoAClosedCylinder) {
       m.append(ring_mesh(r_in, R, 0.0, edge, false, false, false, "inlet"));
       m.append(ring_mesh(r_in, R, height, edge, true, st, st, "outlet"));
       if (r_in > 0) m.append(tube_mesh(r_in, 0.0, height, edge, false, "inner_wall"));
-      // Weld identical coordinates the way the fluid surface does.
-      std::map<std::tuple<double, double, double>, int> id;
-      std::vector<int> to(m.points.size());
-      std::vector<Eigen::Vector3d> kept;
-      for (size_t i = 0; i < m.points.size(); ++i) {
-        auto [it, fresh] = id.emplace(std::make_tuple(m.points[i].x(), m.points[i].y(), m.points[i].z()), int(kept.size()));
-        if (fresh) kept.push_back(m.points[i]);
-        to[i] = it->second;
-      }
-      m.points = kept;
-      for (auto& t : m.triangles)
-        for (int& v : t) v = to[v];
+      m.weld();
       const SurfaceCheck k = check_surface(m, 1'000'000);
       ASSERT_TRUE(k.manifold && k.closed) << "r_in " << r_in << " h " << height;
       EXPECT_FALSE(k.self_intersecting);
