@@ -120,10 +120,15 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
   j["check"] = check.to_json();
   const double exact = j["fluid_volume_exact_m3"].get<double>();
   j["fluid_volume_mesh_m3"] = check.volume;
-  if (!check.manifold || !check.closed || check.self_intersecting)
-    throw std::runtime_error(fmt::format("internal error: the fluid surface is not valid ({}); please report it with "
-                                         "the bed",
-                                         check.to_json().dump()));
+  if (!check.manifold || !check.closed || check.self_intersecting) {
+    std::string where;
+    for (std::size_t k = 0; k < std::min<std::size_t>(5, check.defects.size()); ++k)
+      where += fmt::format(" ({:.4g}, {:.4g}, {:.4g}) m used by {} triangles;", check.defects[k].at.x(),
+                           check.defects[k].at.y(), check.defects[k].at.z(), check.defects[k].triangles);
+    throw std::runtime_error(fmt::format("the fluid surface is not valid ({}); {} defective edges, first at{} please "
+                                         "report it with the bed",
+                                         check.to_json().dump(), check.defects.size(), where));
+  }
   j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
   files.add("fluid.stl", meshing::stl_ascii_by_patch(fs.fluid));
   for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
@@ -133,9 +138,11 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;
   j["summary"] = fmt::format(
-      "surface ({}): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, min angle {:.1f} deg, "
-      "smallest gap {:.3g} d, {:.2f} s",
-      j["parameters"]["treatment"].get<std::string>(), j["triangles"].get<std::size_t>(),
+      "surface ({}, {} contacts treated): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, "
+      "min angle {:.1f} deg, smallest gap {:.3g} d, {:.2f} s",
+      j["parameters"]["treatment"].get<std::string>(),
+      j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"]["particle_wall"].get<long>(),
+      j["triangles"].get<std::size_t>(),
       check.self_intersections_checked ? "no self-intersection" : "self-intersections not checked",
       j["fluid_volume_relative_error"].get<double>(), j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
@@ -301,13 +308,30 @@ int run_command_line(int argc, char** argv) {
   CLI::App* surface = app.add_subcommand("surface", "treat contacts and build the fluid-domain surface of DIR/bed.csv: "
                                                     "writes fluid.stl (a named solid per patch), fluid_PATCH.stl, bed.stl");
   surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
-  std::optional<std::string> treatment;
-  std::optional<double> shrink_factor, edge_length_d, inlet_length_d, outlet_length_d;
-  surface->add_option("--contacts", treatment, "shrink|none, contact treatment (sets contacts.treatment); default shrink");
+  std::optional<std::string> treatment, wall_treatment;
+  std::optional<double> shrink_factor, enlarge_factor, bridge_diameter_d, bridge_gap_d, cap_gap_d, edge_length_d,
+      contact_edge_length_d, inlet_length_d, outlet_length_d;
+  surface->add_option("--contacts", treatment,
+                      "bridge|cap|shrink|enlarge|none, contact treatment (sets contacts.treatment); default shrink");
+  surface->add_option("--wall-contacts", wall_treatment,
+                      "same|bridge|cap|none, treatment of sphere-wall contacts (sets contacts.wall_treatment); "
+                      "default same");
   surface->add_option("--shrink-factor", shrink_factor,
                       "FLOAT in [0.5,1), sphere scale for shrink (sets contacts.shrink_factor); default 0.99");
+  surface->add_option("--enlarge-factor", enlarge_factor,
+                      "FLOAT in (1,1.2], sphere scale for enlarge (sets contacts.enlarge_factor); default 1.01");
+  surface->add_option("--bridge-diameter-d", bridge_diameter_d,
+                      "FLOAT in (0,0.8), bridge diameter in diameters (sets contacts.bridge_diameter_d); default 0.2");
+  surface->add_option("--bridge-gap-d", bridge_gap_d,
+                      "FLOAT in [0,0.5], gaps below this get a bridge, in diameters (sets contacts.bridge_gap_d); "
+                      "default 0.01");
+  surface->add_option("--cap-gap-d", cap_gap_d,
+                      "FLOAT in (0,0.2], gap caps leave, in diameters (sets contacts.cap_gap_d); default 0.02");
   surface->add_option("--edge-length-d", edge_length_d,
                       "FLOAT in [0.001,1], target triangle edge in diameters (sets surface.edge_length_d); default 0.1");
+  surface->add_option("--contact-edge-length-d", contact_edge_length_d,
+                      "FLOAT in [0.001,1], edge where treated contacts meet, in diameters (sets "
+                      "surface.contact_edge_length_d); default 0.025");
   surface->add_option("--inlet-length-d", inlet_length_d,
                       "FLOAT >= 0, empty section below the bed in diameters (sets surface.inlet_length_d); default 1");
   surface->add_option("--outlet-length-d", outlet_length_d,
@@ -352,8 +376,14 @@ int run_command_line(int argc, char** argv) {
 #ifdef BEDFORGE_HAVE_CGAL
   if (*surface) {
     if (treatment) override_key(table, "contacts.treatment", *treatment);
+    if (wall_treatment) override_key(table, "contacts.wall_treatment", *wall_treatment);
     if (shrink_factor) override_key(table, "contacts.shrink_factor", *shrink_factor);
+    if (enlarge_factor) override_key(table, "contacts.enlarge_factor", *enlarge_factor);
+    if (bridge_diameter_d) override_key(table, "contacts.bridge_diameter_d", *bridge_diameter_d);
+    if (bridge_gap_d) override_key(table, "contacts.bridge_gap_d", *bridge_gap_d);
+    if (cap_gap_d) override_key(table, "contacts.cap_gap_d", *cap_gap_d);
     if (edge_length_d) override_key(table, "surface.edge_length_d", *edge_length_d);
+    if (contact_edge_length_d) override_key(table, "surface.contact_edge_length_d", *contact_edge_length_d);
     if (inlet_length_d) override_key(table, "surface.inlet_length_d", *inlet_length_d);
     if (outlet_length_d) override_key(table, "surface.outlet_length_d", *outlet_length_d);
     SceneSection contacts(table["contacts"].as_table(), "contacts"), surf(table["surface"].as_table(), "surface");

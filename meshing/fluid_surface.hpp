@@ -10,14 +10,25 @@ namespace bedforge::meshing {
 // Contact treatment and fluid-domain surface, scene sections [contacts] and [surface]. Lengths
 // in reference diameters d (Sauter mean); `resolve` turns them into metres in one place.
 struct SurfaceParams {
-  enum class Treatment { none, shrink };
+  // none: spheres as they are (no contact allowed); shrink: every sphere scaled about its
+  // centre; enlarge: every sphere grown, overlaps joined (union); bridge: a cylinder joins each
+  // pair (and sphere and wall) closer than bridge_gap_d; cap: both sides cut flat, leaving cap_gap_d.
+  enum class Treatment { none, shrink, enlarge, bridge, cap };
   Treatment treatment = Treatment::shrink;
-  double shrink_factor = 0.99;          // shrink: every sphere scaled about its centre
+  Treatment wall_treatment = Treatment::shrink;  // bridge, cap or none; shrink and enlarge act on the walls' contacts too
+  double shrink_factor = 0.99;
+  double enlarge_factor = 1.01;
+  double bridge_diameter_d = 0.2;
+  double bridge_gap_d = 0.01;           // pairs closer than this get a bridge
+  double cap_gap_d = 0.02;              // pairs closer than this are capped, leaving this gap
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
+  double contact_edge_length_d = 0.025; // edge on the loops where treated contacts meet (refinement near contacts)
+  double growth = 1.3;                  // edge growth per ring away from those loops
   double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
   double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
   long self_intersection_limit = 2'000'000;  // triangles above which the CGAL self-intersection test is skipped
 };
+const char* treatment_name(SurfaceParams::Treatment t);
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);
 nlohmann::json to_json(const SurfaceParams& p);
 

@@ -1,66 +1,70 @@
 #include "meshing/primitives.hpp"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
+
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <map>
 #include <numbers>
+#include <tuple>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "meshing/spaced_points.hpp"
 
 namespace bedforge::meshing {
 
 namespace {
 
-constexpr int kMaxLevel = 6;  // 81920 triangles per sphere
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Hull = CGAL::Surface_mesh<Kernel::Point_3>;
 
-// Unit icospheres of levels 0..kMaxLevel, built once.
-const std::vector<TriangleMesh>& unit_icospheres() {
-  static const std::vector<TriangleMesh> levels = [] {
-    std::vector<TriangleMesh> out;
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    TriangleMesh m;
-    for (auto p : {Eigen::Vector3d(-1, t, 0), Eigen::Vector3d(1, t, 0), Eigen::Vector3d(-1, -t, 0), Eigen::Vector3d(1, -t, 0),
-                   Eigen::Vector3d(0, -1, t), Eigen::Vector3d(0, 1, t), Eigen::Vector3d(0, -1, -t), Eigen::Vector3d(0, 1, -t),
-                   Eigen::Vector3d(t, 0, -1), Eigen::Vector3d(t, 0, 1), Eigen::Vector3d(-t, 0, -1), Eigen::Vector3d(-t, 0, 1)})
-      m.points.push_back(p.normalized());
-    m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                   {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-    out.push_back(m);
-    for (int level = 1; level <= kMaxLevel; ++level) {
-      TriangleMesh next;
-      next.points = out.back().points;
-      std::map<std::pair<int, int>, int> midpoint;
-      auto mid = [&](int a, int b) {
-        const auto key = std::minmax(a, b);
-        const auto it = midpoint.find(key);
-        if (it != midpoint.end()) return it->second;
-        next.points.push_back((next.points[a] + next.points[b]).normalized());
-        return midpoint[key] = static_cast<int>(next.points.size()) - 1;
-      };
-      for (const auto& tr : out.back().triangles) {
-        const int ab = mid(tr[0], tr[1]), bc = mid(tr[1], tr[2]), ca = mid(tr[2], tr[0]);
-        next.triangles.insert(next.triangles.end(), {{tr[0], ab, ca}, {tr[1], bc, ab}, {tr[2], ca, bc}, {ab, bc, ca}});
-      }
-      out.push_back(std::move(next));
-    }
-    return out;
-  }();
-  return levels;
-}
-
-int sphere_level(double r, double edge) {
-  // Icosahedron edge 1.0515 r, halved at every level.
-  int level = 0;
-  while (level < kMaxLevel && 1.0515 * r / std::pow(2.0, level) > edge) ++level;
-  return level;
-}
-
-// Flips every triangle whose normal disagrees with `desired(centroid)`.
-void orient(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& desired) {
-  for (auto& t : m.triangles) {
-    const Eigen::Vector3d &a = m.points[t[0]], &b = m.points[t[1]], &c = m.points[t[2]];
-    if ((b - a).cross(c - a).dot(desired((a + b + c) / 3.0)) < 0.0) std::swap(t[1], t[2]);
+// The loop of `cut` moved away from its axis by the arc `offset` on the sphere (c, r), then
+// resampled at `spacing` (starting half a step on when `stagger`).
+std::vector<Eigen::Vector3d> offset_loop(const SphereCut& cut, const Eigen::Vector3d& c, double r, double offset,
+                                         double spacing, bool stagger) {
+  std::vector<Eigen::Vector3d> moved;
+  for (const auto& p : cut.loop) {
+    const Eigen::Vector3d q = (p - c) / r;
+    const double along = std::clamp(q.dot(cut.axis), -1.0, 1.0);
+    Eigen::Vector3d e = q - along * cut.axis;
+    if (e.norm() < 1e-12) continue;
+    e.normalize();
+    const double beta = std::acos(along) + offset / r;
+    if (beta >= std::numbers::pi) return {};
+    moved.push_back(c + r * (std::cos(beta) * cut.axis + std::sin(beta) * e));
   }
+  if (moved.size() < 3) return {};
+  std::vector<double> at{0.0};
+  for (std::size_t k = 0; k < moved.size(); ++k) at.push_back(at.back() + (moved[(k + 1) % moved.size()] - moved[k]).norm());
+  const int n = std::max(6, static_cast<int>(std::lround(at.back() / spacing)));
+  std::vector<Eigen::Vector3d> out;
+  std::size_t seg = 0;
+  for (int k = 0; k < n; ++k) {
+    const double s = (k + (stagger ? 0.5 : 0.0)) * at.back() / n;
+    while (seg + 1 < moved.size() && at[seg + 1] < s) ++seg;
+    const double t = (s - at[seg]) / std::max(at[seg + 1] - at[seg], 1e-300);
+    const Eigen::Vector3d p = moved[seg] + t * (moved[(seg + 1) % moved.size()] - moved[seg]);
+    out.push_back(c + r * (p - c).normalized());
+  }
+  return out;
+}
+
+long edge_key(int a, int b) { return static_cast<long>(std::min(a, b)) << 32 | static_cast<long>(std::max(a, b)); }
+
+}  // namespace
+
+Frame Frame::along(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis) {
+  Frame f;
+  f.origin = origin;
+  f.w = axis.normalized();
+  if (f.w == Eigen::Vector3d::UnitZ()) return f;
+  const Eigen::Vector3d helper = std::abs(f.w.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  f.u = (helper - helper.dot(f.w) * f.w).normalized();
+  f.v = f.w.cross(f.u);
+  return f;
 }
 
 Eigen::Vector3d on_circle(double R, int j, int n, bool stagger, double z) {
@@ -68,44 +72,129 @@ Eigen::Vector3d on_circle(double R, int j, int n, bool stagger, double z) {
   return {R * std::cos(theta), R * std::sin(theta), z};
 }
 
-}  // namespace
-
-TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, double edge, bool outward, const std::string& patch) {
-  TriangleMesh m = unit_icospheres()[sphere_level(r, edge)];
-  for (auto& p : m.points) p = c + r * p;
-  m.patch.assign(m.triangles.size(), 0);
-  m.patches = {patch};
-  orient(m, [&](const Eigen::Vector3d& q) { return outward ? Eigen::Vector3d(q - c) : Eigen::Vector3d(c - q); });
-  return m;
-}
-
-double sphere_chordal_deviation(double r, double edge) {
-  const TriangleMesh& m = unit_icospheres()[sphere_level(r, edge)];
-  double worst = 0.0;
-  for (const auto& t : m.triangles) {
-    const Eigen::Vector3d n = (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).normalized();
-    worst = std::max(worst, 1.0 - std::abs(n.dot(m.points[t[0]])));
-  }
-  return r * worst;
-}
-
 int ring_points(double R, double edge) {
   return std::max(8, static_cast<int>(std::ceil(2.0 * std::numbers::pi * R / edge)));
 }
 
-bool top_ring_staggered(double z0, double z1, double edge) {
-  const int nz = std::max(1, static_cast<int>(std::ceil((z1 - z0) / (edge * std::sqrt(3.0) / 2.0))));
-  return nz % 2 == 1;
+std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n) {
+  std::vector<Eigen::Vector3d> loop;
+  for (int j = 0; j < n; ++j) loop.push_back(f.to_world(on_circle(rho, j, n, false, 0.0)));
+  return loop;
 }
 
-TriangleMesh tube_mesh(double R, double z0, double z1, double edge, bool outward, const std::string& patch) {
-  TriangleMesh m;
-  const int n = ring_points(R, edge);
-  const int nz = std::max(1, static_cast<int>(std::ceil((z1 - z0) / (edge * std::sqrt(3.0) / 2.0))));
-  for (int k = 0; k <= nz; ++k) {
-    const double z = k == nz ? z1 : z0 + (z1 - z0) * k / nz;
-    for (int j = 0; j < n; ++j) m.points.push_back(on_circle(R, j, n, k % 2 == 1, z));
+TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
+                         double growth, bool outward, const std::string& patch) {
+  const int n_lattice =
+      std::max(48, static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (edge * edge * std::sqrt(3.0) / 2.0))));
+  const double h = std::min(edge, std::sqrt(4.0 * std::numbers::pi * r * r / (n_lattice * std::sqrt(3.0) / 2.0)));
+  SpacedPoints pts(h);
+  auto is_removed = [&](const Eigen::Vector3d& p) {
+    for (const auto& cut : cuts)
+      if (cut.removed(p)) return true;
+    return false;
+  };
+  // 1. The loops, exactly as given; owner[v] = the cut whose loop v is on.
+  std::vector<int> owner;
+  for (std::size_t k = 0; k < cuts.size(); ++k)
+    for (const auto& p : cuts[k].loop) {
+      pts.add(p, std::min(cuts[k].spacing, h));
+      owner.push_back(static_cast<int>(k));
+    }
+  // 2. Rings graded from each loop's spacing to h, ring by ring across all cuts.
+  std::vector<double> spacing(cuts.size()), offset(cuts.size(), 0.0);
+  for (std::size_t k = 0; k < cuts.size(); ++k) spacing[k] = std::min(cuts[k].spacing, h);
+  for (int ring = 1;; ++ring) {
+    bool any = false;
+    for (std::size_t k = 0; k < cuts.size(); ++k) {
+      if (ring > 1 && spacing[k] >= h) continue;
+      const double next = std::min(h, spacing[k] * growth);
+      offset[k] += std::sqrt(3.0) / 2.0 * 0.5 * (spacing[k] + next);
+      spacing[k] = next;
+      any = true;
+      for (const auto& p : offset_loop(cuts[k], c, r, offset[k], next, ring % 2 == 1))
+        if (!is_removed(p) && pts.fits(p, next)) pts.add(p, next), owner.push_back(-1);
+    }
+    if (!any) break;
   }
+  // 3. The Fibonacci lattice.
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < n_lattice; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / n_lattice, rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Eigen::Vector3d p = c + r * Eigen::Vector3d(rho * std::cos(k * golden), rho * std::sin(k * golden), z);
+    if (!is_removed(p) && pts.fits(p, h)) pts.add(p, h), owner.push_back(-1);
+  }
+  // 4. Convex hull; faces spanning one loop are the removed parts.
+  std::vector<Kernel::Point_3> kp;
+  std::map<std::tuple<double, double, double>, int> index;
+  for (std::size_t v = 0; v < pts.points.size(); ++v) {
+    const auto& p = pts.points[v];
+    kp.emplace_back(p.x(), p.y(), p.z());
+    index.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(v));
+  }
+  Hull hull;
+  CGAL::convex_hull_3(kp.begin(), kp.end(), hull);
+  TriangleMesh m;
+  m.points = pts.points;
+  std::unordered_set<long> edges;
+  for (auto f : hull.faces()) {
+    std::array<int, 3> t;
+    int k = 0;
+    for (auto v : hull.vertices_around_face(hull.halfedge(f))) {
+      const auto& p = hull.point(v);
+      t[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
+    }
+    if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
+    m.triangles.push_back(t);
+    for (int e = 0; e < 3; ++e) edges.insert(edge_key(t[e], t[(e + 1) % 3]));
+  }
+  for (int first = 0, k = 0; k < static_cast<int>(cuts.size()); first += static_cast<int>(cuts[k].loop.size()), ++k) {
+    const int n = static_cast<int>(cuts[k].loop.size());
+    for (int j = 0; j < n; ++j)
+      if (!edges.count(edge_key(first + j, first + (j + 1) % n)))
+        throw CutConflict("a cut's loop is not an edge path of the sphere mesh (cuts too close together or crossing)");
+  }
+  m.patch.assign(m.triangles.size(), 0);
+  m.patches = {patch};
+  orient_by(m, [&](const Eigen::Vector3d& q) { return outward ? Eigen::Vector3d(q - c) : Eigen::Vector3d(c - q); });
+  return m;
+}
+
+double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double r) {
+  double worst = 0.0;
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d n = (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).normalized();
+    worst = std::max(worst, r - std::abs(n.dot(m.points[t[0]] - c)));
+  }
+  return worst;
+}
+
+std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length) {
+  std::vector<Eigen::Vector3d> loop;
+  for (int j = 0; j < n; ++j) {
+    Eigen::Vector3d local = on_circle(rho, j, n, false, 0.0);
+    local.z() = length(local.x(), local.y());
+    loop.push_back(f.to_world(local));
+  }
+  return loop;
+}
+
+TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength& length, double edge, bool outward,
+                       const std::string& patch) {
+  TriangleMesh m;
+  const double step = std::min(edge, 2.0 * std::numbers::pi * rho / n);
+  double longest = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d q = on_circle(rho, j, n, false, 0.0);
+    longest = std::max(longest, length(q.x(), q.y()));
+  }
+  const int nz = 2 * std::max(1, static_cast<int>(std::ceil(longest / (std::sqrt(3.0) * step))));
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j < n; ++j) {
+      Eigen::Vector3d local = on_circle(rho, j, n, k % 2 == 1, 0.0);
+      if (k == nz) local.z() = length(local.x(), local.y());
+      else if (k > 0) local.z() = length(local.x(), local.y()) * k / nz;
+      m.points.push_back(f.to_world(local));
+    }
   auto at = [&](int k, int j) { return k * n + (j % n); };
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < n; ++j) {
@@ -119,34 +208,29 @@ TriangleMesh tube_mesh(double R, double z0, double z1, double edge, bool outward
     }
   m.patch.assign(m.triangles.size(), 0);
   m.patches = {patch};
-  orient(m, [&](const Eigen::Vector3d& q) {
-    const Eigen::Vector3d radial(q.x(), q.y(), 0.0);
+  orient_by(m, [&](const Eigen::Vector3d& q) {
+    const Eigen::Vector3d d = q - f.origin, radial = d - d.dot(f.w) * f.w;
     return outward ? radial : Eigen::Vector3d(-radial);
   });
   return m;
 }
 
-TriangleMesh ring_mesh(double r_in, double r_out, double z, double edge, bool up, bool stagger_outer, bool stagger_inner,
-                       const std::string& patch) {
+TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, bool along_w, const std::string& patch) {
   TriangleMesh m;
   const int rings = std::max(1, static_cast<int>(std::ceil((r_out - r_in) / (edge * std::sqrt(3.0) / 2.0))));
-  // Ring m from the inside out; ring 0 of a disk is its centre.
+  // Ring k from the inside out; ring 0 of a disk is its centre.
   std::vector<int> first, count;
-  std::vector<double> offset;
   for (int k = 0; k <= rings; ++k) {
     const double rho = k == rings ? r_out : r_in + (r_out - r_in) * k / rings;
     first.push_back(static_cast<int>(m.points.size()));
     if (rho <= 0.0) {
-      m.points.emplace_back(0.0, 0.0, z);
+      m.points.push_back(f.to_world(Eigen::Vector3d::Zero()));
       count.push_back(1);
-      offset.push_back(0.0);
       continue;
     }
     const int n = k == 0 || k == rings ? ring_points(rho, edge) : std::max(6, ring_points(rho, edge));
-    const bool stagger = (k == rings && stagger_outer) || (k == 0 && stagger_inner);
-    for (int j = 0; j < n; ++j) m.points.push_back(on_circle(rho, j, n, stagger, z));
+    for (const auto& p : circle_loop(f, rho, n)) m.points.push_back(p);
     count.push_back(n);
-    offset.push_back(stagger ? 0.5 : 0.0);
   }
   for (int k = 0; k < rings; ++k) {
     const int na = count[k], nb = count[k + 1];
@@ -157,10 +241,8 @@ TriangleMesh ring_mesh(double r_in, double r_out, double z, double edge, bool up
       continue;
     }
     // Zip the two rings together, always advancing along the ring whose next vertex comes first.
-    auto angle_a = [&](int i) { return (i + offset[k]) / na; };
-    auto angle_b = [&](int j) { return (j + offset[k + 1]) / nb; };
     for (int i = 0, j = 0; i < na || j < nb;) {
-      if (j >= nb || (i < na && angle_a(i + 1) <= angle_b(j + 1))) {
+      if (j >= nb || (i < na && static_cast<double>(i + 1) / na <= static_cast<double>(j + 1) / nb)) {
         m.triangles.push_back({A(i), A(i + 1), B(j)});
         ++i;
       } else {
@@ -171,7 +253,7 @@ TriangleMesh ring_mesh(double r_in, double r_out, double z, double edge, bool up
   }
   m.patch.assign(m.triangles.size(), 0);
   m.patches = {patch};
-  orient(m, [&](const Eigen::Vector3d&) { return Eigen::Vector3d(0, 0, up ? 1.0 : -1.0); });
+  orient_by(m, [&](const Eigen::Vector3d&) { return along_w ? f.w : Eigen::Vector3d(-f.w); });
   return m;
 }
 

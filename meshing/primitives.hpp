@@ -1,35 +1,76 @@
 #pragma once
 #include <Eigen/Core>
 
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
 
 // Meshes of the shapes a fluid domain is made of, each on its own with vertices on the exact
-// surface, so work is proportional to the number of shapes. `edge` is the target edge length
-// (m). `outward` = true orients normals away from the shape's inside, false towards it.
+// surface, so work is proportional to the number of shapes. Shapes that meet share a loop of
+// vertices computed once by the same expression, so their meshes weld into one (no booleans).
+// Lengths in m. `outward` = true orients normals away from the shape's inside.
 
-// Sphere (centre c, radius r) from a subdivided icosahedron: the coarsest level whose edges do
-// not exceed `edge` (at most level 6; minimum angle about 50 degrees at every level).
-TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, double edge, bool outward, const std::string& patch);
+// An orthonormal frame: local (x, y, z) -> origin + x u + y v + z w. `along` builds one whose
+// w is `axis` (unit); for axis +z it is the identity, so z-planes keep exact coordinates.
+struct Frame {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(), v = Eigen::Vector3d::UnitY(),
+                  w = Eigen::Vector3d::UnitZ();
+  static Frame along(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis);
+  Eigen::Vector3d to_world(const Eigen::Vector3d& local) const { return origin + local.x() * u + local.y() * v + local.z() * w; }
+};
 
-// Largest distance between a sphere of radius r and the facets of sphere_mesh (chordal
-// deviation), for the same `edge`.
-double sphere_chordal_deviation(double r, double edge);
-
-// Lateral surface of the cylinder of radius R around the z axis between z0 and z1: rings of
-// `ring_points(R, edge)` vertices, staggered by half a step from ring to ring (near-equilateral
-// triangles); `outward` = normals pointing away from the axis.
-TriangleMesh tube_mesh(double R, double z0, double z1, double edge, bool outward, const std::string& patch);
+// Vertex j of n on the circle of radius R at local height z, half a step on if `stagger`.
+Eigen::Vector3d on_circle(double R, int j, int n, bool stagger, double z);
+// Vertices on a circle of radius R for a target edge: at least 8.
 int ring_points(double R, double edge);
+// The loop where a shape meets a circle of radius rho in the plane z = 0 of `f`: its n
+// vertices, f.to_world(on_circle(rho, j, n, false, 0)).
+std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n);
 
-// Flat ring R_in <= r <= R_out (R_in = 0: a disk) at height z, normal +z if `up`. Its edge
-// circles carry exactly the vertices of tube_mesh's end rings at that height (`stagger` = the
-// half-step offset of the tube's ring there), so a tube and its caps share their seams.
-TriangleMesh ring_mesh(double r_in, double r_out, double z, double edge, bool up, bool stagger_outer,
-                       bool stagger_inner, const std::string& patch);
+// Where a sphere's mesh stops: a closed loop of vertices on the sphere (a circle for caps,
+// bridges and neighbours, the wall curve for a sphere crossing a wall). The sphere keeps the
+// side where `removed` is false.
+struct SphereCut {
+  std::vector<Eigen::Vector3d> loop;              // in order, on the sphere (m)
+  double spacing = 0.0;                           // distance between loop vertices (m)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, from the centre into the removed part
+  std::function<bool(const Eigen::Vector3d&)> removed;
+};
 
-// Whether tube_mesh's ring at height z1 is staggered (the bottom ring at z0 is not).
-bool top_ring_staggered(double z0, double z1, double edge);
+// Thrown when cuts on one sphere overlap or leave a loop edge out of the mesh; the caller
+// names the particles.
+struct CutConflict : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Sphere (centre c, radius r) minus its cuts, open along every cut's loop. Vertices: the loops,
+// rings graded away from each loop (spacing growing by `growth` per ring up to `edge`), and a
+// spherical Fibonacci lattice of spacing `edge` elsewhere, thinned so no two lie closer than
+// 0.8 x their mean spacing; the triangles are their convex hull (the Delaunay triangulation on
+// the sphere) less the faces spanning a loop. At least 48 vertices.
+TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
+                         double growth, bool outward, const std::string& patch);
+
+// Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper
+// bound of the chordal deviation of an inscribed mesh.
+double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double r);
+
+// Generalised tube in frame f: generators at distance rho from the w axis, from local z = 0
+// to z = length(x, y) (> 0), n vertices per ring, rings staggered by half a step, an even
+// number of them so both end loops are unstaggered: the start loop is circle_loop(f, rho, n),
+// the end loop tube_end_loop(f, rho, n, length). `outward` = normals away from the axis.
+using GeneratorLength = std::function<double(double x, double y)>;
+TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength& length, double edge, bool outward,
+                       const std::string& patch);
+std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length);
+
+// Flat ring r_in <= r <= r_out (r_in = 0: a disk) in the plane z = 0 of f, normal +w if
+// `along_w`. Its edge loops are circle_loop(f, r, ring_points(r, edge)).
+TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, bool along_w, const std::string& patch);
 
 }  // namespace bedforge::meshing

@@ -1,6 +1,9 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include <string>
+#include <vector>
+
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -14,6 +17,13 @@ struct SurfaceCheck {
   bool self_intersections_checked = false;  // skipped above the triangle limit (the test is O(n log n) but slow)
   bool self_intersecting = false;
   double volume = 0.0;                      // m^3
+  // Edges not shared by exactly two triangles of opposite orientation: midpoint (m) and the
+  // number of triangles using it. What makes a surface open or non-manifold, and where.
+  struct Defect {
+    Eigen::Vector3d at;
+    int triangles;
+  };
+  std::vector<Defect> defects;
   nlohmann::json to_json() const;
 };
 

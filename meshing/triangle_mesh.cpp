@@ -41,6 +41,13 @@ void TriangleMesh::weld() {
     for (int& v : t) v = to[v];
 }
 
+void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& desired) {
+  for (auto& t : m.triangles) {
+    const Eigen::Vector3d &a = m.points[t[0]], &b = m.points[t[1]], &c = m.points[t[2]];
+    if ((b - a).cross(c - a).dot(desired((a + b + c) / 3.0)) < 0.0) std::swap(t[1], t[2]);
+  }
+}
+
 MeshQuality mesh_quality(const TriangleMesh& m) {
   MeshQuality q;
   q.min_edge = std::numeric_limits<double>::infinity();

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ struct TriangleMesh {
   // vertices become one connected mesh.
   void weld();
 };
+
+// Flips every triangle whose normal disagrees with `desired(centroid)`.
+void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& desired);
 
 // Quality of a mesh: smallest interior angle (degrees), shortest and longest edge (m).
 struct MeshQuality {

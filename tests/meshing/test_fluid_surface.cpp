@@ -78,6 +78,90 @@ TEST(FluidSurface, OverlapsTheTreatmentCannotOpenNameTheParticles) {
   EXPECT_THROW(build_fluid_surface(b, p), InputError);
 }
 
+namespace {
+
+using Treatment = SurfaceParams::Treatment;
+
+// The surface of `b` under treatment `t` must be closed, free of self-intersections, and
+// enclose the exact fluid volume within the discretisation: the chordal deviation over the
+// particle area plus the wall sagitta over the wall area bound the deficit.
+FluidSurface valid_surface(const Bed& b, Treatment t, const std::string& label) {
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = t;
+  const FluidSurface fs = build_fluid_surface(b, p);
+  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
+  EXPECT_TRUE(k.manifold && k.closed) << label << ": " << k.defects.size() << " defective edges";
+  EXPECT_TRUE(k.self_intersections_checked && !k.self_intersecting) << label;
+  const double exact = fs.report["fluid_volume_exact_m3"].get<double>();
+  double particle_area = 0.0;
+  for (double d : b.diameters) particle_area += std::numbers::pi * d * d;
+  const auto& c = *b.container;
+  const double height = fs.report["domain_m"]["outlet_z"].get<double>() - fs.report["domain_m"]["inlet_z"].get<double>();
+  const double wall_area = 2.0 * std::numbers::pi * c.max_radius() * height * 2.0;
+  const double bound = fs.report["chordal_deviation_d"].get<double>() * particle_area +
+                       fs.report["wall_sagitta_d"].get<double>() * wall_area;
+  EXPECT_GT(k.volume, exact - 1e-9 * exact) << label << ": inscribed facets can only add fluid";
+  EXPECT_LT(k.volume - exact, bound) << label;
+  const SurfaceCheck kb = check_surface(fs.bed, 10'000'000);
+  EXPECT_TRUE(kb.closed && !kb.self_intersecting) << label << ": bed solid";
+  EXPECT_GT(kb.volume, 0.0) << label;
+  return fs;
+}
+
+Bed column(std::shared_ptr<Container> c, std::vector<Eigen::Vector3d> centres) {
+  Bed b;
+  b.container = std::move(c);
+  b.centres = std::move(centres);
+  b.diameters.assign(b.centres.size(), 1.0);
+  return b;
+}
+
+const std::vector<std::pair<Treatment, std::string>> kAll{
+    {Treatment::shrink, "shrink"}, {Treatment::bridge, "bridge"}, {Treatment::cap, "cap"}, {Treatment::enlarge, "enlarge"}};
+
+}  // namespace
+
+TEST(FluidSurface, EveryTreatmentHandlesTouchingNearlyTouchingAndWallTangentSpheres) {
+  // A pair exactly touching, a pair 1e-6 d apart, a sphere tangent to the wall of a tube a = 3.
+  const Bed b = column(std::make_shared<Cylinder>(1.5), {{0, 0, 0.6}, {0, 0, 1.6}, {0.0, 0.0, 2.600001}, {0, 1.0, 1.6}});
+  for (const auto& [t, name] : kAll) {
+    const FluidSurface fs = valid_surface(b, t, name);
+    if (t != Treatment::enlarge)
+      EXPECT_GE(fs.report["contacts_treated"]["particle_wall"].get<long>(), 1) << name;
+    EXPECT_GT(fs.report["smallest_gap_d"]["particle_particle"].get<double>(), 0.0) << name;
+  }
+}
+
+TEST(FluidSurface, ThreeMutuallyTouchingSpheresInAnAnnulus) {
+  // Three spheres touching each other (bridges meeting on one sphere), the outer one tangent
+  // to the outer wall, one tangent to the inner wall.
+  const double h = std::sqrt(3.0) / 2.0;
+  const Bed b = column(std::make_shared<Annulus>(3.0, 1.0), {{1.5, 0.0, 0.6}, {2.5, 0.0, 0.6}, {2.0, h, 0.6}});
+  for (const auto& [t, name] : kAll) valid_surface(b, t, name);
+}
+
+TEST(FluidSurface, ImportedOverlapsOfFivePercentAreJoinedOrCapped) {
+  const Bed b = column(std::make_shared<Cylinder>(2.0), {{0, 0, 0.6}, {0.95, 0, 0.6}, {-0.475, 0.82272, 0.6}});
+  for (const auto& [t, name] : kAll)
+    if (t != Treatment::shrink) valid_surface(b, t, name);
+}
+
+TEST(FluidSurface, ABridgeThroughAThirdSphereIsRefusedNamingIt) {
+  // Two large spheres touching, a small one nestled against both at their contact point.
+  Bed b = column(std::make_shared<Cylinder>(4.0), {{-1.0, 0, 1.1}, {1.0, 0, 1.1}, {0.0, 0.0, 1.1 + 0.2}});
+  b.diameters = {2.0, 2.0, 0.2};
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::bridge;
+  p.bridge_diameter_d = 0.5;
+  try {
+    build_fluid_surface(b, p);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("spheres 0 and 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sphere 2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(StlIo, NamedSolidsAndBinarySizes) {
   Bed b;
   b.container = std::make_shared<Cylinder>(1.0);

@@ -1,3 +1,5 @@
+// Meshes of single shapes: closed when they should be, on the exact surface, converging, and
+// sharing their seams bit for bit.
 #include "meshing/primitives.hpp"
 
 #include <gtest/gtest.h>
@@ -11,11 +13,26 @@ using namespace bedforge::meshing;
 
 namespace {
 
+constexpr double kPi = std::numbers::pi;
+
 // Signed volume by the divergence theorem (independent of CGAL).
 double signed_volume(const TriangleMesh& m) {
   double v = 0.0;
   for (const auto& t : m.triangles) v += m.points[t[0]].dot(m.points[t[1]].cross(m.points[t[2]])) / 6.0;
   return v;
+}
+
+// A planar cut of the sphere (c, r) at distance h along the unit axis a, its loop at spacing s.
+SphereCut plane(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, double h, double s, Frame* frame = nullptr) {
+  const double rho = std::sqrt(r * r - h * h);
+  const Frame f = Frame::along(c + h * a, a);
+  if (frame) *frame = f;
+  SphereCut cut;
+  cut.loop = circle_loop(f, rho, ring_points(rho, s));
+  cut.spacing = 2.0 * kPi * rho / cut.loop.size();
+  cut.axis = a;
+  cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
+  return cut;
 }
 
 }  // namespace
@@ -24,44 +41,98 @@ TEST(Primitives, SphereIsClosedInscribedAndConverges) {
   const Eigen::Vector3d c(0.3, -0.2, 1.0);
   double previous_error = 1.0;
   for (double edge : {0.5, 0.25, 0.12, 0.06}) {
-    const TriangleMesh m = sphere_mesh(c, 1.0, edge, true, "particles");
+    const TriangleMesh m = sphere_mesh(c, 1.0, {}, edge, 1.3, true, "particles");
     const SurfaceCheck k = check_surface(m, 1'000'000);
     EXPECT_TRUE(k.manifold && k.closed && k.self_intersections_checked && !k.self_intersecting);
-    const double exact = 4.0 / 3.0 * std::numbers::pi, error = (exact - signed_volume(m)) / exact;
+    const double exact = 4.0 / 3.0 * kPi, error = (exact - signed_volume(m)) / exact;
     EXPECT_NEAR(k.volume, signed_volume(m), 1e-12);
     EXPECT_GT(error, 0.0);  // inscribed: every facet inside the sphere
     EXPECT_LT(error, previous_error);
     // Volume deficit of a polyhedron inside the sphere within its chordal deviation delta: at
     // most the shell 4 pi r^2 delta.
-    EXPECT_LT(error * exact, 4.0 * std::numbers::pi * sphere_chordal_deviation(1.0, edge));
+    EXPECT_LT(error * exact, 4.0 * kPi * chordal_deviation(m, c, 1.0));
     previous_error = error;
     for (const auto& p : m.points) EXPECT_NEAR((p - c).norm(), 1.0, 1e-12);
-    EXPECT_GT(mesh_quality(m).min_angle_deg, 45.0);
-    EXPECT_LE(mesh_quality(m).max_edge, edge * 1.2);
+    EXPECT_GT(mesh_quality(m).min_angle_deg, 30.0);
+    EXPECT_LE(mesh_quality(m).max_edge, edge * 1.6);
   }
   // Inward orientation encloses a negative volume.
-  EXPECT_LT(signed_volume(sphere_mesh(c, 1.0, 0.3, false, "p")), 0.0);
+  EXPECT_LT(signed_volume(sphere_mesh(c, 1.0, {}, 0.3, 1.3, false, "p")), 0.0);
 }
 
-TEST(Primitives, TubeAndCapsWeldIntoAClosedCylinder) {
-  // A cylinder and an annular prism from tube and ring meshes sharing their seams exactly.
-  for (double r_in : {0.0, 0.7}) {
-    for (double height : {1.0, 1.37}) {  // an even and an odd number of rings
-      const double R = 2.0, edge = 0.21;
-      TriangleMesh m;
-      m.append(tube_mesh(R, 0.0, height, edge, true, "wall"));
-      const bool st = top_ring_staggered(0.0, height, edge);
-      m.append(ring_mesh(r_in, R, 0.0, edge, false, false, false, "inlet"));
-      m.append(ring_mesh(r_in, R, height, edge, true, st, st, "outlet"));
-      if (r_in > 0) m.append(tube_mesh(r_in, 0.0, height, edge, false, "inner_wall"));
-      m.weld();
-      const SurfaceCheck k = check_surface(m, 1'000'000);
-      ASSERT_TRUE(k.manifold && k.closed) << "r_in " << r_in << " h " << height;
-      EXPECT_FALSE(k.self_intersecting);
-      // Inscribed polygons: volume within the sagitta of the exact prism.
-      const double exact = std::numbers::pi * (R * R - r_in * r_in) * height;
-      EXPECT_NEAR(k.volume, exact, 0.01 * exact);
-      EXPECT_GT(mesh_quality(m).min_angle_deg, 25.0);
-    }
+TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {
+  // A sphere cut flat by three planes (a large cap, two small ones 60 degrees apart, as where
+  // three spheres touch), each closed by a disk sharing the cut's loop.
+  const Eigen::Vector3d c(1.0, 2.0, 3.0);
+  const double r = 0.5, s = 0.0125, edge = 0.05;
+  const std::vector<std::pair<Eigen::Vector3d, double>> planes{
+      {Eigen::Vector3d::UnitZ(), 0.2},
+      {Eigen::Vector3d(1, 0, 0), 0.49},
+      {Eigen::Vector3d(0.5, std::sqrt(3.0) / 2.0, 0), 0.49}};
+  std::vector<SphereCut> cuts;
+  TriangleMesh m;
+  double exact = 4.0 / 3.0 * kPi * r * r * r;
+  std::vector<Frame> frames(planes.size());
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    cuts.push_back(plane(c, r, planes[k].first.normalized(), planes[k].second, s, &frames[k]));
+    const double H = r - planes[k].second, rho = std::sqrt(r * r - planes[k].second * planes[k].second);
+    exact -= kPi * H * H * (3 * r - H) / 3.0;
+    m.append(ring_mesh(frames[k], 0.0, rho, s, true, "cap"));
   }
+  m.append(sphere_mesh(c, r, cuts, edge, 1.3, true, "particles"));
+  m.weld();
+  const SurfaceCheck k = check_surface(m, 1'000'000);
+  ASSERT_TRUE(k.manifold && k.closed) << "not closed";
+  EXPECT_FALSE(k.self_intersecting);
+  EXPECT_GT(k.volume, 0.0);
+  EXPECT_NEAR(k.volume, exact, 4.0 * kPi * r * r * 2e-3);  // within the shell of the chordal deviation
+  EXPECT_LT((exact - k.volume) / exact, 0.01);
+  EXPECT_GT(mesh_quality(m).min_angle_deg, 15.0);
+}
+
+TEST(Primitives, CutsThatOverlapOnTheSphereAreRefused) {
+  const Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  std::vector<SphereCut> cuts{plane(c, 1.0, Eigen::Vector3d::UnitX(), 0.2, 0.05),
+                              plane(c, 1.0, Eigen::Vector3d::UnitY(), 0.2, 0.05)};
+  EXPECT_THROW(sphere_mesh(c, 1.0, cuts, 0.1, 1.3, true, "p"), CutConflict);
+}
+
+TEST(Primitives, TubeJoinsTwoLoopsAndFollowsItsGeneratorLengths) {
+  // A tube whose generators end on a tilted plane z = 1 + 0.3 x, closed by a disk at the start
+  // and a fan at the end: the truncated cylinder's volume is pi rho^2 x its mean length 1.
+  const Frame f = Frame::along(Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(1, 1, 1));
+  const double rho = 0.4;
+  const int n = ring_points(rho, 0.05);
+  const GeneratorLength length = [](double x, double) { return 1.0 + 0.3 * x; };
+  TriangleMesh m = tube_mesh(f, rho, n, length, 0.05, true, "tube");
+  const std::vector<Eigen::Vector3d> end = tube_end_loop(f, rho, n, length);
+  for (int j = 0; j < n; ++j) EXPECT_EQ(m.points[m.points.size() - n + j], end[j]);  // bit-identical seam
+  EXPECT_GT(mesh_quality(m).min_angle_deg, 25.0);
+  m.append(ring_mesh(f, 0.0, rho, 0.05, false, "start"));
+  TriangleMesh fan;
+  fan.points = end;
+  fan.points.push_back(f.to_world(Eigen::Vector3d(0, 0, 1.0)));
+  for (int j = 0; j < n; ++j) fan.triangles.push_back({j, (j + 1) % n, n});
+  fan.patch.assign(n, 0), fan.patches = {"end"};
+  orient_by(fan, [&](const Eigen::Vector3d&) { return f.w; });
+  m.append(fan);
+  m.weld();
+  const SurfaceCheck k = check_surface(m, 1'000'000);
+  ASSERT_TRUE(k.manifold && k.closed);
+  EXPECT_NEAR(k.volume, kPi * rho * rho, 0.005 * kPi * rho * rho);
+}
+
+TEST(Primitives, RingMeshesShareTheirLoopsWithCircleLoop) {
+  const Frame f = Frame::along(Eigen::Vector3d(0, 0, 2.5), Eigen::Vector3d::UnitZ());
+  const TriangleMesh m = ring_mesh(f, 0.7, 2.0, 0.21, true, "outlet");
+  const auto outer = circle_loop(f, 2.0, ring_points(2.0, 0.21)), inner = circle_loop(f, 0.7, ring_points(0.7, 0.21));
+  int found = 0;
+  for (const auto& p : m.points)
+    for (const auto* loop : {&outer, &inner})
+      for (const auto& q : *loop) found += p == q;
+  EXPECT_EQ(found, static_cast<int>(outer.size() + inner.size()));
+  EXPECT_GT(signed_volume(m) * 0.0 + mesh_quality(m).min_angle_deg, 25.0);
+  double area = 0.0;
+  for (const auto& t : m.triangles) area += 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).z();
+  EXPECT_NEAR(area, kPi * (4.0 - 0.49), 0.01 * kPi * 4.0);  // +z normals, area of the polygonal ring
 }

@@ -1,0 +1,424 @@
+#include "meshing/contacts.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "analysis/intersection_volumes.hpp"
+#include "core/error.hpp"
+#include "core/neighbour_list.hpp"
+
+namespace bedforge::meshing {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kContact = 1e-4;  // a gap below this (in d) is a contact, as in the packers
+
+// Volume and curved area of the cap of height H cut from a sphere of radius r.
+double cap_volume(double r, double H) { return kPi * H * H * (3.0 * r - H) / 3.0; }
+double cap_area(double r, double H) { return 2.0 * kPi * r * H; }
+
+// Distance from point q to the segment [a, b].
+double segment_distance(const Eigen::Vector3d& q, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (q - (a + t * ab)).norm();
+}
+
+// 16-point Gauss-Legendre nodes and weights on [0, 1].
+struct Gauss16 {
+  std::array<double, 16> x, w;
+  Gauss16() {
+    for (int i = 0; i < 16; ++i) {
+      double z = std::cos(kPi * (i + 0.75) / 16.5), dp = 1.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0, p1 = z;
+        for (int k = 2; k <= 16; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+          p0 = p1, p1 = p2;
+        }
+        dp = 16.0 * (z * p1 - p0) / (z * z - 1.0);
+        const double dz = p1 / dp;
+        z -= dz;
+        if (std::abs(dz) < 1e-16) break;
+      }
+      x[i] = 0.5 * (1.0 - z), w[i] = 1.0 / ((1.0 - z * z) * dp * dp);
+    }
+  }
+};
+
+// The container's curved walls as the treatment sees them.
+struct Wall {
+  double R;
+  bool inner;  // the inner wall of an annulus: the fluid lies outside it
+  std::string name() const { return inner ? "inner wall" : "wall"; }
+  // Distance from the sphere surface (centre at radial distance rho, radius r) to the wall.
+  double gap(double rho, double r) const { return inner ? rho - R - r : R - rho - r; }
+  bool beyond(const Eigen::Vector3d& p) const {
+    const double rho = std::hypot(p.x(), p.y());
+    return inner ? rho < R : rho > R;
+  }
+  // Parameter t > 0 where the line p + t a (a horizontal, unit) first meets the wall; NaN if never.
+  double hit(const Eigen::Vector3d& p, const Eigen::Vector3d& a) const {
+    const double b = p.x() * a.x() + p.y() * a.y(), c = p.x() * p.x() + p.y() * p.y() - R * R, disc = b * b - c;
+    if (disc < 0.0) return std::numeric_limits<double>::quiet_NaN();
+    return inner ? -b - std::sqrt(disc) : -b + std::sqrt(disc);
+  }
+};
+
+class Treater {
+ public:
+  Treater(const Bed& bed, const SurfaceParams& p, double z0, double z1) : bed_(bed), p_(p), z0_(z0), z1_(z1) {
+    d_ = sauter_mean(bed.diameters);
+    edge_c_ = p.contact_edge_length_d * d_;
+    const Container& c = *bed.container;
+    if (const auto* cyl = dynamic_cast<const Cylinder*>(&c)) walls_.push_back({cyl->radius(), false});
+    else if (const auto* ann = dynamic_cast<const Annulus*>(&c))
+      walls_.push_back({ann->outer_radius(), false}), walls_.push_back({ann->inner_radius(), true});
+    else
+      throw InputError(fmt::format("the surface stage handles cylinder and annulus containers; this bed's container "
+                                   "is a {}",
+                                   c.kind()));
+    scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
+             : p.treatment == SurfaceParams::Treatment::enlarge ? p.enlarge_factor
+                                                                : 1.0;
+    const std::size_t n = bed.size();
+    out_.radius.resize(n);
+    out_.cuts.resize(n);
+    out_.cut_names.resize(n);
+    cut_angle_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
+      volume_ += 4.0 / 3.0 * kPi * std::pow(out_.radius[i], 3);
+      area_ += 4.0 * kPi * out_.radius[i] * out_.radius[i];
+      volume0_ += 4.0 / 3.0 * kPi * std::pow(0.5 * bed.diameters[i], 3);
+      area0_ += kPi * bed.diameters[i] * bed.diameters[i];
+    }
+  }
+
+  TreatedBed run() {
+    const std::size_t n = bed_.size();
+    const double tolerance = treat_below(p_.treatment);
+    // Skin: the treatment's tolerance, and what a shrink opens (so every contact of the bed is seen).
+    const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
+    NeighbourList nl(std::max(tolerance, 0.0) + std::max(0.0, 1.0 - scale_) * d_max + 1e-3 * d_);
+    nl.build(bed_.centres, out_.radius, *bed_.container);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int j : nl.of(i))
+        if (static_cast<std::size_t>(j) > i) pair(i, j, nl);
+      for (const Wall& w : walls_) wall(i, w, nl);
+      ends(i);
+    }
+    for (std::size_t i = 0; i < n; ++i) check_cuts(i);
+    if (!(min_gap_ > 0.0)) throw InputError(gap_error_);
+    out_.solid_volume = volume_;
+    out_.min_wall_gap = min_wall_gap_;
+    auto angle = [](double a) { return std::isfinite(a) ? nlohmann::json(a * 180.0 / kPi) : nlohmann::json(nullptr); };
+    out_.report = {
+        {"contacts_treated",
+         {{"particle_particle", treated_pp_},
+          {"particle_wall", treated_pw_},
+          {"by_kind", {{"bridge", bridges_}, {"cap", caps_}, {"union", unions_}}}}},
+        {"solid_volume_change_relative", volume_ / volume0_ - 1.0},
+        {"solid_volume_change_m3", volume_ - volume0_},
+        {"particle_area_change_relative", area_ / area0_ - 1.0},
+        {"smallest_gap_d", {{"particle_particle", min_pair_gap_ / d_}, {"particle_wall", min_wall_gap_ / d_}}},
+        {"smallest_fluid_wedge_angle_deg", angle(min_wedge_)},
+        {"solid_volume_exact_m3", volume_}};
+    return std::move(out_);
+  }
+
+ private:
+  using T = SurfaceParams::Treatment;
+
+  // Gap below which a contact is treated (pairs and walls share the tolerance of their treatment).
+  double treat_below(T t) const {
+    switch (t) {
+      case T::bridge: return p_.bridge_gap_d * d_;
+      case T::cap: return p_.cap_gap_d * d_;
+      case T::enlarge: return 0.0;
+      default: return -std::numeric_limits<double>::infinity();
+    }
+  }
+
+  void gap_left(double gap, bool wall, const std::string& what) {
+    double& m = wall ? min_wall_gap_ : min_pair_gap_;
+    m = std::min(m, gap);
+    if (gap < min_gap_) {
+      min_gap_ = gap;
+      gap_error_ = fmt::format("{} still touch{} or overlap{} by {:.3g} d after the '{}' treatment; allowed: a "
+                               "treatment that opens or joins every contact (contacts.treatment, "
+                               "contacts.wall_treatment, their factors and gaps)",
+                               what, wall ? "es" : "", wall ? "s" : "", -gap / d_, treatment_name(p_.treatment));
+    }
+  }
+
+  // `angle`: the largest angle from the cut's axis to its loop, seen from the centre.
+  void add_cut(std::size_t i, SphereCut cut, const std::string& name, double angle) {
+    out_.cuts[i].push_back(std::move(cut));
+    out_.cut_names[i].push_back(name);
+    cut_angle_[i].push_back(angle);
+  }
+
+  // A planar cut of sphere i at distance h along axis a (unit), its loop of n vertices on the
+  // circle of radius rho (given, so a bridge's loop is exactly its tube's); returns the loop's frame.
+  Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, const std::string& name) {
+    const Eigen::Vector3d& c = bed_.centres[i];
+    const double r = out_.radius[i];
+    const Frame f = Frame::along(c + h * a, a);
+    SphereCut cut;
+    cut.loop = circle_loop(f, rho, n);
+    cut.spacing = 2.0 * kPi * rho / n;
+    cut.axis = a;
+    cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
+    add_cut(i, std::move(cut), name, std::acos(std::clamp(h / r, -1.0, 1.0)));
+    volume_ -= cap_volume(r, r - h);
+    area_ -= cap_area(r, r - h);
+    return f;
+  }
+
+  void pair(std::size_t i, std::size_t j, const NeighbourList& nl) {
+    const Eigen::Vector3d &ci = bed_.centres[i], &cj = bed_.centres[j];
+    const double ri = out_.radius[i], rj = out_.radius[j], dist = (cj - ci).norm(), gap = dist - ri - rj;
+    const std::string who = fmt::format("spheres {} and {}", i, j);
+    if (!(gap < treat_below(p_.treatment))) {
+      if (p_.treatment == T::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
+      return gap_left(gap, false, who);
+    }
+    const Eigen::Vector3d a = (cj - ci) / dist;
+    ++treated_pp_;
+    if (p_.treatment == T::cap) {
+      const double g = p_.cap_gap_d * d_, mid = 0.5 * (dist + ri - rj), hi = mid - 0.5 * g, hj = dist - mid - 0.5 * g;
+      if (hi <= 0.1 * ri || hj <= 0.1 * rj)
+        throw InputError(fmt::format("{} overlap too deeply to be capped (centre distance {:.3g} d)", who, dist / d_));
+      for (auto [k, h, axis] : {std::tuple{i, hi, a}, std::tuple{j, hj, Eigen::Vector3d(-a)}}) {
+        const double r = out_.radius[k], rho = std::sqrt(r * r - h * h);
+        const Frame f = plane_cut(k, axis, h, rho, ring_points(rho, edge_c_), fmt::format("cap towards sphere {}", k == i ? j : i));
+        out_.parts.push_back(ring_mesh(f, 0.0, rho, edge_c_, true, "particles"));
+        area_ += kPi * rho * rho;
+      }
+      ++caps_;
+      return gap_left(g, false, who);
+    }
+    const double rb = 0.5 * p_.bridge_diameter_d * d_;
+    const double rho_union = gap < 0.0 ? std::sqrt(std::max(0.0, ri * ri - std::pow((dist * dist + ri * ri - rj * rj) / (2.0 * dist), 2))) : 0.0;
+    if (p_.treatment == T::enlarge || rho_union >= 0.5 * rb) {
+      // Union along the circle where the spheres meet (the radical plane).
+      const double hi = (dist * dist + ri * ri - rj * rj) / (2.0 * dist), hj = dist - hi;
+      if (hi <= 0.0 || hj <= 0.0)
+        throw InputError(fmt::format("{} overlap so deeply that one centre lies inside the other sphere", who));
+      const double rho = std::sqrt(std::max(0.0, ri * ri - hi * hi));
+      const int n = ring_points(rho, edge_c_);
+      const Frame f = plane_cut(i, a, hi, rho, n, fmt::format("union with sphere {}", j));
+      SphereCut cut;
+      cut.loop = out_.cuts[i].back().loop;  // the same vertices on both spheres
+      cut.spacing = out_.cuts[i].back().spacing;
+      cut.axis = -a;
+      cut.removed = [ci, a, hi](const Eigen::Vector3d& q) { return (q - ci).dot(a) < hi; };
+      add_cut(j, std::move(cut), fmt::format("union with sphere {}", i), std::acos(std::clamp(hj / rj, -1.0, 1.0)));
+      volume_ -= cap_volume(rj, rj - hj);
+      area_ -= cap_area(rj, rj - hj);
+      const Eigen::Vector3d q = f.to_world(Eigen::Vector3d(rho, 0.0, 0.0));
+      wedge(kPi - std::acos(std::clamp(((q - ci) / ri).dot((q - cj) / rj), -1.0, 1.0)));
+      ++unions_;
+      return;
+    }
+    if (rb >= 0.9 * std::min(ri, rj))
+      throw InputError(fmt::format("contacts.bridge_diameter_d = {}: a bridge as wide as the smaller of {} (diameter "
+                                   "{:.3g} d); allowed: below 0.9 x the smallest sphere diameter",
+                                   p_.bridge_diameter_d, who, 2.0 * std::min(ri, rj) / d_));
+    const double hi = std::sqrt(ri * ri - rb * rb), hj = std::sqrt(rj * rj - rb * rb), L = dist - hi - hj;
+    if (!(L > 0.0)) throw InputError(fmt::format("{}: no room for a bridge between them", who));
+    const Eigen::Vector3d from = ci + hi * a, to = ci + (hi + L) * a;
+    for (std::size_t s : {i, j})
+      for (int k : nl.of(s))
+        if (static_cast<std::size_t>(k) != i && static_cast<std::size_t>(k) != j &&
+            segment_distance(bed_.centres[k], from, to) < out_.radius[k] + rb)
+          throw InputError(fmt::format("the bridge between {} would cross sphere {}; allowed: a narrower "
+                                       "contacts.bridge_diameter_d or another treatment",
+                                       who, k));
+    const int n = ring_points(rb, edge_c_);
+    const Frame f = plane_cut(i, a, hi, rb, n, fmt::format("bridge to sphere {}", j));
+    const GeneratorLength length = [L](double, double) { return L; };
+    SphereCut cut;
+    cut.loop = tube_end_loop(f, rb, n, length);
+    cut.spacing = 2.0 * kPi * rb / n;
+    cut.axis = -a;
+    const Eigen::Vector3d cjj = cj;
+    cut.removed = [cjj, a, hj](const Eigen::Vector3d& q) { return (q - cjj).dot(-a) > hj; };
+    add_cut(j, std::move(cut), fmt::format("bridge to sphere {}", i), std::acos(std::clamp(hj / rj, -1.0, 1.0)));
+    volume_ += kPi * rb * rb * L - cap_volume(rj, rj - hj);
+    area_ += 2.0 * kPi * rb * L - cap_area(rj, rj - hj);
+    out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
+    wedge(0.5 * kPi + std::asin(rb / std::max(ri, rj)));
+    ++bridges_;
+    gap_left(L, false, who);
+  }
+
+  void wall(std::size_t i, const Wall& w, const NeighbourList& nl) {
+    const Eigen::Vector3d& c = bed_.centres[i];
+    const double r = out_.radius[i], rho = std::hypot(c.x(), c.y()), gap = w.gap(rho, r);
+    const std::string who = fmt::format("sphere {} and the {}", i, w.name());
+    const T t = p_.wall_treatment;
+    if (!(gap < treat_below(t))) {
+      if (t == T::shrink && w.gap(rho, r / scale_) <= kContact * d_) ++treated_pw_;
+      return gap_left(gap, true, who);
+    }
+    ++treated_pw_;
+    const Eigen::Vector3d radial = rho > 0.0 ? Eigen::Vector3d(c.x() / rho, c.y() / rho, 0.0) : Eigen::Vector3d::UnitX();
+    const Eigen::Vector3d a = w.inner ? Eigen::Vector3d(-radial) : radial;  // towards the wall
+    const double to_wall = w.inner ? rho - w.R : w.R - rho;                  // centre to wall along a
+    auto& holes = w.inner ? out_.inner_holes : out_.outer_holes;
+    if (t == T::cap) {
+      const double g = p_.cap_gap_d * d_, h = to_wall - g;
+      if (h <= 0.1 * r) throw InputError(fmt::format("{} overlap too deeply to be capped", who));
+      const double rho_c = std::sqrt(r * r - h * h);
+      const Frame f = plane_cut(i, a, h, rho_c, ring_points(rho_c, edge_c_), "cap towards the " + w.name());
+      out_.parts.push_back(ring_mesh(f, 0.0, rho_c, edge_c_, true, "particles"));
+      area_ += kPi * rho_c * rho_c;
+      double left = g;  // the disk's rim bends towards a concave wall
+      for (const auto& q : out_.cuts[i].back().loop) left = std::min(left, w.gap(std::hypot(q.x(), q.y()), 0.0));
+      ++caps_;
+      return gap_left(left, true, who);
+    }
+    const double rb = 0.5 * p_.bridge_diameter_d * d_;
+    if (t == T::enlarge || (gap < 0.0 && std::sqrt(-gap * (2.0 * r + gap)) >= 0.5 * rb)) return wall_union(i, w, a);
+    if (rb >= 0.9 * r)
+      throw InputError(fmt::format("contacts.bridge_diameter_d = {}: a bridge as wide as sphere {} (diameter {:.3g} d); "
+                                   "allowed: below 0.9 x the smallest sphere diameter",
+                                   p_.bridge_diameter_d, i, 2.0 * r / d_));
+    const double h = std::sqrt(r * r - rb * rb);
+    const int n = ring_points(rb, edge_c_);
+    const Frame f = plane_cut(i, a, h, rb, n, "bridge to the " + w.name());
+    const GeneratorLength length = [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
+    double shortest = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < 64; ++j) {
+      const double l = length(rb * std::cos(2 * kPi * j / 64), rb * std::sin(2 * kPi * j / 64));
+      shortest = std::min(shortest, std::isnan(l) ? -1.0 : l);
+    }
+    if (!(shortest > 0.0))
+      throw InputError(fmt::format("{}: no room for a bridge (the sphere crosses the wall or the bridge misses it)", who));
+    const Eigen::Vector3d from = f.origin, to = f.origin + length(0.0, 0.0) * a;
+    for (int k : nl.of(i))
+      if (segment_distance(bed_.centres[k], from, to) < out_.radius[k] + rb)
+        throw InputError(fmt::format("the bridge between {} would cross sphere {}", who, k));
+    holes.push_back({tube_end_loop(f, rb, n, length), 2.0 * kPi * rb / n, static_cast<int>(i)});
+    out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
+    // Volume and lateral area of the bridge: polar quadrature over its cross-section (smooth
+    // integrand: Gauss-Legendre in radius, trapezoid in angle, both spectrally accurate).
+    static const Gauss16 gauss;
+    constexpr int kAngles = 128;
+    double vol = 0.0, lateral = 0.0;
+    for (int j = 0; j < kAngles; ++j) {
+      const double th = 2.0 * kPi * j / kAngles, cs = std::cos(th), sn = std::sin(th);
+      lateral += length(rb * cs, rb * sn) * rb * 2.0 * kPi / kAngles;
+      for (int g = 0; g < 16; ++g) {
+        const double s = rb * gauss.x[g];
+        vol += gauss.w[g] * rb * length(s * cs, s * sn) * s * 2.0 * kPi / kAngles;
+      }
+    }
+    volume_ += vol;
+    area_ += lateral;
+    wedge(0.5 * kPi + std::asin(rb / r));
+    ++bridges_;
+    gap_left(shortest, true, who);
+  }
+
+  // Sphere i crossing wall w: its mesh stops on the curve where they meet, and the wall gets a hole there.
+  void wall_union(std::size_t i, const Wall& w, const Eigen::Vector3d& a) {
+    const Eigen::Vector3d& c = bed_.centres[i];
+    const double r = out_.radius[i];
+    const Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ(), e2 = a.cross(e1);
+    // Polar angle from a of the curve in the direction phi, by bisection.
+    auto point = [&](double beta, double phi) {
+      return Eigen::Vector3d(c + r * (std::cos(beta) * a + std::sin(beta) * (std::cos(phi) * e1 + std::sin(phi) * e2)));
+    };
+    auto beta_at = [&](double phi) {
+      double lo = 0.0, hi = kPi;
+      for (int it = 0; it < 80; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (w.beyond(point(mid, phi)) ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    };
+    constexpr int kAngles = 256;
+    double removed_area = 0.0, beta_max = 0.0, perimeter = 0.0;
+    for (int j = 0; j < kAngles; ++j) {
+      const double b = beta_at(2.0 * kPi * j / kAngles);
+      removed_area += r * r * (1.0 - std::cos(b)) * 2.0 * kPi / kAngles;
+      perimeter += r * std::sin(b) * 2.0 * kPi / kAngles;
+      beta_max = std::max(beta_max, b);
+    }
+    const int n = std::max(8, static_cast<int>(std::ceil(perimeter / edge_c_)));
+    SphereCut cut;
+    for (int j = 0; j < n; ++j) {
+      const double phi = 2.0 * kPi * j / n;
+      cut.loop.push_back(point(beta_at(phi), phi));
+    }
+    cut.spacing = perimeter / n;
+    cut.axis = a;
+    cut.removed = [w](const Eigen::Vector3d& q) { return w.beyond(q); };
+    (w.inner ? out_.inner_holes : out_.outer_holes).push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+    const Eigen::Vector3d q = cut.loop[0];
+    const Eigen::Vector3d wall_normal = (w.inner ? 1.0 : -1.0) * Eigen::Vector3d(q.x(), q.y(), 0.0).normalized();
+    wedge(kPi - std::acos(std::clamp(((q - c) / r).dot(wall_normal), -1.0, 1.0)));
+    add_cut(i, std::move(cut), "union with the " + w.name(), beta_max);
+    const double rho = std::hypot(c.x(), c.y());
+    const double inside = analysis::sphere_cylinder_volume(r, rho, c.z(), w.R, c.z() - r, c.z() + r);
+    volume_ -= w.inner ? inside : 4.0 / 3.0 * kPi * r * r * r - inside;
+    area_ -= removed_area;
+    ++unions_;
+  }
+
+  // Spheres must stay clear of the inlet and outlet planes.
+  void ends(std::size_t i) {
+    const double z = bed_.centres[i].z(), r = out_.radius[i];
+    if (z - r <= z0_ || z + r >= z1_)
+      throw InputError(fmt::format("sphere {} reaches the {} plane (surface.{}_length_d = {}); allowed: a longer "
+                                   "empty section",
+                                   i, z - r <= z0_ ? "inlet" : "outlet", z - r <= z0_ ? "inlet" : "outlet",
+                                   z - r <= z0_ ? p_.inlet_length_d : p_.outlet_length_d));
+  }
+
+  // The cuts on one sphere must not overlap: the angle between their axes must exceed the sum
+  // of their angular radii.
+  void check_cuts(std::size_t i) {
+    const auto& cuts = out_.cuts[i];
+    const auto& radius = cut_angle_[i];
+    for (std::size_t k = 0; k < cuts.size(); ++k)
+      for (std::size_t l = k + 1; l < cuts.size(); ++l) {
+        const double between = std::acos(std::clamp(cuts[k].axis.dot(cuts[l].axis), -1.0, 1.0));
+        if (between - radius[k] - radius[l] <= 0.0)
+          throw InputError(fmt::format("sphere {}: its {} and its {} overlap on the sphere; allowed: a narrower "
+                                       "contacts.bridge_diameter_d, a smaller cap or enlarge, or another treatment",
+                                       i, out_.cut_names[i][k], out_.cut_names[i][l]));
+      }
+  }
+
+  void wedge(double angle) { min_wedge_ = std::min(min_wedge_, angle); }
+
+  const Bed& bed_;
+  const SurfaceParams& p_;
+  double z0_, z1_, d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
+  std::vector<Wall> walls_;
+  TreatedBed out_;
+  double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
+  double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
+  double min_wedge_ = std::numeric_limits<double>::infinity();
+  std::string gap_error_;
+  long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0;
+  std::vector<std::vector<double>> cut_angle_;  // per sphere and cut, see add_cut
+};
+
+}  // namespace
+
+TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, double z0, double z1) {
+  if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
+  return Treater(bed, p, z0, z1).run();
+}
+
+}  // namespace bedforge::meshing

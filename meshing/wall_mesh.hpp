@@ -1,0 +1,35 @@
+#pragma once
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "meshing/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// A hole in a container wall where the bed meets it (a bridge's end, a sphere crossing the
+// wall): a closed loop of vertices on the wall, shared exactly with the part that meets it.
+struct WallHole {
+  std::vector<Eigen::Vector3d> loop;  // m
+  double spacing = 0.0;               // distance between loop vertices (m)
+  int particle = -1;                  // for error messages
+};
+
+struct WallMesh {
+  TriangleMesh outside;  // the wall less its holes
+  TriangleMesh inside;   // what the holes cut out (closes the bed solid there)
+};
+
+// Lateral wall of the cylinder of radius R about the z axis, z0 <= z <= z1, with holes.
+// Meshed unrolled (s = R theta, z): a staggered lattice of spacing about `edge` (its end rows
+// are circle_loop(Frame at z0 or z1, R, ring_points(R, edge)), the edges of ring_mesh), the
+// hole loops, rings graded away from them by `growth`, thinned like sphere_mesh, and a CGAL
+// constrained Delaunay triangulation with the loops as constraints (no vertex is added). The
+// unrolled strip is cut along a lattice generator clear of every hole; its two sides share
+// their vertices. `outward` = normals away from the axis. CutConflict when a hole crosses the
+// strip's ends or no generator is clear of the holes.
+WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
+                   bool outward, const std::string& patch);
+
+}  // namespace bedforge::meshing

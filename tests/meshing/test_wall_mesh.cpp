@@ -1,0 +1,82 @@
+// The container wall meshed unrolled: closed with its inlet and outlet, periodic across
+// theta = 0, holes that follow their loops exactly.
+#include "meshing/wall_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "meshing/primitives.hpp"
+#include "meshing/surface_checks.hpp"
+
+using namespace bedforge::meshing;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+TriangleMesh container(double R, double z0, double z1, double edge, const WallMesh& wall) {
+  TriangleMesh m = wall.outside;
+  m.append(ring_mesh(Frame::along({0, 0, z0}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, false, "inlet"));
+  m.append(ring_mesh(Frame::along({0, 0, z1}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, true, "outlet"));
+  m.weld();
+  return m;
+}
+
+// A hole where a radial tube of radius rho at height z and angle theta meets the wall R.
+WallHole radial_hole(double R, double theta, double z, double rho, double spacing) {
+  const Eigen::Vector3d a(std::cos(theta), std::sin(theta), 0.0);
+  const Frame f = Frame::along(Eigen::Vector3d(0.0, 0.0, z) + 0.5 * R * a, a);
+  const GeneratorLength length = [f, R](double x, double y) {
+    const Eigen::Vector3d p = f.to_world(Eigen::Vector3d(x, y, 0.0));
+    const double b = p.x() * f.w.x() + p.y() * f.w.y(), c = p.x() * p.x() + p.y() * p.y() - R * R;
+    return -b + std::sqrt(b * b - c);
+  };
+  const int n = ring_points(rho, spacing);
+  return {tube_end_loop(f, rho, n, length), 2 * kPi * rho / n, 0};
+}
+
+}  // namespace
+
+TEST(WallMesh, WithoutHolesClosesWithInletAndOutlet) {
+  for (double height : {1.0, 2.37}) {
+    const double R = 1.3, edge = 0.1;
+    const WallMesh w = wall_mesh(R, -0.5, height, edge, {}, 1.3, true, "wall");
+    EXPECT_TRUE(w.inside.triangles.empty());
+    const SurfaceCheck k = check_surface(container(R, -0.5, height, edge, w), 1'000'000);
+    ASSERT_TRUE(k.manifold && k.closed) << k.defects.size() << " defects";
+    EXPECT_FALSE(k.self_intersecting);
+    const double exact = kPi * R * R * (height + 0.5);
+    EXPECT_NEAR(k.volume, exact, 0.005 * exact);  // inscribed polygon
+    EXPECT_GT(mesh_quality(w.outside).min_angle_deg, 30.0);
+  }
+}
+
+TEST(WallMesh, HolesAcrossThetaZeroAreCutExactlyAndFilledByInside) {
+  const double R = 1.0, edge = 0.1;
+  // One hole straddling theta = 0 (the unrolled strip's ends), one elsewhere.
+  const std::vector<WallHole> holes{radial_hole(R, 0.0, 0.5, 0.1, 0.025), radial_hole(R, 2.0, 1.0, 0.2, 0.025)};
+  const WallMesh w = wall_mesh(R, 0.0, 1.5, edge, holes, 1.3, true, "wall");
+  // Wall plus what the holes cut out: the whole closed container again.
+  TriangleMesh m = container(R, 0.0, 1.5, edge, w);
+  m.append(w.inside);
+  m.weld();
+  const SurfaceCheck k = check_surface(m, 1'000'000);
+  for (const auto& d : k.defects) ADD_FAILURE() << d.at.transpose() << " used by " << d.triangles;
+  ASSERT_TRUE(k.manifold && k.closed) << k.defects.size() << " defects";
+  EXPECT_FALSE(k.self_intersecting);
+  EXPECT_NEAR(k.volume, kPi * R * R * 1.5, 0.005 * kPi * R * R * 1.5);
+  // Every loop vertex is a vertex of the wall, and the area cut out is about pi rho^2 each.
+  for (const auto& h : holes)
+    for (const auto& p : h.loop) EXPECT_NE(std::find(w.outside.points.begin(), w.outside.points.end(), p), w.outside.points.end());
+  double area = 0.0;
+  for (const auto& t : w.inside.triangles)
+    area += 0.5 * (w.inside.points[t[1]] - w.inside.points[t[0]]).cross(w.inside.points[t[2]] - w.inside.points[t[0]]).norm();
+  EXPECT_NEAR(area, kPi * (0.01 + 0.04), 0.03 * kPi * 0.05);
+  EXPECT_GT(mesh_quality(w.outside).min_angle_deg, 20.0);
+}
+
+TEST(WallMesh, HoleReachingAnEndIsRefused) {
+  EXPECT_THROW(wall_mesh(1.0, 0.0, 1.5, 0.1, {radial_hole(1.0, 1.0, 0.05, 0.1, 0.025)}, 1.3, true, "wall"), CutConflict);
+}
