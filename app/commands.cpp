@@ -115,8 +115,11 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
                  Outputs& files, const Console& console) {
   const auto t0 = std::chrono::steady_clock::now();
   meshing::FluidSurface fs = meshing::build_fluid_surface(bed, p);
+  const auto t1 = std::chrono::steady_clock::now();
   const meshing::SurfaceCheck check = meshing::check_surface(fs.fluid, p.self_intersection_limit);
   nlohmann::json& j = fs.report;
+  j["time_build_s"] = std::chrono::duration<double>(t1 - t0).count();
+  j["time_check_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   j["check"] = check.to_json();
   const double exact = j["fluid_volume_exact_m3"].get<double>();
   j["fluid_volume_mesh_m3"] = check.volume;

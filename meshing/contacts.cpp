@@ -245,7 +245,7 @@ class Treater {
     const Frame f = plane_cut(i, a, hi, rb, n, fmt::format("bridge to sphere {}", j));
     const GeneratorLength length = [L](double, double) { return L; };
     SphereCut cut;
-    cut.loop = tube_end_loop(f, rb, n, length);
+    cut.loop = tube_end_loop(f, rb, n, length, edge_c_);
     cut.spacing = 2.0 * kPi * rb / n;
     cut.axis = -a;
     const Eigen::Vector3d cjj = cj;
@@ -306,7 +306,7 @@ class Treater {
     for (int k : nl.of(i))
       if (segment_distance(bed_.centres[k], from, to) < out_.radius[k] + rb)
         throw InputError(fmt::format("the bridge between {} would cross sphere {}", who, k));
-    holes.push_back({tube_end_loop(f, rb, n, length), 2.0 * kPi * rb / n, static_cast<int>(i)});
+    holes.push_back({tube_end_loop(f, rb, n, length, edge_c_), 2.0 * kPi * rb / n, static_cast<int>(i)});
     out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
     // Volume and lateral area of the bridge: polar quadrature over its cross-section (smooth
     // integrand: Gauss-Legendre in radius, trapezoid in angle, both spectrally accurate).

@@ -22,8 +22,8 @@ struct SurfaceParams {
   double bridge_gap_d = 0.01;           // pairs closer than this get a bridge
   double cap_gap_d = 0.02;              // pairs closer than this are capped, leaving this gap
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
-  double contact_edge_length_d = 0.025; // edge on the loops where treated contacts meet (refinement near contacts)
-  double growth = 1.3;                  // edge growth per ring away from those loops
+  double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
+  double growth = 1.5;                  // edge growth per ring away from those loops
   double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
   double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
   long self_intersection_limit = 2'000'000;  // triangles above which the CGAL self-intersection test is skipped

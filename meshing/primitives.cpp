@@ -123,30 +123,48 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     const Eigen::Vector3d p = c + r * Eigen::Vector3d(rho * std::cos(k * golden), rho * std::sin(k * golden), z);
     if (!is_removed(p) && pts.fits(p, h)) pts.add(p, h), owner.push_back(-1);
   }
-  // 4. Convex hull; faces spanning one loop are the removed parts.
-  std::vector<Kernel::Point_3> kp;
-  std::map<std::tuple<double, double, double>, int> index;
-  for (std::size_t v = 0; v < pts.points.size(); ++v) {
-    const auto& p = pts.points[v];
-    kp.emplace_back(p.x(), p.y(), p.z());
-    index.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(v));
-  }
-  Hull hull;
-  CGAL::convex_hull_3(kp.begin(), kp.end(), hull);
+  // 4. Convex hull less the faces spanning one loop; where the thinning left a gap (a face
+  // whose circumradius exceeds 0.7 x its vertices' spacing), its circumcentre on the sphere
+  // is added and the hull taken again (Delaunay refinement, at most 3 rounds).
   TriangleMesh m;
+  for (int round = 0;; ++round) {
+    std::vector<Kernel::Point_3> kp;
+    std::map<std::tuple<double, double, double>, int> index;
+    for (std::size_t v = 0; v < pts.points.size(); ++v) {
+      const auto& p = pts.points[v];
+      kp.emplace_back(p.x(), p.y(), p.z());
+      index.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(v));
+    }
+    Hull hull;
+    CGAL::convex_hull_3(kp.begin(), kp.end(), hull);
+    m.triangles.clear();
+    for (auto f : hull.faces()) {
+      std::array<int, 3> t;
+      int k = 0;
+      for (auto v : hull.vertices_around_face(hull.halfedge(f))) {
+        const auto& p = hull.point(v);
+        t[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
+      }
+      if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
+      m.triangles.push_back(t);
+    }
+    if (round == 3) break;
+    const std::size_t before = pts.points.size();
+    for (const auto& t : m.triangles) {
+      const Eigen::Vector3d &a = pts.points[t[0]], &b = pts.points[t[1]], &q = pts.points[t[2]];
+      const Eigen::Vector3d ab = b - a, aq = q - a, n = ab.cross(aq);
+      const Eigen::Vector3d centre = a + (aq.squaredNorm() * n.cross(ab) + ab.squaredNorm() * aq.cross(n)) / (2.0 * n.squaredNorm());
+      const double local = std::max({pts.spacing(t[0]), pts.spacing(t[1]), pts.spacing(t[2])});
+      if ((centre - a).norm() <= 0.7 * local) continue;
+      const Eigen::Vector3d p = c + r * (centre - c).normalized();
+      if (!is_removed(p) && pts.fits(p, 0.7 * local)) pts.add(p, local), owner.push_back(-1);
+    }
+    if (pts.points.size() == before) break;
+  }
   m.points = pts.points;
   std::unordered_set<long> edges;
-  for (auto f : hull.faces()) {
-    std::array<int, 3> t;
-    int k = 0;
-    for (auto v : hull.vertices_around_face(hull.halfedge(f))) {
-      const auto& p = hull.point(v);
-      t[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
-    }
-    if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
-    m.triangles.push_back(t);
+  for (const auto& t : m.triangles)
     for (int e = 0; e < 3; ++e) edges.insert(edge_key(t[e], t[(e + 1) % 3]));
-  }
   for (int first = 0, k = 0; k < static_cast<int>(cuts.size()); first += static_cast<int>(cuts[k].loop.size()), ++k) {
     const int n = static_cast<int>(cuts[k].loop.size());
     for (int j = 0; j < n; ++j)
@@ -168,10 +186,27 @@ double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double
   return worst;
 }
 
-std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length) {
+namespace {
+
+// Rings along a tube: about one per sqrt(3)/2 of the loop spacing over the longest generator,
+// at least one; the end loop is staggered when their number is odd.
+int tube_rings(double rho, int n, const GeneratorLength& length, double edge) {
+  const double step = std::min(edge, 2.0 * std::numbers::pi * rho / n);
+  double longest = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d q = on_circle(rho, j, n, false, 0.0);
+    longest = std::max(longest, length(q.x(), q.y()));
+  }
+  return std::max(1, static_cast<int>(std::lround(longest / (std::sqrt(3.0) / 2.0 * step))));
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length, double edge) {
+  const bool stagger = tube_rings(rho, n, length, edge) % 2 == 1;
   std::vector<Eigen::Vector3d> loop;
   for (int j = 0; j < n; ++j) {
-    Eigen::Vector3d local = on_circle(rho, j, n, false, 0.0);
+    Eigen::Vector3d local = on_circle(rho, j, n, stagger, 0.0);
     local.z() = length(local.x(), local.y());
     loop.push_back(f.to_world(local));
   }
@@ -181,13 +216,7 @@ std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, co
 TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength& length, double edge, bool outward,
                        const std::string& patch) {
   TriangleMesh m;
-  const double step = std::min(edge, 2.0 * std::numbers::pi * rho / n);
-  double longest = 0.0;
-  for (int j = 0; j < n; ++j) {
-    const Eigen::Vector3d q = on_circle(rho, j, n, false, 0.0);
-    longest = std::max(longest, length(q.x(), q.y()));
-  }
-  const int nz = 2 * std::max(1, static_cast<int>(std::ceil(longest / (std::sqrt(3.0) * step))));
+  const int nz = tube_rings(rho, n, length, edge);
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j < n; ++j) {
       Eigen::Vector3d local = on_circle(rho, j, n, k % 2 == 1, 0.0);

@@ -61,13 +61,14 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
 double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double r);
 
 // Generalised tube in frame f: generators at distance rho from the w axis, from local z = 0
-// to z = length(x, y) (> 0), n vertices per ring, rings staggered by half a step, an even
-// number of them so both end loops are unstaggered: the start loop is circle_loop(f, rho, n),
-// the end loop tube_end_loop(f, rho, n, length). `outward` = normals away from the axis.
+// to z = length(x, y) (> 0), n vertices per ring, rings staggered by half a step, about one
+// per sqrt(3)/2 of the loop spacing (at least one, so short bridges get near-equilateral
+// triangles). The start loop is circle_loop(f, rho, n), the end loop tube_end_loop(f, rho, n,
+// length, edge). `outward` = normals away from the axis.
 using GeneratorLength = std::function<double(double x, double y)>;
 TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength& length, double edge, bool outward,
                        const std::string& patch);
-std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length);
+std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length, double edge);
 
 // Flat ring r_in <= r <= r_out (r_in = 0: a disk) in the plane z = 0 of f, normal +w if
 // `along_w`. Its edge loops are circle_loop(f, r, ring_points(r, edge)).

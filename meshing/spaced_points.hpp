@@ -32,6 +32,7 @@ class SpacedPoints {
     points.push_back(p);
     spacing_.push_back(spacing);
   }
+  double spacing(int i) const { return spacing_[i]; }
   std::vector<Eigen::Vector3d> points;
 
  private:

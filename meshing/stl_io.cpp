@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <cstring>
+#include <iterator>
+#include <vector>
 
 namespace bedforge::meshing {
 
@@ -21,15 +23,25 @@ std::string stl_ascii_by_patch(const TriangleMesh& m) {
   std::string out;
   for (std::size_t p = 0; p < m.patches.size(); ++p) {
     out += "solid " + m.patches[p] + "\n";
-    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-      if (m.patch[k] != static_cast<int>(p)) continue;
-      const auto& t = m.triangles[k];
-      const Eigen::Vector3d n = unit_normal(m, t);
-      out += fmt::format("  facet normal {:.9g} {:.9g} {:.9g}\n    outer loop\n", n.x(), n.y(), n.z());
-      for (int v : t)
-        out += fmt::format("      vertex {:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
-      out += "    endloop\n  endfacet\n";
+    std::vector<std::size_t> mine;
+    for (std::size_t k = 0; k < m.triangles.size(); ++k)
+      if (m.patch[k] == static_cast<int>(p)) mine.push_back(k);
+    // Formatting is the slow part: chunks in parallel, joined in order.
+    constexpr std::size_t kChunk = 1 << 15;
+    std::vector<std::string> chunks((mine.size() + kChunk - 1) / kChunk);
+#pragma omp parallel for schedule(dynamic)
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      auto it = std::back_inserter(chunks[c]);
+      for (std::size_t i = c * kChunk; i < std::min(mine.size(), (c + 1) * kChunk); ++i) {
+        const auto& t = m.triangles[mine[i]];
+        const Eigen::Vector3d n = unit_normal(m, t);
+        fmt::format_to(it, "  facet normal {:.9g} {:.9g} {:.9g}\n    outer loop\n", n.x(), n.y(), n.z());
+        for (int v : t)
+          fmt::format_to(it, "      vertex {:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
+        fmt::format_to(it, "    endloop\n  endfacet\n");
+      }
     }
+    for (const auto& c : chunks) out += c;
     out += "endsolid " + m.patches[p] + "\n";
   }
   return out;

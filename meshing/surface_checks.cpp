@@ -1,8 +1,7 @@
 #include "meshing/surface_checks.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/measure.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/manifoldness.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
@@ -49,18 +48,29 @@ SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) 
   std::sort(out.defects.begin(), out.defects.end(), [](const auto& a, const auto& b) {
     return std::tie(a.at.x(), a.at.y(), a.at.z()) < std::tie(b.at.x(), b.at.y(), b.at.z());
   });
-  // Step 1: the soup must describe an oriented 2-manifold to become a polygon mesh at all.
-  out.manifold = PMP::is_polygon_soup_a_polygon_mesh(polygons);
-  if (!out.manifold) return out;
+  // Step 1: closed and consistently oriented iff no edge is defective; then a CGAL mesh, built
+  // face by face (a face that would make an edge or vertex non-manifold is refused).
+  out.closed = out.defects.empty();
   Mesh mesh;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
-  // Step 2: closed (no border edges), then the enclosed volume.
-  out.closed = CGAL::is_closed(mesh);
-  if (out.closed) out.volume = PMP::volume(mesh);
+  mesh.reserve(m.points.size(), 3 * m.triangles.size() / 2, m.triangles.size());
+  for (const auto& p : m.points) mesh.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
+  out.manifold = out.closed;
+  for (const auto& t : m.triangles)
+    if (out.manifold && mesh.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]), Mesh::Vertex_index(t[2])) ==
+                            Mesh::null_face())
+      out.manifold = false;
+  if (out.manifold) {
+    std::vector<Mesh::Halfedge_index> pinched;
+    PMP::non_manifold_vertices(mesh, std::back_inserter(pinched));
+    out.manifold = pinched.empty();
+  }
+  if (!out.manifold) return out;
+  // Step 2: the enclosed volume, by the divergence theorem.
+  for (const auto& t : m.triangles) out.volume += m.points[t[0]].dot(m.points[t[1]].cross(m.points[t[2]])) / 6.0;
   // Step 3: self-intersections, by CGAL's box-intersection test over all faces.
   if (static_cast<long>(m.triangles.size()) <= self_intersection_limit) {
     out.self_intersections_checked = true;
-    out.self_intersecting = PMP::does_self_intersect(mesh);
+    out.self_intersecting = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
   }
   return out;
 }

@@ -1,6 +1,9 @@
 #include "meshing/triangle_mesh.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <unordered_map>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -27,12 +30,24 @@ void TriangleMesh::append(const TriangleMesh& other) {
 }
 
 void TriangleMesh::weld() {
-  std::map<std::tuple<double, double, double>, int> index;
+  // Keyed by the coordinates' bits: only bit-identical points merge.
+  struct Bits {
+    std::array<std::uint64_t, 3> b;
+    bool operator==(const Bits&) const = default;
+  };
+  struct Hash {
+    std::size_t operator()(const Bits& k) const {
+      return k.b[0] * 0x9E3779B97F4A7C15ULL ^ (k.b[1] * 0xC2B2AE3D27D4EB4FULL + (k.b[2] << 7 | k.b[2] >> 57));
+    }
+  };
+  std::unordered_map<Bits, int, Hash> index;
+  index.reserve(points.size());
   std::vector<int> to(points.size());
   std::vector<Eigen::Vector3d> kept;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto [it, fresh] = index.emplace(std::make_tuple(points[i].x(), points[i].y(), points[i].z()),
-                                           static_cast<int>(kept.size()));
+    Bits key;
+    for (int k = 0; k < 3; ++k) key.b[k] = std::bit_cast<std::uint64_t>(points[i][k] == 0.0 ? 0.0 : points[i][k]);
+    const auto [it, fresh] = index.emplace(key, static_cast<int>(kept.size()));
     if (fresh) kept.push_back(points[i]);
     to[i] = it->second;
   }

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev
+packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev libtbb-dev
           libgtest-dev python3-numpy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do

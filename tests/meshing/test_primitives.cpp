@@ -105,7 +105,7 @@ TEST(Primitives, TubeJoinsTwoLoopsAndFollowsItsGeneratorLengths) {
   const int n = ring_points(rho, 0.05);
   const GeneratorLength length = [](double x, double) { return 1.0 + 0.3 * x; };
   TriangleMesh m = tube_mesh(f, rho, n, length, 0.05, true, "tube");
-  const std::vector<Eigen::Vector3d> end = tube_end_loop(f, rho, n, length);
+  const std::vector<Eigen::Vector3d> end = tube_end_loop(f, rho, n, length, 0.05);
   for (int j = 0; j < n; ++j) EXPECT_EQ(m.points[m.points.size() - n + j], end[j]);  // bit-identical seam
   EXPECT_GT(mesh_quality(m).min_angle_deg, 25.0);
   m.append(ring_mesh(f, 0.0, rho, 0.05, false, "start"));

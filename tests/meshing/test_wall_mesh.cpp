@@ -34,7 +34,7 @@ WallHole radial_hole(double R, double theta, double z, double rho, double spacin
     return -b + std::sqrt(b * b - c);
   };
   const int n = ring_points(rho, spacing);
-  return {tube_end_loop(f, rho, n, length), 2 * kPi * rho / n, 0};
+  return {tube_end_loop(f, rho, n, length, 0.05), 2 * kPi * rho / n, 0};
 }
 
 }  // namespace
