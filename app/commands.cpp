@@ -38,11 +38,17 @@ struct Console {
 };
 
 // Files of one run, written together at the end so a failure leaves nothing half-made.
+// Large files are streamed by a writer at that point instead of held as a string.
 struct Outputs {
-  std::vector<std::pair<std::string, std::string>> files;
-  void add(std::string name, std::string contents) { files.emplace_back(std::move(name), std::move(contents)); }
+  using Writer = std::function<void(std::ostream&)>;
+  std::vector<std::pair<std::string, Writer>> files;
+  void add(std::string name, std::string contents) {
+    auto text = std::make_shared<const std::string>(std::move(contents));
+    add_writer(std::move(name), [text](std::ostream& out) { out << *text; });
+  }
+  void add_writer(std::string name, Writer w) { files.emplace_back(std::move(name), std::move(w)); }
   void write(const fs::path& dir) const {
-    for (const auto& [name, contents] : files) write_file_atomically(dir / name, contents);
+    for (const auto& [name, writer] : files) write_file_atomically(dir / name, writer);
   }
 };
 
@@ -114,7 +120,8 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
 void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::string& version, Report& report,
                  Outputs& files, const Console& console) {
   const auto t0 = std::chrono::steady_clock::now();
-  meshing::FluidSurface fs = meshing::build_fluid_surface(bed, p);
+  auto built = std::make_shared<meshing::FluidSurface>(meshing::build_fluid_surface(bed, p));
+  meshing::FluidSurface& fs = *built;
   const auto t1 = std::chrono::steady_clock::now();
   const meshing::SurfaceCheck check = meshing::check_surface(fs.fluid, p.self_intersection_limit);
   nlohmann::json& j = fs.report;
@@ -133,11 +140,14 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
                                          check.to_json().dump(), check.defects.size(), where));
   }
   j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
-  files.add("fluid.stl", meshing::stl_ascii_by_patch(fs.fluid));
+  files.add_writer("fluid.stl", [built](std::ostream& out) { meshing::write_stl_ascii_by_patch(out, built->fluid); });
   for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
-    files.add("fluid_" + fs.fluid.patches[k] + ".stl",
-              meshing::stl_binary(fs.fluid, static_cast<int>(k), "bedforge " + version + " " + fs.fluid.patches[k]));
-  files.add("bed.stl", meshing::stl_binary(fs.bed, -1, "bedforge " + version + " bed solid"));
+    files.add_writer("fluid_" + fs.fluid.patches[k] + ".stl", [built, k, version](std::ostream& out) {
+      meshing::write_stl_binary(out, built->fluid, static_cast<int>(k), "bedforge " + version + " " + built->fluid.patches[k]);
+    });
+  files.add_writer("bed.stl", [built, version](std::ostream& out) {
+    meshing::write_stl_binary(out, built->bed, -1, "bedforge " + version + " bed solid");
+  });
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;
   j["summary"] = fmt::format(

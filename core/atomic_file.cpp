@@ -13,6 +13,10 @@ namespace bedforge {
 namespace fs = std::filesystem;
 
 void write_file_atomically(const fs::path& path, const std::string& contents) {
+  write_file_atomically(path, [&](std::ostream& out) { out.write(contents.data(), static_cast<std::streamsize>(contents.size())); });
+}
+
+void write_file_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
   std::error_code ec;
   if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
   if (ec) throw InputError(fmt::format("cannot create directory '{}': {}", path.parent_path().string(), ec.message()));
@@ -20,7 +24,7 @@ void write_file_atomically(const fs::path& path, const std::string& contents) {
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(fmt::format("cannot write '{}'", tmp.string()));
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    write(out);
     if (!out) throw InputError(fmt::format("failed writing '{}'", tmp.string()));
   }
   fs::rename(tmp, path, ec);

@@ -1,5 +1,7 @@
 #pragma once
 #include <filesystem>
+#include <functional>
+#include <ostream>
 #include <string>
 
 namespace bedforge {
@@ -8,6 +10,8 @@ namespace bedforge {
 // reader never sees a half-written file and a failed run leaves the previous file intact.
 // Creates missing parent directories. Throws InputError when the directory cannot be written.
 void write_file_atomically(const std::filesystem::path& path, const std::string& contents);
+// The same, with the contents streamed by `write` (large files never held in memory whole).
+void write_file_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
 
 // Whole file as a string; InputError naming the path when it cannot be read.
 std::string read_file(const std::filesystem::path& path);

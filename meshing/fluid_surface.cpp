@@ -40,13 +40,13 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
                                  "bridge, cap or none",
                                  wall, treatment_name(p.treatment)));
   p.shrink_factor = c.number("shrink_factor", p.shrink_factor, Range{0.5, 1.0, false, true});
-  p.enlarge_factor = c.number("enlarge_factor", p.enlarge_factor, Range{1.0, 1.2, false, true});
-  p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, false, true});
-  p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, true, true});
-  p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, false, true});
+  p.enlarge_factor = c.number("enlarge_factor", p.enlarge_factor, Range{1.0, 1.2, true, false});
+  p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, true, true});
+  p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
+  p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
   p.edge_length_d = s.number("edge_length_d", p.edge_length_d, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", p.contact_edge_length_d, Range{1e-3, 1.0, false, false});
-  p.growth = s.number("growth", p.growth, Range{1.05, 2.0, true, true});
+  p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
   p.self_intersection_limit = s.integer("self_intersection_limit", p.self_intersection_limit, 0, 1'000'000'000);

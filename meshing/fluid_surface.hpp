@@ -26,7 +26,7 @@ struct SurfaceParams {
   double growth = 1.5;                  // edge growth per ring away from those loops
   double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
   double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
-  long self_intersection_limit = 2'000'000;  // triangles above which the CGAL self-intersection test is skipped
+  long self_intersection_limit = 5'000'000;  // triangles above which the CGAL self-intersection test is skipped
 };
 const char* treatment_name(SurfaceParams::Treatment t);
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);

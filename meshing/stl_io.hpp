@@ -1,4 +1,5 @@
 #pragma once
+#include <ostream>
 #include <string>
 
 #include "meshing/triangle_mesh.hpp"
@@ -7,10 +8,10 @@ namespace bedforge::meshing {
 
 // ASCII STL with one named solid per patch (`solid inlet ... endsolid inlet`), the layout
 // snappyHexMesh and surfaceFeatureExtract read as separate regions. Coordinates in metres.
-std::string stl_ascii_by_patch(const TriangleMesh& mesh);
+void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& mesh);
 
 // Binary STL of the triangles of one patch (all triangles when `patch` < 0); `header` goes
 // into the 80-byte header (truncated).
-std::string stl_binary(const TriangleMesh& mesh, int patch, const std::string& header);
+void write_stl_binary(std::ostream& out, const TriangleMesh& mesh, int patch, const std::string& header);
 
 }  // namespace bedforge::meshing

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "meshing/primitives.hpp"
 #include "meshing/spaced_points.hpp"
@@ -148,17 +149,27 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
       }
     }
   }
+  // Holes by their lowest z, so a point is tested against the few that can hold it.
   std::vector<std::array<double, 4>> boxes;  // s_min, s_max, z_min, z_max
+  double tallest = 0.0;
   for (const auto& poly : polygons) {
     std::array<double, 4> box{poly[0].x(), poly[0].x(), poly[0].y(), poly[0].y()};
     for (const auto& q : poly) box = {std::min(box[0], q.x()), std::max(box[1], q.x()), std::min(box[2], q.y()), std::max(box[3], q.y())};
     boxes.push_back(box);
+    tallest = std::max(tallest, box[3] - box[2]);
   }
+  std::vector<std::size_t> by_z(polygons.size());
+  std::iota(by_z.begin(), by_z.end(), 0);
+  std::sort(by_z.begin(), by_z.end(), [&](std::size_t a, std::size_t b) { return boxes[a][2] < boxes[b][2]; });
+  std::vector<double> z_low;
+  for (std::size_t h : by_z) z_low.push_back(boxes[h][2]);
   auto in_hole = [&](const Eigen::Vector2d& q) {
-    for (std::size_t h = 0; h < polygons.size(); ++h)
-      if (q.x() >= boxes[h][0] && q.x() <= boxes[h][1] && q.y() >= boxes[h][2] && q.y() <= boxes[h][3] &&
-          inside_polygon(polygons[h], q))
+    const auto first = std::lower_bound(z_low.begin(), z_low.end(), q.y() - tallest) - z_low.begin();
+    for (auto k = first; k < static_cast<long>(z_low.size()) && z_low[k] <= q.y(); ++k) {
+      const std::size_t h = by_z[k];
+      if (q.x() >= boxes[h][0] && q.x() <= boxes[h][1] && q.y() <= boxes[h][3] && inside_polygon(polygons[h], q))
         return true;
+    }
     return false;
   };
   auto try_add = [&](Eigen::Vector2d q, double spacing) {
@@ -189,10 +200,20 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
       try_add(Eigen::Vector2d(R * (j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n, row_z(k)), step);
 
   // 4. Constrained Delaunay triangulation of the strip; faces inside a hole go to `inside`.
+  // Inserted row by row, back and forth, so each point is found from the previous one in a
+  // few steps (hole loops come in bed order, which jumps about).
+  std::vector<std::size_t> order(uv.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto row = [&](std::size_t i) { return static_cast<long>(std::floor((uv[i].y() - z0) / step)); };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const long ra = row(a), rb = row(b);
+    if (ra != rb) return ra < rb;
+    return ra % 2 == 0 ? uv[a].x() < uv[b].x() : uv[a].x() > uv[b].x();
+  });
   Cdt cdt;
   std::vector<Cdt::Vertex_handle> handle(uv.size());
   Cdt::Face_handle hint;
-  for (std::size_t i = 0; i < uv.size(); ++i) {
+  for (std::size_t i : order) {
     handle[i] = cdt.insert(Kernel::Point_2(uv[i].x(), uv[i].y()), hint);
     handle[i]->info() = static_cast<int>(i);
     hint = handle[i]->face();

@@ -119,6 +119,11 @@ TEST(CommandLine, DefaultSceneRuns) {
 TEST(CommandLine, EveryShippedSceneRuns) {
   for (const auto& e : fs::recursive_directory_iterator(fs::path(BEDFORGE_SOURCE_DIR) / "scenes")) {
     if (e.path().extension() != ".toml") continue;
+#ifndef BEDFORGE_HAVE_CGAL
+    std::stringstream text;
+    text << std::ifstream(e.path()).rdbuf();
+    if (text.str().find("[contacts]") != std::string::npos) continue;  // needs the surface stage
+#endif
     const fs::path out = fresh_dir("scene_" + e.path().stem().string());
     // The Monte Carlo schedule cut short (the validation tool runs it in full); the options only
     // set keys of [packing.monte_carlo], so soft-sphere scenes run as shipped.

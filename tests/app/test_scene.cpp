@@ -8,7 +8,7 @@ using namespace bedforge;
 
 namespace {
 
-Scene read(const char* text, const std::filesystem::path& base = {}) {
+Scene read(const std::string& text, const std::filesystem::path& base = {}) {
   return read_scene(parse_scene_text(text, "t.toml"), "t.toml", base);
 }
 
@@ -55,3 +55,27 @@ TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
   EXPECT_THROW(read("[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[outputs]\nfiles = [\"openfoam\"]\n"),
                InputError);
 }
+
+#ifdef BEDFORGE_HAVE_CGAL
+TEST(Scene, ContactTreatmentsAndTheirErrors) {
+  const std::string base = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
+  const Scene s = read(base + "[contacts]\ntreatment = \"cap\"\ncap_gap_d = 0.03\n");
+  EXPECT_EQ(s.surface.treatment, meshing::SurfaceParams::Treatment::cap);
+  EXPECT_EQ(s.surface.wall_treatment, meshing::SurfaceParams::Treatment::cap);  // "same" by default
+  EXPECT_DOUBLE_EQ(s.surface.cap_gap_d, 0.03);
+  EXPECT_EQ(read(base + "[contacts]\ntreatment = \"bridge\"\nwall_treatment = \"none\"\n").surface.wall_treatment,
+            meshing::SurfaceParams::Treatment::none);
+  for (const auto& [bad, names] : std::vector<std::pair<std::string, std::string>>{
+           {"treatment = \"glue\"", "contacts.treatment"},
+           {"treatment = \"shrink\"\nwall_treatment = \"bridge\"", "contacts.wall_treatment"},
+           {"bridge_diameter_d = 0.9", "contacts.bridge_diameter_d"},
+           {"cap_gap_d = 0", "contacts.cap_gap_d"}}) {
+    try {
+      read(base + "[contacts]\n" + bad + "\n");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(names), std::string::npos) << e.what();
+    }
+  }
+}
+#endif

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "meshing/stl_io.hpp"
@@ -168,7 +169,9 @@ TEST(StlIo, NamedSolidsAndBinarySizes) {
   b.centres = {{0, 0, 0.5}};
   b.diameters = {1.0};
   const FluidSurface fs = build_fluid_surface(b, {});
-  const std::string ascii = stl_ascii_by_patch(fs.fluid);
+  std::ostringstream text, binary;
+  write_stl_ascii_by_patch(text, fs.fluid);
+  const std::string ascii = text.str();
   for (const char* patch : {"inlet", "outlet", "wall", "particles"}) {
     EXPECT_NE(ascii.find(std::string("solid ") + patch + "\n"), std::string::npos) << patch;
     EXPECT_NE(ascii.find(std::string("endsolid ") + patch + "\n"), std::string::npos) << patch;
@@ -177,5 +180,6 @@ TEST(StlIo, NamedSolidsAndBinarySizes) {
   for (std::size_t at = 0; (at = ascii.find("facet normal", at)) != std::string::npos; ++at) ++facets;
   EXPECT_EQ(facets, fs.fluid.triangles.size());
   // Binary: 80-byte header, count, 50 bytes per triangle.
-  EXPECT_EQ(stl_binary(fs.fluid, -1, "x").size(), 84 + 50 * fs.fluid.triangles.size());
+  write_stl_binary(binary, fs.fluid, -1, "x");
+  EXPECT_EQ(binary.str().size(), 84 + 50 * fs.fluid.triangles.size());
 }
