@@ -112,22 +112,39 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     if (copies && q.x() < margin) add_site(q + Eigen::Vector2d(period, 0.0), v, 1);
     if (copies && q.x() > period - margin) add_site(q - Eigen::Vector2d(period, 0.0), v, -1);
   };
+  // The strip's ends (s = 0) along the lattice generator farthest from every hole's centre:
+  // faces there are matched with their copies one period on, which is exact only where the
+  // two triangulations agree, so keep holes away from it where the wall has room.
+  std::vector<double> centres;
+  for (const auto& hole : holes) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : hole.loop) mean += Eigen::Vector2d(p.x(), p.y()).normalized();
+    centres.push_back(std::atan2(mean.y(), mean.x()));
+  }
+  int j_seam = 0;
+  double clearest = -1.0;
+  for (int j = 0; j < n && !centres.empty(); ++j) {
+    double clearance = std::numbers::pi;
+    for (double c : centres) clearance = std::min(clearance, std::abs(wrap_pi(2.0 * std::numbers::pi * j / n - c)));
+    if (clearance > clearest) clearest = clearance, j_seam = j;
+  }
+  const double seam = 2.0 * std::numbers::pi * j_seam / n;
   // 1. Fixed vertices: the end rows and the hole loops; a hole is unrolled around its own
   // centre, so it stays one polygon even where it crosses theta = 0.
   for (int k : {0, nz})
     for (int j = 0; j < n; ++j)
       add_vertex(row_frame(k).to_world(on_circle(R, j, n, false, 0.0)),
-                 Eigen::Vector2d(R * 2.0 * std::numbers::pi * j / n, row_z(k)), step, true);
+                 Eigen::Vector2d(R * wrap_2pi(2.0 * std::numbers::pi * j / n - seam), row_z(k)), step, true);
   std::vector<std::vector<Eigen::Vector2d>> polygons;
   std::vector<std::vector<int>> loop_sites;
   std::vector<std::size_t> original;  // per hole, its polygon at offset 0
   for (const auto& hole : holes) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (const auto& p : hole.loop) mean += Eigen::Vector2d(p.x(), p.y()).normalized();
-    const double centre = wrap_2pi(std::atan2(mean.y(), mean.x()));
+    const double centre = wrap_2pi(std::atan2(mean.y(), mean.x()) - seam);
     std::vector<Eigen::Vector2d> poly;
     for (const auto& p : hole.loop) {
-      const Eigen::Vector2d q(R * (centre + wrap_pi(std::atan2(p.y(), p.x()) - centre)), p.z());
+      const Eigen::Vector2d q(R * (centre + wrap_pi(std::atan2(p.y(), p.x()) - seam - centre)), p.z());
       if (q.y() <= z0 + 0.5 * step || q.y() >= z1 - 0.5 * step)
         throw CutConflict("a hole in the wall reaches the inlet or outlet plane");
       poly.push_back(q);
@@ -176,7 +193,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     q.x() = R * wrap_2pi(q.x() / R);
     if (q.y() < z0 + 0.4 * spacing || q.y() > z1 - 0.4 * spacing) return;
     if (in_hole(q) || in_hole(q + Eigen::Vector2d(period, 0.0)) || !fits(q, spacing)) return;
-    const double theta = q.x() / R;
+    const double theta = seam + q.x() / R;
     add_vertex(Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y()), q, spacing, true);
   };
   // 2. Rings graded away from the holes, ring by ring across all holes (the first copy of each).
@@ -197,7 +214,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   // 3. The staggered lattice.
   for (int k = 1; k < nz; ++k)
     for (int j = 0; j < n; ++j)
-      try_add(Eigen::Vector2d(R * (j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n, row_z(k)), step);
+      try_add(Eigen::Vector2d(R * ((j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row_z(k)), step);
 
   // 4. Constrained Delaunay triangulation of the strip; faces inside a hole go to `inside`.
   // Inserted row by row, back and forth, so each point is found from the previous one in a

@@ -58,7 +58,13 @@ def main():
                                                    s["smallest_gap_d"]["particle_wall"])})
                 print(rows[-1], flush=True)
                 shutil.rmtree(work)
-    base = {r["treatment"]: r["wall_s"] / r["n"] for r in rows if r["n"] == min(args.counts)}
+                write(rows)
+
+
+def write(rows):
+    """The table so far (rewritten after every run, so a long sweep leaves its results as it goes)."""
+    smallest = min(r["n"] for r in rows)
+    base = {r["treatment"]: r["wall_s"] / r["n"] for r in rows if r["n"] == smallest}
     lines = ["# Surface stage: speed, memory and accuracy against N", "",
              "Made by `/usr/bin/python3 tools/benchmark_surface.py` (a = 5, soft-sphere beds, seed 1, "
              "default `[contacts]` and `[surface]` settings, 2 cores). Wall time and peak memory of the whole "
@@ -70,7 +76,7 @@ def main():
     for r in rows:
         lines.append(f"| {r['n']} | {r['treatment']} | {r['contacts']} | {r['triangles']} | {r['wall_s']:.1f} | "
                      f"{r['build_s']:.1f} | {r['check_s']:.1f}{'' if r['self_intersections_checked'] else ' (no SI)'} | "
-                     f"{r['peak_mb']:.0f} | {r['wall_s'] / r['n'] / base[r['treatment']]:.2f} | "
+                     f"{r['peak_mb']:.0f} | {r['wall_s'] / r['n'] / base.get(r['treatment'], r['wall_s'] / r['n']):.2f} | "
                      f"{r['volume_error']:.2e} | {r['chordal_d']:.1e} | {r['min_angle_deg']:.1f} | "
                      f"{r['smallest_gap_d']:.3g} |")
     lines += ["", "(no SI): above `surface.self_intersection_limit` triangles the CGAL self-intersection test is "

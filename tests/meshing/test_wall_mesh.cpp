@@ -53,9 +53,9 @@ TEST(WallMesh, WithoutHolesClosesWithInletAndOutlet) {
   }
 }
 
-TEST(WallMesh, HolesAcrossThetaZeroAreCutExactlyAndFilledByInside) {
+TEST(WallMesh, HolesAreCutExactlyAndFilledByInside) {
   const double R = 1.0, edge = 0.1;
-  // One hole straddling theta = 0 (the unrolled strip's ends), one elsewhere.
+  // One hole at theta = 0, one elsewhere (the strip is cut along the generator farthest from both).
   const std::vector<WallHole> holes{radial_hole(R, 0.0, 0.5, 0.1, 0.025), radial_hole(R, 2.0, 1.0, 0.2, 0.025)};
   const WallMesh w = wall_mesh(R, 0.0, 1.5, edge, holes, 1.3, true, "wall");
   // Wall plus what the holes cut out: the whole closed container again.
