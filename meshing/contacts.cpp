@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "analysis/intersection_volumes.hpp"
+#include "analysis/quadrature.hpp"
 #include "core/error.hpp"
 #include "core/neighbour_list.hpp"
 
@@ -28,28 +29,6 @@ double segment_distance(const Eigen::Vector3d& q, const Eigen::Vector3d& a, cons
   const double t = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
   return (q - (a + t * ab)).norm();
 }
-
-// 16-point Gauss-Legendre nodes and weights on [0, 1].
-struct Gauss16 {
-  std::array<double, 16> x, w;
-  Gauss16() {
-    for (int i = 0; i < 16; ++i) {
-      double z = std::cos(kPi * (i + 0.75) / 16.5), dp = 1.0;
-      for (int it = 0; it < 100; ++it) {
-        double p0 = 1.0, p1 = z;
-        for (int k = 2; k <= 16; ++k) {
-          const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-          p0 = p1, p1 = p2;
-        }
-        dp = 16.0 * (z * p1 - p0) / (z * z - 1.0);
-        const double dz = p1 / dp;
-        z -= dz;
-        if (std::abs(dz) < 1e-16) break;
-      }
-      x[i] = 0.5 * (1.0 - z), w[i] = 1.0 / ((1.0 - z * z) * dp * dp);
-    }
-  }
-};
 
 // The container's curved walls as the treatment sees them.
 struct Wall {
@@ -310,16 +289,13 @@ class Treater {
     out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
     // Volume and lateral area of the bridge: polar quadrature over its cross-section (smooth
     // integrand: Gauss-Legendre in radius, trapezoid in angle, both spectrally accurate).
-    static const Gauss16 gauss;
     constexpr int kAngles = 128;
     double vol = 0.0, lateral = 0.0;
     for (int j = 0; j < kAngles; ++j) {
       const double th = 2.0 * kPi * j / kAngles, cs = std::cos(th), sn = std::sin(th);
       lateral += length(rb * cs, rb * sn) * rb * 2.0 * kPi / kAngles;
-      for (int g = 0; g < 16; ++g) {
-        const double s = rb * gauss.x[g];
-        vol += gauss.w[g] * rb * length(s * cs, s * sn) * s * 2.0 * kPi / kAngles;
-      }
+      vol += analysis::integrate_pieces({0.0, rb}, [&](double s) { return length(s * cs, s * sn) * s; }) * 2.0 * kPi /
+             kAngles;
     }
     volume_ += vol;
     area_ += lateral;

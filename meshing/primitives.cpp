@@ -37,18 +37,8 @@ std::vector<Eigen::Vector3d> offset_loop(const SphereCut& cut, const Eigen::Vect
     moved.push_back(c + r * (std::cos(beta) * cut.axis + std::sin(beta) * e));
   }
   if (moved.size() < 3) return {};
-  std::vector<double> at{0.0};
-  for (std::size_t k = 0; k < moved.size(); ++k) at.push_back(at.back() + (moved[(k + 1) % moved.size()] - moved[k]).norm());
-  const int n = std::max(6, static_cast<int>(std::lround(at.back() / spacing)));
-  std::vector<Eigen::Vector3d> out;
-  std::size_t seg = 0;
-  for (int k = 0; k < n; ++k) {
-    const double s = (k + (stagger ? 0.5 : 0.0)) * at.back() / n;
-    while (seg + 1 < moved.size() && at[seg + 1] < s) ++seg;
-    const double t = (s - at[seg]) / std::max(at[seg + 1] - at[seg], 1e-300);
-    const Eigen::Vector3d p = moved[seg] + t * (moved[(seg + 1) % moved.size()] - moved[seg]);
-    out.push_back(c + r * (p - c).normalized());
-  }
+  std::vector<Eigen::Vector3d> out = resample_loop(moved, spacing, stagger);
+  for (auto& p : out) p = c + r * (p - c).normalized();
   return out;
 }
 
@@ -100,22 +90,13 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
       pts.add(p, std::min(cuts[k].spacing, h));
       owner.push_back(static_cast<int>(k));
     }
-  // 2. Rings graded from each loop's spacing to h, ring by ring across all cuts.
-  std::vector<double> spacing(cuts.size()), offset(cuts.size(), 0.0);
-  for (std::size_t k = 0; k < cuts.size(); ++k) spacing[k] = std::min(cuts[k].spacing, h);
-  for (int ring = 1;; ++ring) {
-    bool any = false;
-    for (std::size_t k = 0; k < cuts.size(); ++k) {
-      if (ring > 1 && spacing[k] >= h) continue;
-      const double next = std::min(h, spacing[k] * growth);
-      offset[k] += std::sqrt(3.0) / 2.0 * 0.5 * (spacing[k] + next);
-      spacing[k] = next;
-      any = true;
-      for (const auto& p : offset_loop(cuts[k], c, r, offset[k], next, ring % 2 == 1))
-        if (!is_removed(p) && pts.fits(p, next)) pts.add(p, next), owner.push_back(-1);
-    }
-    if (!any) break;
-  }
+  // 2. Rings graded from each loop's spacing to h.
+  std::vector<double> spacing;
+  for (const auto& cut : cuts) spacing.push_back(cut.spacing);
+  graded_rings(spacing, h, growth, [&](std::size_t k, int ring, double offset, double next) {
+    for (const auto& p : offset_loop(cuts[k], c, r, offset, next, ring % 2 == 1))
+      if (!is_removed(p) && pts.fits(p, next)) pts.add(p, next), owner.push_back(-1);
+  });
   // 3. The Fibonacci lattice.
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   for (int k = 0; k < n_lattice; ++k) {

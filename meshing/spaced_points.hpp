@@ -2,7 +2,9 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <unordered_map>
 #include <vector>
 
@@ -45,5 +47,46 @@ class SpacedPoints {
   std::unordered_map<long, std::vector<int>> grid_;
   std::vector<double> spacing_;
 };
+
+// Rings graded away from loops (sphere cuts, wall holes) until their spacing reaches `full`:
+// ring by ring across all loops, spacing times `growth` per ring, rings sqrt(3)/2 of their
+// mean spacing apart. Calls emit(loop, ring, offset from the loop, spacing); odd rings are
+// staggered by the caller.
+inline void graded_rings(std::vector<double> spacing, double full, double growth,
+                         const std::function<void(std::size_t, int, double, double)>& emit) {
+  std::vector<double> offset(spacing.size(), 0.0);
+  for (auto& s : spacing) s = std::min(s, full);
+  for (int ring = 1;; ++ring) {
+    bool any = false;
+    for (std::size_t k = 0; k < spacing.size(); ++k) {
+      if (ring > 1 && spacing[k] >= full) continue;
+      const double next = std::min(full, spacing[k] * growth);
+      offset[k] += std::sqrt(3.0) / 2.0 * 0.5 * (spacing[k] + next);
+      spacing[k] = next;
+      any = true;
+      emit(k, ring, offset[k], next);
+    }
+    if (!any) return;
+  }
+}
+
+// The closed polyline `loop` resampled at about `spacing` by arc length (at least 6 points),
+// starting half a step on when `stagger`.
+template <class Point>
+std::vector<Point> resample_loop(const std::vector<Point>& loop, double spacing, bool stagger) {
+  const std::size_t n = loop.size();
+  std::vector<double> at{0.0};
+  for (std::size_t k = 0; k < n; ++k) at.push_back(at.back() + (loop[(k + 1) % n] - loop[k]).norm());
+  const int count = std::max(6, static_cast<int>(std::lround(at.back() / spacing)));
+  std::vector<Point> out;
+  std::size_t seg = 0;
+  for (int k = 0; k < count; ++k) {
+    const double s = (k + (stagger ? 0.5 : 0.0)) * at.back() / count;
+    while (seg + 1 < n && at[seg + 1] < s) ++seg;
+    const double t = (s - at[seg]) / std::max(at[seg + 1] - at[seg], 1e-300);
+    out.push_back(loop[seg] + t * (loop[(seg + 1) % n] - loop[seg]));
+  }
+  return out;
+}
 
 }  // namespace bedforge::meshing

@@ -54,18 +54,7 @@ std::vector<Eigen::Vector2d> offset_polygon(const std::vector<Eigen::Vector2d>& 
     const Eigen::Vector2d normal = sense * Eigen::Vector2d(e0.y() + e1.y(), -e0.x() - e1.x()).normalized();
     moved.push_back(poly[i] + offset * normal);
   }
-  std::vector<double> at{0.0};
-  for (std::size_t k = 0; k < n; ++k) at.push_back(at.back() + (moved[(k + 1) % n] - moved[k]).norm());
-  const int count = std::max(6, static_cast<int>(std::lround(at.back() / spacing)));
-  std::vector<Eigen::Vector2d> out;
-  std::size_t seg = 0;
-  for (int k = 0; k < count; ++k) {
-    const double s = (k + (stagger ? 0.5 : 0.0)) * at.back() / count;
-    while (seg + 1 < n && at[seg + 1] < s) ++seg;
-    const double t = (s - at[seg]) / std::max(at[seg + 1] - at[seg], 1e-300);
-    out.push_back(moved[seg] + t * (moved[(seg + 1) % n] - moved[seg]));
-  }
-  return out;
+  return resample_loop(moved, spacing, stagger);
 }
 
 // Drops the vertices no triangle uses.
@@ -196,21 +185,12 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     const double theta = seam + q.x() / R;
     add_vertex(Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y()), q, spacing, true);
   };
-  // 2. Rings graded away from the holes, ring by ring across all holes (the first copy of each).
-  std::vector<double> spacing(holes.size()), offset(holes.size(), 0.0);
-  for (std::size_t h = 0; h < holes.size(); ++h) spacing[h] = std::min(holes[h].spacing, step);
-  for (int ring = 1;; ++ring) {
-    bool any = false;
-    for (std::size_t h = 0; h < holes.size(); ++h) {
-      if (ring > 1 && spacing[h] >= step) continue;
-      const double next = std::min(step, spacing[h] * growth);
-      offset[h] += std::sqrt(3.0) / 2.0 * 0.5 * (spacing[h] + next);
-      spacing[h] = next;
-      any = true;
-      for (const auto& q : offset_polygon(polygons[original[h]], offset[h], next, ring % 2 == 1)) try_add(q, next);
-    }
-    if (!any) break;
-  }
+  // 2. Rings graded away from the holes (around the first copy of each).
+  std::vector<double> spacing;
+  for (const auto& hole : holes) spacing.push_back(hole.spacing);
+  graded_rings(spacing, step, growth, [&](std::size_t h, int ring, double offset, double next) {
+    for (const auto& q : offset_polygon(polygons[original[h]], offset, next, ring % 2 == 1)) try_add(q, next);
+  });
   // 3. The staggered lattice.
   for (int k = 1; k < nz; ++k)
     for (int j = 0; j < n; ++j)
