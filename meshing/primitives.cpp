@@ -127,8 +127,12 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
         t[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
       }
       if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
+      std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
       m.triangles.push_back(t);
     }
+    // CGAL lists the hull's faces in an order that changes from call to call; the refinement
+    // below depends on the order, so sort them for the same mesh every run.
+    std::sort(m.triangles.begin(), m.triangles.end());
     if (round == 3) break;
     const std::size_t before = pts.points.size();
     for (const auto& t : m.triangles) {

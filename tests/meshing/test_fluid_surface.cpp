@@ -183,3 +183,15 @@ TEST(StlIo, NamedSolidsAndBinarySizes) {
   write_stl_binary(binary, fs.fluid, -1, "x");
   EXPECT_EQ(binary.str().size(), 84 + 50 * fs.fluid.triangles.size());
 }
+
+TEST(FluidSurface, TheSameBedGivesTheSameSurface) {
+  // Reproducible: two builds of one bed, in one process and on all threads, give the same
+  // vertices and triangles (CGAL's hull lists its faces in an order that varies between calls).
+  const double h = std::sqrt(3.0) / 2.0;
+  const Bed b = column(std::make_shared<Annulus>(3.0, 1.0), {{1.5, 0.0, 0.6}, {2.5, 0.0, 0.6}, {2.0, h, 0.6}});
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::bridge;
+  const FluidSurface first = build_fluid_surface(b, p), second = build_fluid_surface(b, p);
+  EXPECT_EQ(first.fluid.points, second.fluid.points);
+  EXPECT_EQ(first.fluid.triangles, second.fluid.triangles);
+}
