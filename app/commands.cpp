@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "analysis/bed_analysis.hpp"
+#include "analysis/void_fraction.hpp"
 #include "app/scene.hpp"
 #include "core/atomic_file.hpp"
 #include "core/bed_io.hpp"
@@ -18,9 +19,13 @@
 #include "core/version.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
+#include "cases/openfoam_case.hpp"
 #include "meshing/fluid_surface.hpp"
 #include "meshing/stl_io.hpp"
 #include "meshing/surface_checks.hpp"
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+#include "meshing/volume_mesh.hpp"
 #endif
 
 namespace bedforge {
@@ -47,9 +52,18 @@ struct Outputs {
     add_writer(std::move(name), [text](std::ostream& out) { out << *text; });
   }
   void add_writer(std::string name, Writer w) { files.emplace_back(std::move(name), std::move(w)); }
-  void write(const fs::path& dir) const {
+  // A file a library wrote itself (gmsh) at `temporary`, renamed to `name` with the others.
+  void add_made(std::string name, fs::path temporary) { made.emplace_back(std::move(name), std::move(temporary)); }
+  void write(const fs::path& dir) {
     for (const auto& [name, writer] : files) write_file_atomically(dir / name, writer);
+    for (const auto& [name, temporary] : made) fs::rename(temporary, dir / name);
+    made.clear();
   }
+  ~Outputs() {
+    std::error_code ec;
+    for (const auto& m : made) fs::remove(m.second, ec);
+  }
+  std::vector<std::pair<std::string, fs::path>> made;
 };
 
 // Packing stage: the packed (or imported) bed and its report entry.
@@ -117,8 +131,10 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
 
 #ifdef BEDFORGE_HAVE_CGAL
 // Surface stage: treated contacts, the fluid-domain surface checked by CGAL, STL files.
-void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::string& version, Report& report,
-                 Outputs& files, const Console& console) {
+// Returns the surface for the mesh stage; writes the STL files when `write_files`.
+std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const meshing::SurfaceParams& p,
+                                                         const std::string& version, bool write_files, Report& report,
+                                                         Outputs& files, const Console& console) {
   const auto t0 = std::chrono::steady_clock::now();
   auto built = std::make_shared<meshing::FluidSurface>(meshing::build_fluid_surface(bed, p));
   meshing::FluidSurface& fs = *built;
@@ -140,6 +156,7 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
                                          check.to_json().dump(), check.defects.size(), where));
   }
   j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
+  if (write_files) {
   files.add_writer("fluid.stl", [built](std::ostream& out) { meshing::write_stl_ascii_by_patch(out, built->fluid); });
   for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
     files.add_writer("fluid_" + fs.fluid.patches[k] + ".stl", [built, k, version](std::ostream& out) {
@@ -148,6 +165,7 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
   files.add_writer("bed.stl", [built, version](std::ostream& out) {
     meshing::write_stl_binary(out, built->bed, -1, "bedforge " + version + " bed solid");
   });
+  }
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;
   j["summary"] = fmt::format(
@@ -163,6 +181,89 @@ void add_surface(const Bed& bed, const meshing::SurfaceParams& p, const std::str
       time);
   console.line(j["summary"].get<std::string>());
   report.set_stage("surface", j);
+  return built;
+}
+
+// Case stage: the OpenFOAM case in DIR/case, run when asked.
+void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CaseParams& p, const Provenance& prov,
+              const std::string& scene_toml, const std::string& fluid_stl, const fs::path& dir, bool overwrite,
+              Report& report, const Console& console) {
+  const auto t0 = std::chrono::steady_clock::now();
+  cases::CaseGeometry g;
+  g.d_ref = sauter_mean(bed.diameters);
+  if (const auto* ann = dynamic_cast<const Annulus*>(bed.container.get())) {
+    g.outer_radius = ann->outer_radius();
+    g.inner_radius = ann->inner_radius();
+  } else if (const auto* cyl = dynamic_cast<const Cylinder*>(bed.container.get())) {
+    g.outer_radius = cyl->radius();
+  } else {
+    throw InputError(fmt::format("container.type = \"{}\": cases are made for cylinders and annuli only",
+                                 bed.container->kind()));
+  }
+  g.aspect_ratio = 2.0 * (g.outer_radius - g.inner_radius) / g.d_ref;  // hydraulic for an annulus
+  g.inlet_z = std::numeric_limits<double>::infinity();
+  g.outlet_z = -g.inlet_z;
+  for (const auto& x : mesh.points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
+  g.bed_top = analysis::bed_height(bed);
+  const fs::path case_dir = dir / "case";
+  if (overwrite && fs::exists(case_dir)) fs::remove_all(case_dir);
+  const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
+  nlohmann::json j = cases::write_case(case_dir, mesh, g, p, note, scene_toml, bed_to_csv(bed, prov), fluid_stl);
+  std::string line = fmt::format("case: {} cells in {}, Re_p {}, u {:.3g} m/s, bed section eps {:.4f}",
+                                 mesh.cells, case_dir.string(), p.reynolds, j["velocity_m_s"].get<double>(),
+                                 j["section"]["void_fraction_mesh"].get<double>());
+  if (p.run) {
+    const nlohmann::json flow = cases::run_case(case_dir, j);
+    j["flow"] = flow;
+    line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = {:.3f} x "
+                        "Eisfeld & Schnitzlein",
+                        flow["converged"].get<bool>() ? "converged" : "NOT converged", flow["iterations"].get<long>(),
+                        flow["final_initial_residual"]["U"].get<double>(),
+                        flow["final_initial_residual"]["p"].get<double>(),
+                        flow["pressure_gradient_bed_pa_m"].get<double>(),
+                        flow["ratio_to_eisfeld_schnitzlein"].get<double>());
+  }
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  j["time_s"] = time;
+  line += fmt::format(", {:.2f} s", time);
+  j["summary"] = line;
+  console.line(line);
+  report.set_stage("case", j);
+}
+#endif
+
+#ifdef BEDFORGE_HAVE_GMSH
+// Mesh stage: gmsh's volume mesh of the surface, held to the quality gate; fluid.msh when `write_msh`.
+std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh& surface, double exact_volume,
+                                                    const Bed& bed, const meshing::VolumeMeshParams& p,
+                                                    bool write_msh, const fs::path& dir, Report& report,
+                                                    Outputs& files, const Console& console) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fs::create_directories(dir);
+  const fs::path msh = write_msh ? dir / ".fluid.partial.msh"  /* gmsh picks the format by extension */ : fs::path();
+  if (write_msh) files.add_made("fluid.msh", msh);
+  Progress progress("mesh", console.progress);
+  const double d = sauter_mean(bed.diameters);
+  auto vm = std::make_shared<meshing::VolumeMesh>(
+      meshing::build_volume_mesh(surface, bed, d, p, msh, dir / "bad_cells.vtk", progress));
+  progress.finish();
+  nlohmann::json& j = vm->report;
+  j["parameters"] = meshing::to_json(p);
+  j["fluid_volume_exact_m3"] = exact_volume;
+  j["fluid_volume_relative_error"] = (vm->quality.total_volume - exact_volume) / exact_volume;
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  j["time_s"] = time;
+  const auto& q = j["quality"];
+  j["summary"] = fmt::format(
+      "mesh ({}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
+      "max aspect ratio {:.1f}, volume error {:.2e}, {:.0f} MB, {:.2f} s",
+      j["algorithm"].get<std::string>(), vm->mesh.cells, q["max_non_orthogonality_deg"].get<double>(),
+      q["mean_non_orthogonality_deg"].get<double>(), q["faces_over_70_deg"].get<long>(), q["max_skewness"].get<double>(),
+      q["max_aspect_ratio"].get<double>(), j["fluid_volume_relative_error"].get<double>(),
+      j["peak_memory_mb"].get<double>(), time);
+  console.line(j["summary"].get<std::string>());
+  report.set_stage("mesh", j);
+  return vm;
 }
 #endif
 
@@ -170,7 +271,8 @@ Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, sce
 
 // `run`, `pack` and `import`: a scene (file plus overrides) into DIR. `run` follows the scene's
 // outputs; `pack` and `import` always write the bed and leave the analysis to `analyse`.
-int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool write_positions, const Console& console) {
+int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool write_positions, bool overwrite,
+              const Console& console) {
   PackStage pack = pack_stage(scene, console);
   Report report;  // a new bed makes every earlier result in DIR stale
   report.set_provenance(kVersion, scene.to_json(), scene.seed);
@@ -182,9 +284,26 @@ int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool w
   files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
   if (run_analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
 #ifdef BEDFORGE_HAVE_CGAL
-  if (scene.wants("stl")) add_surface(pack.bed, scene.surface, kVersion, report, files, console);
+  if (scene.wants("case") && !overwrite && fs::exists(dir / "case"))  // before hours of work, not after
+    throw InputError(fmt::format("{} exists; remove it or pass --overwrite", (dir / "case").string()));
+  std::shared_ptr<const meshing::FluidSurface> surface;
+  if (scene.needs_surface())
+    surface = add_surface(pack.bed, scene.surface, kVersion, scene.wants("stl") || scene.case_params.snappy, report,
+                          files, console);
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+  std::shared_ptr<const meshing::VolumeMesh> mesh;
+  if (scene.needs_mesh())
+    mesh = add_mesh(surface->fluid, surface->report["fluid_volume_exact_m3"].get<double>(), pack.bed, scene.mesh,
+                    scene.wants("mesh"), dir, report, files, console);
+  surface.reset();  // the case needs the volume mesh only
 #endif
   files.write(dir);
+#ifdef BEDFORGE_HAVE_GMSH
+  if (scene.wants("case"))
+    add_case(mesh->mesh, pack.bed, scene.case_params, prov, read_file(dir / "scene.toml"),
+             scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir, overwrite, report, console);
+#endif
   report.save(dir);
   return 0;
 }
@@ -291,6 +410,8 @@ int run_command_line(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "run the stages a scene's [outputs] need; writes into -o DIR");
   run->add_option("scene", scene_file, "TOML scene file")->required();
   run->add_option("-o,--output", dir, "output directory (created if missing)")->required();
+  bool overwrite = false;
+  run->add_flag("--overwrite", overwrite, "replace DIR/case when the scene asks for a case and it exists");
   overrides.add_to(*run);
 
   CLI::App* pack = app.add_subcommand("pack", "pack spheres: writes DIR/bed.csv, bed.vtp, scene.toml, report.json");
@@ -349,6 +470,38 @@ int run_command_line(int argc, char** argv) {
                       "FLOAT >= 0, empty section below the bed in diameters (sets surface.inlet_length_d); default 1");
   surface->add_option("--outlet-length-d", outlet_length_d,
                       "FLOAT >= 0, empty section above the bed in diameters (sets surface.outlet_length_d); default 1");
+
+  CLI::App* case_cmd = app.add_subcommand("case", "write the OpenFOAM case DIR/case from DIR/fluid.msh (simpleFoam, "
+                                                  "laminar); run it with DIR/case/Allrun [-np N]");
+  case_cmd->add_option("dir", dir, "directory holding fluid.msh (as written by mesh)")->required();
+  std::optional<double> reynolds;
+  std::optional<long long> processors, iterations;
+  std::optional<std::string> case_format;
+  bool run_flow = false, snappy = false;
+  case_cmd->add_option("--reynolds", reynolds,
+                       "FLOAT in (0,1000], particle Reynolds number of the superficial velocity (sets case.reynolds); "
+                       "default 1");
+  case_cmd->add_option("--iterations", iterations, "INT >= 1, simpleFoam iteration cap (sets case.iterations); default 3000");
+  case_cmd->add_option("--processors", processors,
+                       "INT >= 1, subdomains in decomposeParDict (sets case.processors); default 1");
+  case_cmd->add_option("--format", case_format, "binary|ascii, polyMesh and field format (sets case.format); default binary");
+  case_cmd->add_flag("--snappy", snappy, "also write the snappyHexMesh set-up, used by Allrun -snappy (sets case.snappy)");
+  case_cmd->add_flag("--run", run_flow, "run Allrun and add the pressure drop to the report (sets case.run)");
+  case_cmd->add_flag("--overwrite", overwrite, "replace DIR/case when it exists");
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+  CLI::App* mesh_cmd = app.add_subcommand("mesh", "mesh the fluid domain of DIR/fluid.stl with gmsh, held to the quality "
+                                                  "gate: writes DIR/fluid.msh (bad_cells.vtk when the gate fails)");
+  mesh_cmd->add_option("dir", dir, "directory holding fluid.stl and bed.csv (as written by surface)")->required();
+  std::optional<std::string> mesh_algorithm;
+  std::optional<double> max_size_d, max_non_orthogonality;
+  mesh_cmd->add_option("--algorithm", mesh_algorithm,
+                       "hxt|delaunay, first 3D algorithm tried, the other is the fallback (sets mesh.algorithm); "
+                       "default hxt");
+  mesh_cmd->add_option("--max-size-d", max_size_d,
+                       "FLOAT in [0.01,10], largest cell edge in diameters (sets mesh.max_size_d); default 0.25");
+  mesh_cmd->add_option("--max-non-orthogonality", max_non_orthogonality,
+                       "FLOAT in (0,90), quality gate in degrees (sets mesh.gate.max_non_orthogonality_deg); default 85");
 #endif
 
   try {
@@ -368,11 +521,11 @@ int run_command_line(int argc, char** argv) {
     overrides.apply(table);
     const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file,
                                    scene_file.empty() ? fs::path() : fs::path(scene_file).parent_path());
-    if (*run) return run_scene(scene, dir, scene.wants("analysis"), scene.wants("positions"), console);
-    return run_scene(scene, dir, false, true, console);
+    if (*run) return run_scene(scene, dir, scene.wants("analysis"), scene.wants("positions"), overwrite, console);
+    return run_scene(scene, dir, false, true, false, console);
   }
 
-  // analyse DIR or surface DIR
+  // analyse, surface, mesh or case on DIR
   const fs::path d(dir);
   ImportedBed in = read_bed_text(d / "bed.csv", 1.0);
   if (!in.bed.container)
@@ -403,7 +556,49 @@ int run_command_line(int argc, char** argv) {
     const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
     contacts.finish();
     surf.finish();
-    add_surface(in.bed, params, kVersion, report, files, console);
+    add_surface(in.bed, params, kVersion, true, report, files, console);
+    files.write(d);
+    report.save(d);
+    return 0;
+  }
+  if (*case_cmd) {
+    if (reynolds) override_key(table, "case.reynolds", *reynolds);
+    if (iterations) override_key(table, "case.iterations", *iterations);
+    if (processors) override_key(table, "case.processors", *processors);
+    if (case_format) override_key(table, "case.format", *case_format);
+    if (snappy) override_key(table, "case.snappy", true);
+    if (run_flow) override_key(table, "case.run", true);
+    SceneSection section(table["case"].as_table(), "case");
+    const cases::CaseParams params = cases::read_case_params(section);
+    section.finish();
+#ifdef BEDFORGE_HAVE_GMSH
+    const meshing::PolyMesh mesh = meshing::read_msh(d / "fluid.msh");
+#else
+    throw InputError("this bedforge was built without gmsh and cannot read DIR/fluid.msh; install libgmsh-dev and rebuild");
+#endif
+    const Provenance prov{kVersion, report.data().value("seed", 0ULL), report.data().value("scene", nlohmann::json())};
+    add_case(mesh, in.bed, params, prov,
+             scene_to_toml(table), params.snappy ? read_file(d / "fluid.stl") : std::string(), d, overwrite, report,
+             console);
+    report.save(d);
+    return 0;
+  }
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+  if (*mesh_cmd) {
+    if (mesh_algorithm) override_key(table, "mesh.algorithm", *mesh_algorithm);
+    if (max_size_d) override_key(table, "mesh.max_size_d", *max_size_d);
+    if (max_non_orthogonality) override_key(table, "mesh.gate.max_non_orthogonality_deg", *max_non_orthogonality);
+    SceneSection section(table["mesh"].as_table(), "mesh");
+    const meshing::VolumeMeshParams params = meshing::read_volume_mesh_params(section);
+    section.finish();
+    const meshing::TriangleMesh surface =
+        meshing::read_stl_ascii_by_patch(read_file(d / "fluid.stl"), (d / "fluid.stl").string());
+    const nlohmann::json& stage = report.data().contains("stages") ? report.data()["stages"] : nlohmann::json();
+    double exact = std::numeric_limits<double>::quiet_NaN();
+    if (stage.contains("surface") && stage["surface"].contains("fluid_volume_exact_m3"))
+      exact = stage["surface"]["fluid_volume_exact_m3"].get<double>();
+    add_mesh(surface, exact, in.bed, params, true, d, report, files, console);
     files.write(d);
     report.save(d);
     return 0;

@@ -14,10 +14,10 @@ namespace bedforge {
 
 namespace {
 
-const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis", "stl"};
+const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis", "stl", "mesh", "case"};
 const std::vector<std::string> kDefaultOutputs = {"positions", "vtp", "analysis"};
 const std::vector<std::string> kSections = {"container", "particles", "packing", "analysis",
-                                            "contacts",  "surface",   "outputs"};
+                                            "contacts",  "surface",   "mesh",     "case", "outputs"};
 
 double unit_to_metres(const std::string& unit) {
   if (unit == "m") return 1.0;
@@ -47,7 +47,7 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
     const std::string key(k.str());
     if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
       throw InputError(fmt::format("unknown section [{}] in {}; allowed: [container], [particles], [packing], "
-                                   "[analysis], [contacts], [surface], [outputs]",
+                                   "[analysis], [contacts], [surface], [mesh], [case], [outputs]",
                                    key, source));
   }
 
@@ -103,12 +103,28 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
 #ifdef BEDFORGE_HAVE_CGAL
   sc.surface = meshing::read_surface_params(contacts, surface);
 #else
-  if (sc.wants("stl") || table.contains("contacts") || table.contains("surface"))
+  if (sc.needs_surface() || table.contains("contacts") || table.contains("surface"))
     throw InputError("this bedforge was built without CGAL, so it has no surface stage ([contacts], [surface], "
                      "outputs.files \"stl\"); install libcgal-dev and rebuild");
 #endif
   contacts.finish();
   surface.finish();
+
+  SceneSection mesh = root.sub("mesh"), case_section = root.sub("case");
+#ifdef BEDFORGE_HAVE_GMSH
+  sc.mesh = meshing::read_volume_mesh_params(mesh);
+#else
+  if (sc.needs_mesh() || table.contains("mesh"))
+    throw InputError("this bedforge was built without gmsh, so it has no volume mesh stage ([mesh], outputs.files "
+                     "\"mesh\" or \"case\", which needs the mesh); install libgmsh-dev and rebuild");
+#endif
+#ifdef BEDFORGE_HAVE_CGAL
+  sc.case_params = cases::read_case_params(case_section);
+#else
+  if (table.contains("case")) throw InputError("this bedforge was built without CGAL, so it has no [case] stage");
+#endif
+  mesh.finish();
+  case_section.finish();
   return sc;
 }
 

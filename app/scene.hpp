@@ -14,14 +14,18 @@
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
+#include "cases/openfoam_case.hpp"
 #include "meshing/fluid_surface.hpp"
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+#include "meshing/volume_mesh.hpp"
 #endif
 
 namespace bedforge {
 
 // A scene: what to build and which outputs to write. Sections: [container], [particles],
 // [packing] (with [packing.soft_sphere] and [packing.monte_carlo]), [analysis], [contacts],
-// [surface], [outputs]. Lengths are given in metres
+// [surface], [mesh], [case], [outputs]. Lengths are given in metres
 // (keys ending in _m) or in particle diameters (keys ending in _d).
 struct Scene {
   toml::table table;   // as run: the file plus command-line overrides
@@ -44,12 +48,21 @@ struct Scene {
   analysis::AnalysisParams analysis;
 #ifdef BEDFORGE_HAVE_CGAL
   meshing::SurfaceParams surface;  // [contacts] and [surface]
+  cases::CaseParams case_params;   // [case]
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+  meshing::VolumeMeshParams mesh;  // [mesh]
 #endif
   // [outputs] files: "positions" (bed.csv), "vtp" (bed.vtp), "analysis" (profiles, contacts),
-  // "stl" (the fluid-domain surface and the bed solid; needs a build with CGAL).
+  // "stl" (the fluid-domain surface and the bed solid; needs a build with CGAL), "mesh" (the
+  // gmsh volume mesh fluid.msh; needs gmsh), "case" (the OpenFOAM case in case/; runs the
+  // surface and mesh stages).
   std::vector<std::string> outputs;
 
   bool wants(const std::string& output) const;
+  // Whether a stage must run: for its own output or for a later stage's.
+  bool needs_surface() const { return wants("stl") || needs_mesh(); }
+  bool needs_mesh() const { return wants("mesh") || wants("case"); }
   nlohmann::json to_json() const;  // the table as JSON, for headers and reports
 };
 

@@ -2,10 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
 #include <vector>
+
+#include "core/error.hpp"
 
 namespace bedforge::meshing {
 
@@ -65,6 +68,55 @@ void write_stl_binary(std::ostream& out, const TriangleMesh& m, int patch, const
     for (int v : t) put(m.points[v]);
     out.write("\0\0", 2);  // attribute byte count
   }
+}
+
+TriangleMesh read_stl_ascii_by_patch(const std::string& text, const std::string& source) {
+  TriangleMesh m;
+  int patch = -1, corner = 0;
+  std::size_t line = 1;
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  auto fail = [&](const std::string& what) {
+    throw InputError(fmt::format("{}:{}: {} (expected an ASCII STL as written by `bedforge surface`)", source, line, what));
+  };
+  auto skip_blanks = [&] {
+    while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
+  };
+  auto word = [&] {
+    skip_blanks();
+    const char* b = p;
+    while (p < end && *p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') ++p;
+    return std::string_view(b, p - b);
+  };
+  while (p < end) {
+    const std::string_view w = word();
+    if (w == "solid") {
+      patch = m.patch_index(std::string(word()));
+    } else if (w == "vertex") {
+      if (patch < 0) fail("a vertex outside any solid");
+      Eigen::Vector3d v;
+      for (int k = 0; k < 3; ++k) {
+        skip_blanks();
+        const auto r = std::from_chars(p, end, v[k]);
+        if (r.ec != std::errc()) fail("a vertex without three numbers");
+        p = r.ptr;
+      }
+      m.points.push_back(v);
+      if (++corner == 3) {
+        const int n = static_cast<int>(m.points.size());
+        m.triangles.push_back({n - 3, n - 2, n - 1});
+        m.patch.push_back(patch);
+        corner = 0;
+      }
+    } else if (w == "endloop" && corner != 0) {
+      fail("a facet without three vertices");
+    }
+    while (p < end && *p != '\n') ++p;  // the rest of the line (normals, names) is not needed
+    if (p < end) ++p, ++line;
+  }
+  if (m.triangles.empty()) fail("no triangles");
+  m.weld();
+  return m;
 }
 
 }  // namespace bedforge::meshing

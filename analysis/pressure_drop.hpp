@@ -1,0 +1,30 @@
+#pragma once
+#include <cmath>
+
+namespace bedforge::analysis {
+
+// Pressure drop of a packed bed of spheres as the friction factor
+//   f_p = (dp/L) (d / (rho u^2)) eps^3 / (1 - eps) = F(Re_m),   Re_m = Re_p / (1 - eps),
+// with u the superficial velocity and Re_p = rho u d / mu.
+
+// Eisfeld & Schnitzlein (2001), Chem. Eng. Sci. 56:4321, spheres, with the wall correction:
+//   F = K1 A_w^2 / Re_m + A_w / B_w,  K1 = 154,  A_w = 1 + 2 / (3 a (1 - eps)),
+//   B_w = (k1 / a^2 + k2)^2,  k1 = 1.15,  k2 = 0.87,
+// for 0.01 <= Re_p <= 17635, 1.624 <= a <= 250, 0.33 <= eps <= 0.882; a = D/d (for an annulus
+// its hydraulic aspect ratio). Its own data scatter about +-20 % (correlations.md, grade C).
+inline double eisfeld_schnitzlein_f(double reynolds_p, double eps, double aspect_ratio) {
+  const double re_m = reynolds_p / (1.0 - eps);
+  const double a_w = 1.0 + 2.0 / (3.0 * aspect_ratio * (1.0 - eps));
+  const double b_w = std::pow(1.15 / (aspect_ratio * aspect_ratio) + 0.87, 2);
+  return 154.0 * a_w * a_w / re_m + a_w / b_w;
+}
+
+// Ergun (1952): F = 150 / Re_m + 1.75, for a > 10 and 1 < Re_m < ~700.
+inline double ergun_f(double reynolds_p, double eps) { return 150.0 * (1.0 - eps) / reynolds_p + 1.75; }
+
+// Pressure gradient dp/L (Pa/m) from F: rho u^2 / d (1 - eps) / eps^3 F.
+inline double pressure_gradient(double f, double eps, double density, double velocity, double diameter) {
+  return f * (1.0 - eps) / (eps * eps * eps) * density * velocity * velocity / diameter;
+}
+
+}  // namespace bedforge::analysis

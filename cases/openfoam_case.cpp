@@ -1,0 +1,377 @@
+#include "cases/openfoam_case.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "analysis/pressure_drop.hpp"
+#include "cases/poly_mesh_io.hpp"
+#include "core/error.hpp"
+
+namespace bedforge::cases {
+
+namespace fs = std::filesystem;
+
+CaseParams read_case_params(SceneSection& s) {
+  CaseParams p;
+  p.reynolds = s.number("reynolds", p.reynolds, Range{0.0, 1000.0, true, false});
+  p.density_kg_m3 = s.number("density_kg_m3", p.density_kg_m3, Range::positive());
+  p.viscosity_pa_s = s.number("viscosity_pa_s", p.viscosity_pa_s, Range::positive());
+  p.iterations = static_cast<int>(s.integer("iterations", p.iterations, 1, 1'000'000));
+  p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
+  p.residual_u = s.number("residual_u", p.residual_u, Range::open(0.0, 1.0));
+  p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
+  p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
+  p.snappy = s.boolean("snappy", p.snappy);
+  p.snappy_cell_d = s.number("snappy_cell_d", p.snappy_cell_d, Range::closed(0.01, 10.0));
+  p.snappy_level = static_cast<int>(s.integer("snappy_level", p.snappy_level, 0, 6));
+  p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
+  p.run = s.boolean("run", p.run);
+  return p;
+}
+
+nlohmann::json to_json(const CaseParams& p) {
+  return {{"reynolds", p.reynolds},         {"density_kg_m3", p.density_kg_m3},
+          {"viscosity_pa_s", p.viscosity_pa_s}, {"iterations", p.iterations},
+          {"residual_p", p.residual_p},     {"residual_u", p.residual_u},
+          {"processors", p.processors},     {"format", p.binary ? "binary" : "ascii"},
+          {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
+          {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
+          {"run", p.run}};
+}
+
+BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d) {
+  BedSection s{exclude_d * g.d_ref, g.bed_top - exclude_d * g.d_ref, 0.0};
+  if (s.z_high - s.z_low < 0.5 * g.d_ref)
+    throw InputError(fmt::format("case.section_exclude_d = {}: leaves a bed section of {:.3g} d (bed height {:.3g} d); "
+                                 "the pressure drop needs at least 0.5 d, lower it",
+                                 exclude_d, (s.z_high - s.z_low) / g.d_ref, g.bed_top / g.d_ref));
+  const std::vector<Eigen::Vector3d> c = meshing::cell_centres(mesh);
+  const std::vector<double> v = meshing::cell_volumes(mesh);
+  double fluid = 0.0;
+  for (int k = 0; k < mesh.cells; ++k)
+    if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
+  const double area = std::numbers::pi * (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius);
+  s.void_fraction = fluid / (area * (s.z_high - s.z_low));
+  return s;
+}
+
+namespace {
+
+void write_text(const fs::path& path, const std::string& text, bool executable = false) {
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  out.close();
+  if (executable)
+    fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add);
+}
+
+std::string dict(const std::string& cls, const std::string& location, const std::string& object,
+                 const std::string& note, const std::string& body) {
+  return foam_header(cls, location, object, note) + body +
+         "\n// ************************************************************************* //\n";
+}
+
+// Walls and particles take the same conditions; `.*wall` matches wall and inner_wall.
+std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls) {
+  return fmt::format("boundaryField\n{{\n    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n"
+                     "    \"(.*wall|particles)\"\n    {{\n{}    }}\n}}\n",
+                     inlet, outlet, walls);
+}
+
+std::string surface_value(const std::string& name, const std::string& region, const std::string& operation,
+                          const std::string& field) {
+  return fmt::format("    {}\n    {{\n        type            surfaceFieldValue;\n"
+                     "        libs            (\"libfieldFunctionObjects.so\");\n        writeControl    timeStep;\n"
+                     "        writeInterval   1;\n        log             false;\n        writeFields     false;\n"
+                     "{}        operation       {};\n        fields          ({});\n    }}\n",
+                     name, region, operation, field);
+}
+
+std::string patch_region(const std::string& patch) {
+  return fmt::format("        regionType      patch;\n        name            {};\n", patch);
+}
+
+std::string plane_region(const std::string& name, double z) {
+  return fmt::format("        regionType      sampledSurface;\n        name            {};\n"
+                     "        sampledSurfaceDict\n        {{\n            type        cuttingPlane;\n"
+                     "            planeType   pointAndNormal;\n            pointAndNormalDict\n            {{\n"
+                     "                point   (0 0 {:.12g});\n                normal  (0 0 1);\n            }}\n"
+                     "            interpolate false;\n        }}\n",
+                     name, z);
+}
+
+std::string allrun(bool snappy) {
+  std::string s =
+      "#!/bin/sh\n"
+      "# Runs the case: ./Allrun (serial) or ./Allrun -np N (decomposePar, mpirun, reconstructPar).\n";
+  if (snappy) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh.\n";
+  s += "cd \"${0%/*}\" || exit 1\n"
+       "export WM_PROJECT_DIR=\"${WM_PROJECT_DIR:-/usr/share/openfoam}\"\n"
+       "np=1\nsnappy=0\n"
+       "while [ $# -gt 0 ]; do\n"
+       "    case \"$1\" in\n"
+       "        -np) np=\"$2\"; shift 2 ;;\n";
+  if (snappy) s += "        -snappy) snappy=1; shift ;;\n";
+  s += "        *) echo \"usage: ./Allrun [-np N]" + std::string(snappy ? " [-snappy]" : "") +
+       "\" >&2; exit 2 ;;\n"
+       "    esac\n"
+       "done\n"
+       "run() { log=\"log.$1\"; echo \"running $*\"; \"$@\" > \"$log\" 2>&1 || { echo \"$1 failed, see $log\" >&2; exit 1; }; }\n"
+       "# Open MPI refuses root unless told (containers, CI).\n"
+       "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1\n";
+  if (snappy)
+    s += "if [ \"$snappy\" = 1 ]; then\n"
+         "    run blockMesh\n"
+         "    run surfaceFeatureExtract\n"
+         "    run snappyHexMesh -overwrite\n"
+         "    run checkMesh\n"
+         "fi\n";
+  s += "if [ \"$np\" -gt 1 ]; then\n"
+       "    sed -i \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" system/decomposeParDict\n"
+       "    run decomposePar -force\n"
+       "    run mpirun -np \"$np\" simpleFoam -parallel\n"
+       "    mv log.mpirun log.simpleFoam\n"
+       "    run reconstructPar -latestTime\n"
+       "else\n"
+       "    run simpleFoam\n"
+       "fi\n";
+  return s;
+}
+
+const char* kAllclean =
+    "#!/bin/sh\n"
+    "# Removes what Allrun made: results, logs, processor directories; keeps the mesh and 0/.\n"
+    "cd \"${0%/*}\" || exit 1\n"
+    "rm -rf processor* postProcessing log.* [1-9]* 0.[0-9]*\n";
+
+}  // namespace
+
+nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mesh, const CaseGeometry& g,
+                          const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                          const std::string& bed_csv, const std::string& fluid_stl) {
+  if (fs::exists(case_dir))
+    throw InputError(fmt::format("{} exists; remove it or ask to overwrite (--overwrite)", case_dir.string()));
+  std::random_device rd;
+  const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
+  const double nu = p.viscosity_pa_s / p.density_kg_m3;
+  const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
+  const BedSection section = bed_section(mesh, g, p.section_exclude_d);
+  try {
+    write_poly_mesh(tmp / "constant/polyMesh", mesh, p.binary, note);
+    const std::string fmt_word = p.binary ? "binary" : "ascii";
+    auto field_dict = [&](const std::string& cls, const std::string& object, const std::string& body) {
+      return foam_header(cls, "0", object, note, false) + body;
+    };
+    write_text(tmp / "0/U",
+               field_dict("volVectorField", "U",
+                          fmt::format("// superficial velocity {:.6g} m/s: Re_p = {} with d = {:.6g} m, nu = {:.6g} m2/s\n"
+                                      "dimensions      [0 1 -1 0 0 0 0];\n\ninternalField   uniform (0 0 {:.12g});\n\n",
+                                      u, p.reynolds, g.d_ref, nu, u) +
+                              boundary_field(fmt::format("        type            fixedValue;\n"
+                                                         "        value           uniform (0 0 {:.12g});\n",
+                                                         u),
+                                             "        type            inletOutlet;\n"
+                                             "        inletValue      uniform (0 0 0);\n"
+                                             "        value           uniform (0 0 0);\n",
+                                             "        type            noSlip;\n")));
+    write_text(tmp / "0/p", field_dict("volScalarField", "p",
+                                       "// kinematic pressure p/rho\ndimensions      [0 2 -2 0 0 0 0];\n\n"
+                                       "internalField   uniform 0;\n\n" +
+                                           boundary_field("        type            zeroGradient;\n",
+                                                          "        type            fixedValue;\n"
+                                                          "        value           uniform 0;\n",
+                                                          "        type            zeroGradient;\n")));
+    write_text(tmp / "constant/transportProperties",
+               dict("dictionary", "constant", "transportProperties", note,
+                    fmt::format("transportModel  Newtonian;\n\nnu              {:.12g};  // mu/rho = {} / {}\n", nu,
+                                p.viscosity_pa_s, p.density_kg_m3)));
+    write_text(tmp / "constant/turbulenceProperties",
+               dict("dictionary", "constant", "turbulenceProperties", note, "simulationType  laminar;\n"));
+    const std::string functions =
+        surface_value("pInlet", patch_region("inlet"), "areaAverage", "p") +
+        surface_value("pOutlet", patch_region("outlet"), "areaAverage", "p") +
+        surface_value("pBedBottom", plane_region("bedBottom", section.z_low), "areaAverage", "p") +
+        surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p") +
+        surface_value("flowRate", patch_region("outlet"), "sum", "phi");
+    write_text(tmp / "system/controlDict",
+               dict("dictionary", "system", "controlDict", note,
+                    fmt::format("application     simpleFoam;\nstartFrom       startTime;\nstartTime       0;\n"
+                                "stopAt          endTime;\nendTime         {};\ndeltaT          1;\n"
+                                "writeControl    timeStep;\nwriteInterval   {};\npurgeWrite      1;\n"
+                                "writeFormat     {};\nwritePrecision  10;\nwriteCompression off;\n"
+                                "timeFormat      general;\ntimePrecision   8;\nrunTimeModifiable false;\n\n"
+                                "// Pressure (kinematic, p/rho) averaged over the inlet, the outlet and the bed section's\n"
+                                "// planes z = {:.6g} and {:.6g} m; flow rate through the outlet (m3/s).\n"
+                                "functions\n{{\n{}}}\n",
+                                p.iterations, p.iterations, fmt_word, section.z_low, section.z_high, functions)));
+    // Tetrahedra in narrow gaps are far from orthogonal: limited corrections, one
+    // non-orthogonal corrector, and SIMPLEC, which converges these creeping flows fast.
+    write_text(tmp / "system/fvSchemes",
+               dict("dictionary", "system", "fvSchemes", note,
+                    "ddtSchemes\n{\n    default         steadyState;\n}\n\n"
+                    "gradSchemes\n{\n    default         Gauss linear;\n    grad(U)         cellLimited Gauss linear 1;\n}\n\n"
+                    "divSchemes\n{\n    default         none;\n    div(phi,U)      bounded Gauss linearUpwind grad(U);\n"
+                    "    div((nuEff*dev2(T(grad(U))))) Gauss linear;\n}\n\n"
+                    "laplacianSchemes\n{\n    default         Gauss linear limited 0.5;\n}\n\n"
+                    "interpolationSchemes\n{\n    default         linear;\n}\n\n"
+                    "snGradSchemes\n{\n    default         limited 0.5;\n}\n"));
+    write_text(tmp / "system/fvSolution",
+               dict("dictionary", "system", "fvSolution", note,
+                    fmt::format("solvers\n{{\n    p\n    {{\n        solver          GAMG;\n        smoother        GaussSeidel;\n"
+                                "        tolerance       1e-8;\n        relTol          0.05;\n    }}\n"
+                                "    U\n    {{\n        solver          smoothSolver;\n        smoother        symGaussSeidel;\n"
+                                "        tolerance       1e-9;\n        relTol          0.1;\n    }}\n}}\n\n"
+                                "SIMPLE\n{{\n    nNonOrthogonalCorrectors 1;\n    consistent      yes;\n"
+                                "    residualControl\n    {{\n        p               {};\n        U               {};\n    }}\n}}\n\n"
+                                "relaxationFactors\n{{\n    equations\n    {{\n        U               0.7;\n    }}\n"
+                                "    fields\n    {{\n        p               0.7;\n    }}\n}}\n",
+                                p.residual_p, p.residual_u)));
+    write_text(tmp / "system/decomposeParDict",
+               dict("dictionary", "system", "decomposeParDict", note,
+                    fmt::format("numberOfSubdomains {};\n\nmethod          scotch;\n", p.processors)));
+    write_text(tmp / "Allrun", allrun(p.snappy), true);
+    write_text(tmp / "Allclean", kAllclean, true);
+    write_text(tmp / "case.foam", "");  // for ParaView
+    write_text(tmp / "bedforge/scene.toml", scene_toml);
+    write_text(tmp / "bedforge/bed.csv", bed_csv);
+    if (p.snappy) {
+      // Background cells, refined `snappy_level` times at every surface; the fluid is the side
+      // holding a point in the empty inlet section.
+      const double cell = p.snappy_cell_d * g.d_ref, pad = cell, r = g.outer_radius + pad;
+      const double z0 = g.inlet_z - pad, z1 = g.outlet_z + pad;
+      const int nxy = std::max(1, static_cast<int>(std::ceil(2 * r / cell))),
+                nz = std::max(1, static_cast<int>(std::ceil((z1 - z0) / cell)));
+      write_text(tmp / "constant/triSurface/fluid.stl", fluid_stl);
+      write_text(tmp / "system/blockMeshDict",
+                 dict("dictionary", "system", "blockMeshDict", note,
+                      fmt::format("convertToMeters 1;\n\nvertices\n(\n    ({0} {0} {2}) ({1} {0} {2}) ({1} {1} {2}) ({0} {1} {2})\n"
+                                  "    ({0} {0} {3}) ({1} {0} {3}) ({1} {1} {3}) ({0} {1} {3})\n);\n\n"
+                                  "blocks\n(\n    hex (0 1 2 3 4 5 6 7) ({4} {4} {5}) simpleGrading (1 1 1)\n);\n\n"
+                                  "boundary\n(\n    background\n    {{\n        type patch;\n        faces\n        (\n"
+                                  "            (0 3 2 1) (4 5 6 7) (0 1 5 4) (1 2 6 5) (2 3 7 6) (3 0 4 7)\n        );\n    }}\n);\n",
+                                  -r, r, z0, z1, nxy, nz)));
+      write_text(tmp / "system/surfaceFeatureExtractDict",
+                 dict("dictionary", "system", "surfaceFeatureExtractDict", note,
+                      "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
+                      "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
+                      "    writeObj            no;\n}\n"));
+      const double loc_r = 0.5 * (g.outer_radius + g.inner_radius) + 1e-3 * g.d_ref;
+      std::string regions, levels;
+      for (const auto& patch : mesh.patches) {
+        const bool wall = patch.type == "wall";
+        regions += fmt::format("            {0} {{ name {0}; }}\n", patch.name);
+        levels += fmt::format("                {0} {{ level ({2} {2}); patchInfo {{ type {1}; }} }}\n", patch.name,
+                              patch.type, wall ? p.snappy_level : 0);
+      }
+      write_text(tmp / "system/snappyHexMeshDict",
+                 dict("dictionary", "system", "snappyHexMeshDict", note,
+                      fmt::format("castellatedMesh true;\nsnap            true;\naddLayers       false;\n\n"
+                                  "geometry\n{{\n    fluid.stl\n    {{\n        type triSurfaceMesh;\n        name fluid;\n"
+                                  "        regions\n        {{\n{}        }}\n    }}\n}}\n\n"
+                                  "castellatedMeshControls\n{{\n    maxLocalCells   20000000;\n    maxGlobalCells  200000000;\n"
+                                  "    minRefinementCells 0;\n    maxLoadUnbalance 0.1;\n    nCellsBetweenLevels 2;\n"
+                                  "    features ( {{ file \"fluid.eMesh\"; level {}; }} );\n"
+                                  "    refinementSurfaces\n    {{\n        fluid\n        {{\n            level (0 0);\n"
+                                  "            regions\n            {{\n{}            }}\n        }}\n    }}\n"
+                                  "    resolveFeatureAngle 30;\n    refinementRegions {{}}\n"
+                                  "    locationInMesh ({:.9g} 0 {:.9g});\n    allowFreeStandingZoneFaces true;\n}}\n\n"
+                                  "snapControls\n{{\n    nSmoothPatch 3;\n    tolerance 2.0;\n    nSolveIter 30;\n    nRelaxIter 5;\n"
+                                  "    nFeatureSnapIter 10;\n    implicitFeatureSnap false;\n    explicitFeatureSnap true;\n"
+                                  "    multiRegionFeatureSnap false;\n}}\n\n"
+                                  "addLayersControls\n{{\n    relativeSizes true;\n    layers {{}}\n    expansionRatio 1.0;\n"
+                                  "    finalLayerThickness 0.3;\n    minThickness 0.1;\n    nGrow 0;\n    featureAngle 60;\n"
+                                  "    nRelaxIter 3;\n    nSmoothSurfaceNormals 1;\n    nSmoothNormals 3;\n    nSmoothThickness 10;\n"
+                                  "    maxFaceThicknessRatio 0.5;\n    maxThicknessToMedialRatio 0.3;\n    minMedialAxisAngle 90;\n"
+                                  "    nBufferCellsNoExtrude 0;\n    nLayerIter 50;\n}}\n\n"
+                                  "meshQualityControls\n{{\n    #includeEtc \"caseDicts/meshQualityDict\"\n}}\n\n"
+                                  "mergeTolerance 1e-6;\n",
+                                  regions, p.snappy_level, levels, loc_r, 0.5 * (g.inlet_z + std::min(0.0, g.outlet_z)))));
+    }
+    fs::rename(tmp, case_dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  return {{"directory", case_dir.string()},
+          {"parameters", to_json(p)},
+          {"velocity_m_s", u},
+          {"kinematic_viscosity_m2_s", nu},
+          {"cells", mesh.cells},
+          {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
+          {"aspect_ratio", g.aspect_ratio},
+          {"d_ref_m", g.d_ref}};
+}
+
+namespace {
+
+// Last value of the last data row of a function object's output.
+double last_value(const fs::path& case_dir, const std::string& name) {
+  const fs::path file = case_dir / "postProcessing" / name / "0" / "surfaceFieldValue.dat";
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("the solver wrote no " + file.string());
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty() && line[0] != '#') last = line;
+  std::istringstream row(last);
+  double t = 0.0, v = 0.0;
+  if (!(row >> t >> v)) throw std::runtime_error("no value in " + file.string());
+  return v;
+}
+
+}  // namespace
+
+nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int np = c["parameters"]["processors"].get<int>();
+  const std::string cmd = fmt::format("'{}/Allrun' -np {} > '{}/log.Allrun' 2>&1", case_dir.string(), np, case_dir.string());
+  if (std::system(cmd.c_str()) != 0)
+    throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
+                                         case_dir.string()));
+  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Convergence: SIMPLE's own message, the iteration count and the last initial residuals.
+  std::ifstream log(case_dir / "log.simpleFoam");
+  std::string line;
+  long iterations = 0;
+  bool converged = false, p_seen = false;
+  double res_u = 0.0, res_p = 0.0;  // first initial residual of p and largest of U's components, last iteration
+  while (std::getline(log, line)) {
+    if (line.rfind("Time = ", 0) == 0) ++iterations, p_seen = false, res_u = 0.0;
+    if (line.find("SIMPLE solution converged") != std::string::npos) converged = true;
+    const auto at = line.find("Initial residual = ");
+    if (at == std::string::npos) continue;
+    const double r = std::atof(line.c_str() + at + 19);
+    if (line.find("Solving for U") != std::string::npos) res_u = std::max(res_u, r);
+    if (line.find("Solving for p,") != std::string::npos && !p_seen) res_p = r, p_seen = true;
+  }
+  const double rho = c["parameters"]["density_kg_m3"].get<double>(), u = c["velocity_m_s"].get<double>();
+  const double d = c["d_ref_m"].get<double>(), a = c["aspect_ratio"].get<double>();
+  const double zl = c["section"]["z_low_m"].get<double>(), zh = c["section"]["z_high_m"].get<double>();
+  const double eps = c["section"]["void_fraction_mesh"].get<double>();
+  const double re = c["parameters"]["reynolds"].get<double>();
+  const double gradient = rho * (last_value(case_dir, "pBedBottom") - last_value(case_dir, "pBedTop")) / (zh - zl);
+  const double overall = rho * (last_value(case_dir, "pInlet") - last_value(case_dir, "pOutlet"));
+  const double es = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps, a), eps, rho, u, d);
+  const double flow = last_value(case_dir, "flowRate");
+  return {{"time_s", time},
+          {"iterations", iterations},
+          {"converged", converged},
+          {"final_initial_residual", {{"U", res_u}, {"p", res_p}}},
+          {"pressure_gradient_bed_pa_m", gradient},
+          {"pressure_drop_inlet_outlet_pa", overall},
+          {"flow_rate_m3_s", flow},
+          {"eisfeld_schnitzlein_pa_m", es},
+          {"ratio_to_eisfeld_schnitzlein", gradient / es},
+          {"void_fraction_section", eps}};
+}
+
+}  // namespace bedforge::cases

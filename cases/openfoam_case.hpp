@@ -1,0 +1,61 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/scene_section.hpp"
+#include "meshing/poly_mesh.hpp"
+
+namespace bedforge::cases {
+
+// The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
+// through the bed, inlet at the bottom.
+struct CaseParams {
+  double reynolds = 1.0;                // particle Reynolds number rho u d / mu, u superficial, d the reference diameter
+  double density_kg_m3 = 1000.0;        // fluid density (water)
+  double viscosity_pa_s = 1.0e-3;       // dynamic viscosity (water)
+  int iterations = 3000;                // simpleFoam iteration cap (endTime)
+  double residual_p = 1.0e-4;           // SIMPLE stops when the initial residuals fall below these (on
+                                        // these tetrahedral meshes p plateaus near 5e-5 once dp has 4 digits)
+  double residual_u = 1.0e-5;
+  int processors = 1;                   // subdomains in decomposeParDict; Allrun -np N overrides
+  bool binary = true;                   // polyMesh and fields in binary, else ASCII
+  bool snappy = false;                  // also write the snappyHexMesh set-up (Allrun -snappy)
+  double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
+  int snappy_level = 2;                 // refinement levels at particles and walls
+  double section_exclude_d = 0.5;       // bed section for the pressure drop: floor + this to bed top - this
+  bool run = false;                     // run Allrun after writing and read the pressure drop back
+};
+CaseParams read_case_params(SceneSection& s);
+nlohmann::json to_json(const CaseParams& p);
+
+// What the case needs to know about the bed and its domain (m).
+struct CaseGeometry {
+  double d_ref = 0.0;          // reference (Sauter) diameter
+  double aspect_ratio = 0.0;   // D/d, for the correlation
+  double outer_radius = 0.0, inner_radius = 0.0;  // inner_radius > 0 for an annulus
+  double inlet_z = 0.0, outlet_z = 0.0, bed_top = 0.0;
+};
+
+// Bed section over which the pressure drop is measured: its planes and its void fraction as
+// meshed (cells with their centre between the planes over the container's volume between them).
+struct BedSection {
+  double z_low = 0.0, z_high = 0.0, void_fraction = 0.0;
+};
+BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d);
+
+// Writes the whole case into `case_dir` (which must not exist; it is built under a temporary
+// name and renamed at the end): constant/polyMesh, 0/U, 0/p, transport and turbulence
+// properties, controlDict with pressure and flow function objects, fvSchemes, fvSolution,
+// decomposeParDict, Allrun, Allclean, and the records `bedforge/scene.toml` and
+// `bedforge/bed.csv`. Returns the case's report entry.
+nlohmann::json write_case(const std::filesystem::path& case_dir, const meshing::PolyMesh& mesh, const CaseGeometry& g,
+                          const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                          const std::string& bed_csv, const std::string& fluid_stl);
+
+// Runs `case_dir/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and reads
+// back the solver's convergence and the pressure drop, compared with Eisfeld & Schnitzlein at
+// the section's own void fraction. std::runtime_error naming the log when the solver fails.
+nlohmann::json run_case(const std::filesystem::path& case_dir, const nlohmann::json& case_report);
+
+}  // namespace bedforge::cases

@@ -1,0 +1,100 @@
+#include "cases/poly_mesh_io.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <fstream>
+#include <stdexcept>
+
+namespace bedforge::cases {
+
+std::string foam_header(const std::string& cls, const std::string& location, const std::string& object,
+                        const std::string& note, bool binary) {
+  return fmt::format(
+      "/*--------------------------------*- C++ -*----------------------------------*\\\n"
+      "  written by bedforge for OpenFOAM v1912\n"
+      "\\*---------------------------------------------------------------------------*/\n"
+      "FoamFile\n{{\n    version     2.0;\n    format      {};\n    arch        \"LSB;label=32;scalar=64\";\n"
+      "    class       {};\n    location    \"{}\";\n    object      {};\n    note        \"{}\";\n}}\n\n",
+      binary ? "binary" : "ascii", cls, location, object, note);
+}
+
+namespace {
+
+std::ofstream open(const std::filesystem::path& path) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  return out;
+}
+
+// A list of N items: `N\n(` raw bytes `)` in binary, one item per line in ASCII.
+template <class T, class Ascii>
+void write_list(std::ostream& out, const std::vector<T>& items, bool binary, Ascii ascii) {
+  out << items.size() << "\n(";
+  if (binary) {
+    out.write(reinterpret_cast<const char*>(items.data()), static_cast<std::streamsize>(items.size() * sizeof(T)));
+  } else {
+    out << "\n";
+    std::string buf;
+    for (const T& x : items) {
+      buf.clear();
+      ascii(buf, x);
+      out << buf << "\n";
+    }
+  }
+  out << ")\n";
+}
+
+}  // namespace
+
+void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& m, bool binary,
+                     const std::string& note) {
+  std::filesystem::create_directories(dir);
+  const std::string loc = "constant/polyMesh";
+  {
+    auto out = open(dir / "points");
+    out << foam_header("vectorField", loc, "points", note, binary);
+    static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double));
+    write_list(out, m.points, binary, [](std::string& b, const Eigen::Vector3d& p) {
+      fmt::format_to(std::back_inserter(b), "({:.12g} {:.12g} {:.12g})", p.x(), p.y(), p.z());
+    });
+  }
+  {
+    auto out = open(dir / "faces");
+    if (binary) {
+      // Binary faces are a compact list: N+1 offsets, then the vertex labels of all faces.
+      out << foam_header("faceCompactList", loc, "faces", note, true);
+      std::vector<std::int32_t> offsets(m.faces.size() + 1), labels(3 * m.faces.size());
+      for (std::size_t f = 0; f <= m.faces.size(); ++f) offsets[f] = static_cast<std::int32_t>(3 * f);
+      for (std::size_t f = 0; f < m.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k) labels[3 * f + k] = m.faces[f][k];
+      write_list(out, offsets, true, [](std::string&, std::int32_t) {});
+      out << "\n";
+      write_list(out, labels, true, [](std::string&, std::int32_t) {});
+    } else {
+      out << foam_header("faceList", loc, "faces", note, false);
+      write_list(out, m.faces, false, [](std::string& b, const std::array<int, 3>& f) {
+        fmt::format_to(std::back_inserter(b), "3({} {} {})", f[0], f[1], f[2]);
+      });
+    }
+  }
+  const std::string sizes = fmt::format("nPoints:{}  nCells:{}  nFaces:{}  nInternalFaces:{}", m.points.size(), m.cells,
+                                        m.faces.size(), m.internal_faces());
+  for (const auto& [name, list] : {std::pair{"owner", &m.owner}, std::pair{"neighbour", &m.neighbour}}) {
+    auto out = open(dir / name);
+    out << foam_header("labelList", loc, name, note + "; " + sizes, binary);
+    static_assert(sizeof(int) == sizeof(std::int32_t));
+    write_list(out, *list, binary, [](std::string& b, int v) { fmt::format_to(std::back_inserter(b), "{}", v); });
+  }
+  auto out = open(dir / "boundary");
+  out << foam_header("polyBoundaryMesh", loc, "boundary", note, false);
+  out << m.patches.size() << "\n(\n";
+  for (const auto& p : m.patches) {
+    out << fmt::format("    {}\n    {{\n        type            {};\n", p.name, p.type);
+    if (p.type == "wall") out << "        inGroups        List<word> 1(wall);\n";
+    out << fmt::format("        nFaces          {};\n        startFace       {};\n    }}\n", p.size, p.start);
+  }
+  out << ")\n";
+}
+
+}  // namespace bedforge::cases

@@ -1,0 +1,350 @@
+#include "meshing/volume_mesh.hpp"
+
+#include <fmt/format.h>
+#include <gmsh.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+#include <thread>
+
+#include "core/error.hpp"
+
+namespace bedforge::meshing {
+
+const char* algorithm_name(VolumeMeshParams::Algorithm a) {
+  return a == VolumeMeshParams::Algorithm::hxt ? "hxt" : "delaunay";
+}
+
+VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
+  VolumeMeshParams p;
+  p.algorithm = s.choice("algorithm", "hxt", {"hxt", "delaunay"}) == "hxt" ? VolumeMeshParams::Algorithm::hxt
+                                                                          : VolumeMeshParams::Algorithm::delaunay;
+  p.fallback = s.boolean("fallback", p.fallback);
+  p.max_size_d = s.number("max_size_d", p.max_size_d, Range::closed(0.01, 10.0));
+  p.optimize = s.boolean("optimize", p.optimize);
+  p.threads = static_cast<int>(s.integer("threads", p.threads, 0, 1024));
+  SceneSection g = s.sub("gate");
+  p.gate.max_non_orthogonality_deg =
+      g.number("max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg, Range::open(0.0, 90.0));
+  p.gate.max_skewness = g.number("max_skewness", p.gate.max_skewness, Range::positive());
+  p.gate.max_aspect_ratio = g.number("max_aspect_ratio", p.gate.max_aspect_ratio, Range{1.0, 1e12, false, false});
+  p.gate.min_volume_d3 = g.number("min_volume_d3", p.gate.min_volume_d3, Range::positive());
+  g.finish();
+  return p;
+}
+
+nlohmann::json to_json(const VolumeMeshParams& p) {
+  return {{"algorithm", algorithm_name(p.algorithm)},
+          {"fallback", p.fallback},
+          {"max_size_d", p.max_size_d},
+          {"optimize", p.optimize},
+          {"threads", p.threads},
+          {"gate",
+           {{"max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg},
+            {"max_skewness", p.gate.max_skewness},
+            {"max_aspect_ratio", p.gate.max_aspect_ratio},
+            {"min_volume_d3", p.gate.min_volume_d3}}}};
+}
+
+namespace {
+
+// gmsh is a process-wide singleton: one session per mesh, closed however the work ends.
+struct GmshSession {
+  GmshSession() {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.Verbosity", 1);
+  }
+  ~GmshSession() { gmsh::finalize(); }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+};
+
+std::string patch_type(const std::string& name) { return name == "inlet" || name == "outlet" ? "patch" : "wall"; }
+
+// Components of the surface joined through shared vertices: the container (with whatever
+// touches it) and one shell per free particle or cluster.
+std::vector<int> shells(const TriangleMesh& s) {
+  std::vector<int> parent(s.points.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : s.triangles)
+    for (int k = 1; k < 3; ++k) parent[find(t[k])] = find(t[0]);
+  std::vector<int> shell(s.triangles.size());
+  std::map<int, int> number;
+  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+    shell[t] = number.emplace(find(s.triangles[t][0]), static_cast<int>(number.size())).first->second;
+  return shell;
+}
+
+// The discrete surfaces (one per shell and patch, so that HXT sees each closed shell on its own),
+// their physical groups, and the fluid volume bounded by them.
+void load_surface(const TriangleMesh& s) {
+  const std::vector<int> shell = shells(s);
+  const int n_patches = static_cast<int>(s.patches.size());
+  const int inlet = static_cast<int>(std::find(s.patches.begin(), s.patches.end(), "inlet") - s.patches.begin());
+  int outer = -1;
+  for (std::size_t t = 0; t < s.triangles.size() && outer < 0; ++t)
+    if (s.patch[t] == inlet) outer = shell[t];
+  if (outer < 0) throw InputError("volume mesh: the surface has no `inlet` patch");
+
+  std::map<std::pair<int, int>, std::vector<std::size_t>> groups;  // (shell, patch) -> triangles
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) groups[{shell[t], s.patch[t]}].push_back(t);
+  std::vector<int> node_entity(s.points.size(), 0);
+  std::map<int, std::vector<int>> shell_surfaces;
+  std::vector<std::vector<int>> patch_surfaces(n_patches);
+  std::vector<std::pair<int, const std::vector<std::size_t>*>> entities;
+  for (const auto& [key, tris] : groups) {
+    const int tag = gmsh::model::addDiscreteEntity(2);
+    entities.emplace_back(tag, &tris);
+    shell_surfaces[key.first].push_back(tag);
+    patch_surfaces[key.second].push_back(tag);
+    for (std::size_t t : tris)
+      for (int v : s.triangles[t])
+        if (node_entity[v] == 0) node_entity[v] = tag;
+  }
+  // Each node belongs to one entity (the first that uses it); elements may use any node.
+  std::map<int, std::pair<std::vector<std::size_t>, std::vector<double>>> nodes;
+  for (std::size_t v = 0; v < s.points.size(); ++v) {
+    if (node_entity[v] == 0) continue;
+    auto& [tags, xyz] = nodes[node_entity[v]];
+    tags.push_back(v + 1);
+    xyz.insert(xyz.end(), {s.points[v].x(), s.points[v].y(), s.points[v].z()});
+  }
+  for (const auto& [tag, n] : nodes) gmsh::model::mesh::addNodes(2, tag, n.first, n.second);
+  for (const auto& [tag, tris] : entities) {
+    std::vector<std::size_t> element_tags, node_tags;
+    element_tags.reserve(tris->size());
+    node_tags.reserve(3 * tris->size());
+    for (std::size_t t : *tris) {
+      element_tags.push_back(t + 1);
+      for (int v : s.triangles[t]) node_tags.push_back(static_cast<std::size_t>(v) + 1);
+    }
+    gmsh::model::mesh::addElementsByType(tag, 2, element_tags, node_tags);
+  }
+  // The outer shell first: gmsh takes the first loop as the volume's outside.
+  std::vector<int> loops{gmsh::model::geo::addSurfaceLoop(shell_surfaces[outer])};
+  for (const auto& [sh, tags] : shell_surfaces)
+    if (sh != outer) loops.push_back(gmsh::model::geo::addSurfaceLoop(tags));
+  const int volume = gmsh::model::geo::addVolume(loops);
+  gmsh::model::geo::synchronize();
+  for (int p = 0; p < n_patches; ++p) {
+    if (patch_surfaces[p].empty()) continue;
+    const int group = gmsh::model::addPhysicalGroup(2, patch_surfaces[p]);
+    gmsh::model::setPhysicalName(2, group, s.patches[p]);
+  }
+  const int fluid = gmsh::model::addPhysicalGroup(3, {volume});
+  gmsh::model::setPhysicalName(3, fluid, "fluid");
+}
+
+// The current gmsh model's tetrahedra and physical boundary triangles as a PolyMesh.
+PolyMesh extract_poly_mesh() {
+  std::vector<std::size_t> node_tags;
+  std::vector<double> xyz, uvw;
+  gmsh::model::mesh::getNodes(node_tags, xyz, uvw, -1, -1, false, false);
+  std::unordered_map<std::size_t, int> index;
+  index.reserve(node_tags.size());
+  std::vector<Eigen::Vector3d> points(node_tags.size());
+  for (std::size_t k = 0; k < node_tags.size(); ++k) {
+    index.emplace(node_tags[k], static_cast<int>(k));
+    points[k] = {xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
+  }
+  std::vector<std::size_t> element_tags, element_nodes;
+  gmsh::model::mesh::getElementsByType(4, element_tags, element_nodes);
+  std::vector<std::array<int, 4>> tets(element_tags.size());
+  for (std::size_t e = 0; e < tets.size(); ++e)
+    for (int k = 0; k < 4; ++k) tets[e][k] = index.at(element_nodes[4 * e + k]);
+
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups, 2);
+  std::vector<std::string> names, types;
+  std::vector<std::array<int, 3>> boundary;
+  std::vector<int> patch;
+  // Patches in a fixed order whatever gmsh's group numbering: inlet, outlet, walls, particles.
+  std::vector<std::pair<std::string, int>> named;
+  for (const auto& [dim, tag] : groups) {
+    std::string name;
+    gmsh::model::getPhysicalName(dim, tag, name);
+    named.emplace_back(name, tag);
+  }
+  const std::vector<std::string> order{"inlet", "outlet", "wall", "inner_wall", "particles"};
+  auto rank = [&](const std::string& n) { return std::find(order.begin(), order.end(), n) - order.begin(); };
+  std::sort(named.begin(), named.end(), [&](const auto& a, const auto& b) {
+    return rank(a.first) != rank(b.first) ? rank(a.first) < rank(b.first) : a.first < b.first;
+  });
+  for (const auto& [name, tag] : named) {
+    const int p = static_cast<int>(names.size());
+    names.push_back(name);
+    types.push_back(patch_type(name));
+    std::vector<int> entities;
+    gmsh::model::getEntitiesForPhysicalGroup(2, tag, entities);
+    for (int e : entities) {
+      // Fresh vectors each call: gmsh 4.8 leaves a non-empty tag vector at its old size.
+      std::vector<std::size_t> triangle_tags, triangle_nodes;
+      gmsh::model::mesh::getElementsByType(2, triangle_tags, triangle_nodes, e);
+      for (std::size_t t = 0; 3 * t + 2 < triangle_nodes.size(); ++t) {
+        boundary.push_back({index.at(triangle_nodes[3 * t]), index.at(triangle_nodes[3 * t + 1]),
+                            index.at(triangle_nodes[3 * t + 2])});
+        patch.push_back(p);
+      }
+    }
+  }
+  return poly_mesh_from_tets(std::move(points), std::move(tets), boundary, patch, names, types);
+}
+
+double peak_memory_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// Legacy VTK of the given cells, with their quality and the nearest particle, for ParaView.
+void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
+                     const std::vector<int>& bad, const std::vector<int>& nearest) {
+  std::vector<std::array<int, 4>> cells(m.cells, {-1, -1, -1, -1});
+  std::vector<int> filled(m.cells, 0);
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
+      if (c < 0) continue;
+      for (int v : m.faces[f]) {
+        auto& cell = cells[c];
+        if (std::find(cell.begin(), cell.begin() + filled[c], v) == cell.begin() + filled[c]) cell[filled[c]++] = v;
+      }
+    }
+  std::ofstream out(path);
+  out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << 4 * bad.size() << " double\n";
+  for (int c : bad)
+    for (int v : cells[c]) out << fmt::format("{:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
+  out << "CELLS " << bad.size() << " " << 5 * bad.size() << "\n";
+  for (std::size_t k = 0; k < bad.size(); ++k)
+    out << fmt::format("4 {} {} {} {}\n", 4 * k, 4 * k + 1, 4 * k + 2, 4 * k + 3);
+  out << "CELL_TYPES " << bad.size() << "\n";
+  for (std::size_t k = 0; k < bad.size(); ++k) out << "10\n";
+  out << "CELL_DATA " << bad.size() << "\n";
+  auto field = [&](const char* name, const auto& value) {
+    out << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
+    for (std::size_t k = 0; k < bad.size(); ++k) out << fmt::format("{:.6g}\n", static_cast<double>(value(k)));
+  };
+  field("non_orthogonality_deg", [&](std::size_t k) { return q.non_orthogonality_deg[bad[k]]; });
+  field("skewness", [&](std::size_t k) { return q.skewness[bad[k]]; });
+  field("aspect_ratio", [&](std::size_t k) { return q.aspect_ratio[bad[k]]; });
+  field("volume_m3", [&](std::size_t k) { return q.volume[bad[k]]; });
+  field("nearest_particle", [&](std::size_t k) { return nearest[k]; });
+}
+
+}  // namespace
+
+VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
+                             const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
+                             Progress& progress) {
+  std::vector<VolumeMeshParams::Algorithm> tries{p.algorithm};
+  if (p.fallback)
+    tries.push_back(p.algorithm == VolumeMeshParams::Algorithm::hxt ? VolumeMeshParams::Algorithm::delaunay
+                                                                     : VolumeMeshParams::Algorithm::hxt);
+  nlohmann::json attempts = nlohmann::json::array();
+  std::string failure;
+  for (const auto algorithm : tries) {
+    const auto t0 = std::chrono::steady_clock::now();
+    progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), surface.triangles.size()));
+    GmshSession session;
+    try {
+      gmsh::model::add("bedforge");
+      load_surface(surface);
+      gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == VolumeMeshParams::Algorithm::hxt ? 10 : 1);
+      gmsh::option::setNumber("General.NumThreads",
+                              p.threads > 0 ? p.threads : std::max(1u, std::thread::hardware_concurrency()));
+      gmsh::option::setNumber("Mesh.MeshSizeMax", p.max_size_d * d_ref);
+      gmsh::option::setNumber("Mesh.Optimize", p.optimize ? 1 : 0);
+      progress.update(fmt::format("{}: tetrahedra", algorithm_name(algorithm)));
+      gmsh::model::mesh::generate(3);
+    } catch (const std::string& e) {  // gmsh's API throws its last error message
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e}});
+      failure = fmt::format("{} failed: {}", algorithm_name(algorithm), e);
+      continue;
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    progress.update(fmt::format("{}: checking cells", algorithm_name(algorithm)));
+    VolumeMesh out;
+    try {
+      out.mesh = extract_poly_mesh();
+    } catch (const std::exception& e) {
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e.what()}});
+      failure = fmt::format("{} gave an invalid mesh: {}", algorithm_name(algorithm), e.what());
+      continue;
+    }
+    out.quality = cell_quality(out.mesh);
+    const std::vector<int> bad = out.quality.bad_cells(p.gate, d_ref);
+    nlohmann::json attempt = {{"algorithm", algorithm_name(algorithm)},
+                              {"cells", out.mesh.cells},
+                              {"time_generate_s", std::chrono::duration<double>(t1 - t0).count()},
+                              {"quality", out.quality.to_json(d_ref)},
+                              {"cells_failing_gate", bad.size()}};
+    attempts.push_back(attempt);
+    if (bad.empty()) {
+      if (!msh_path.empty()) {
+        try {
+          gmsh::option::setNumber("Mesh.Binary", 1);
+          gmsh::write(msh_path.string());
+        } catch (const std::string& e) {
+          throw std::runtime_error(fmt::format("gmsh cannot write {}: {}", msh_path.string(), e));
+        }
+      }
+      out.report = attempt;
+      out.report["attempts"] = attempts;
+      out.report["peak_memory_mb"] = peak_memory_mb();
+      return out;
+    }
+    // Say where the bad cells are: the nearest particle surface to each.
+    const std::vector<Eigen::Vector3d> centres = cell_centres(out.mesh);
+    std::vector<int> nearest(bad.size(), -1);
+    std::map<int, int> by_particle;
+    for (std::size_t k = 0; k < bad.size(); ++k) {
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < bed.size(); ++i) {
+        const double gap = (centres[bad[k]] - bed.centres[i]).norm() - 0.5 * bed.diameters[i];
+        if (gap < best) best = gap, nearest[k] = static_cast<int>(i);
+      }
+      ++by_particle[nearest[k]];
+    }
+    std::vector<std::pair<int, int>> worst(by_particle.begin(), by_particle.end());
+    std::sort(worst.begin(), worst.end(), [](auto a, auto b) { return a.second > b.second; });
+    std::string near;
+    for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
+      near += fmt::format("{}particle {} ({} cells)", k ? ", " : "", worst[k].first, worst[k].second);
+    if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, nearest);
+    failure = fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
+                          "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
+                          "most near {}; cells written to {}",
+                          algorithm_name(algorithm), bad.size(), out.mesh.cells, out.quality.max_non_orthogonality_deg,
+                          p.gate.max_non_orthogonality_deg, out.quality.max_skewness, p.gate.max_skewness,
+                          out.quality.max_aspect_ratio, p.gate.max_aspect_ratio,
+                          out.quality.min_volume / (d_ref * d_ref * d_ref), p.gate.min_volume_d3, near,
+                          bad_cells_path.string());
+  }
+  throw std::runtime_error("volume mesh: no algorithm passed the quality gate. " + failure +
+                           ". Refine the surface near contacts ([surface] contact_edge_length_d), widen the gaps "
+                           "([contacts]) or relax [mesh.gate]");
+}
+
+PolyMesh read_msh(const std::filesystem::path& msh_path) {
+  if (!std::filesystem::exists(msh_path))
+    throw InputError(fmt::format("{}: no volume mesh; run `bedforge mesh` on the directory first", msh_path.string()));
+  GmshSession session;
+  try {
+    gmsh::open(msh_path.string());
+  } catch (const std::string& e) {
+    throw InputError(fmt::format("{}: gmsh cannot read it: {}", msh_path.string(), e));
+  }
+  return extract_poly_mesh();
+}
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,53 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/bed.hpp"
+#include "core/progress.hpp"
+#include "core/scene_section.hpp"
+#include "meshing/cell_quality.hpp"
+#include "meshing/poly_mesh.hpp"
+#include "meshing/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// Volume mesh of the fluid domain with gmsh, scene section [mesh]. Lengths in reference
+// diameters d. The surface's own triangles fix the cell size at the boundary, so refinement at
+// the particles and in the gaps near contacts is set by [surface] edge_length_d and
+// contact_edge_length_d; inside, gmsh interpolates between the boundary sizes, capped at
+// `max_size_d` (in a packed bed every point is within about d/2 of a surface, so the cap acts
+// mostly in the empty inlet and outlet sections).
+struct VolumeMeshParams {
+  enum class Algorithm { hxt, delaunay };
+  Algorithm algorithm = Algorithm::hxt;  // the first tried; the other is the fallback
+  bool fallback = true;                  // retry with the other algorithm when the gate fails
+  double max_size_d = 0.25;              // largest cell edge, away from every surface
+  bool optimize = true;                  // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio)
+  int threads = 0;                       // 0: every core
+  QualityGate gate;
+};
+const char* algorithm_name(VolumeMeshParams::Algorithm a);
+VolumeMeshParams read_volume_mesh_params(SceneSection& mesh);
+nlohmann::json to_json(const VolumeMeshParams& p);
+
+struct VolumeMesh {
+  PolyMesh mesh;        // patches in the surface's order, `fluid` cells
+  CellQuality quality;
+  nlohmann::json report;
+};
+
+// Meshes the inside of `surface` (closed, labelled by patch; the fluid surface of the surface
+// stage). `bed` names the particles near bad cells; `d_ref` (m) scales the parameters. Writes
+// the gmsh mesh (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty.
+// Tries the algorithms in turn; when none passes the gate, throws std::runtime_error saying
+// how many cells fail which limit and near which particles, after writing them as a legacy VTK
+// file to `bad_cells_path` (open it in ParaView).
+VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& params,
+                             const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
+                             Progress& progress);
+
+// A volume mesh written by build_volume_mesh, read back (for `bedforge case DIR`).
+PolyMesh read_msh(const std::filesystem::path& msh_path);
+
+}  // namespace bedforge::meshing
