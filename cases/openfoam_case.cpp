@@ -27,6 +27,7 @@ CaseParams read_case_params(SceneSection& s) {
   p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
   p.residual_u = s.number("residual_u", p.residual_u, Range::open(0.0, 1.0));
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
+  p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
   p.snappy = s.boolean("snappy", p.snappy);
   p.snappy_cell_d = s.number("snappy_cell_d", p.snappy_cell_d, Range::closed(0.01, 10.0));
@@ -40,7 +41,8 @@ nlohmann::json to_json(const CaseParams& p) {
   return {{"reynolds", p.reynolds},         {"density_kg_m3", p.density_kg_m3},
           {"viscosity_pa_s", p.viscosity_pa_s}, {"iterations", p.iterations},
           {"residual_p", p.residual_p},     {"residual_u", p.residual_u},
-          {"processors", p.processors},     {"format", p.binary ? "binary" : "ascii"},
+          {"processors", p.processors},     {"decomposition", p.decomposition},
+          {"format", p.binary ? "binary" : "ascii"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
           {"run", p.run}};
@@ -136,7 +138,8 @@ std::string allrun(bool snappy) {
          "    run checkMesh\n"
          "fi\n";
   s += "if [ \"$np\" -gt 1 ]; then\n"
-       "    sed -i \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" system/decomposeParDict\n"
+       "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
+       "        -e \"s/^    n .*/    n               (1 1 $np);/\" system/decomposeParDict\n"
        "    run decomposePar -force\n"
        "    run mpirun -np \"$np\" simpleFoam -parallel\n"
        "    mv log.mpirun log.simpleFoam\n"
@@ -232,12 +235,15 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
                                 "        tolerance       1e-9;\n        relTol          0.1;\n    }}\n}}\n\n"
                                 "SIMPLE\n{{\n    nNonOrthogonalCorrectors 1;\n    consistent      yes;\n"
                                 "    residualControl\n    {{\n        p               {};\n        U               {};\n    }}\n}}\n\n"
-                                "relaxationFactors\n{{\n    equations\n    {{\n        U               0.7;\n    }}\n"
-                                "    fields\n    {{\n        p               0.7;\n    }}\n}}\n",
+                                "relaxationFactors\n{{\n    equations\n    {{\n        U               0.9;\n    }}\n"
+                                "    fields\n    {{\n        p               1;\n    }}\n}}\n",
                                 p.residual_p, p.residual_u)));
     write_text(tmp / "system/decomposeParDict",
                dict("dictionary", "system", "decomposeParDict", note,
-                    fmt::format("numberOfSubdomains {};\n\nmethod          scotch;\n", p.processors)));
+                    fmt::format("numberOfSubdomains {};\n\nmethod          {};\n\n"
+                                "hierarchicalCoeffs\n{{\n    n               (1 1 {});\n    delta           0.001;\n"
+                                "    order           xyz;\n}}\n",
+                                p.processors, p.decomposition, p.processors)));
     write_text(tmp / "Allrun", allrun(p.snappy), true);
     write_text(tmp / "Allclean", kAllclean, true);
     write_text(tmp / "case.foam", "");  // for ParaView
@@ -309,22 +315,26 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
           {"cells", mesh.cells},
           {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
           {"aspect_ratio", g.aspect_ratio},
+          {"inlet_area_m2", std::numbers::pi * (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius)},
           {"d_ref_m", g.d_ref}};
 }
 
 namespace {
 
-// Last value of the last data row of a function object's output.
-double last_value(const fs::path& case_dir, const std::string& name) {
+// The values (second column) of a function object's output, one per iteration.
+std::vector<double> series(const fs::path& case_dir, const std::string& name) {
   const fs::path file = case_dir / "postProcessing" / name / "0" / "surfaceFieldValue.dat";
   std::ifstream in(file);
   if (!in) throw std::runtime_error("the solver wrote no " + file.string());
-  std::string line, last;
-  while (std::getline(in, line))
-    if (!line.empty() && line[0] != '#') last = line;
-  std::istringstream row(last);
-  double t = 0.0, v = 0.0;
-  if (!(row >> t >> v)) throw std::runtime_error("no value in " + file.string());
+  std::vector<double> v;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream row(line);
+    double t = 0.0, x = 0.0;
+    if (row >> t >> x) v.push_back(x);
+  }
+  if (v.empty()) throw std::runtime_error("no value in " + file.string());
   return v;
 }
 
@@ -358,17 +368,24 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
   const double zl = c["section"]["z_low_m"].get<double>(), zh = c["section"]["z_high_m"].get<double>();
   const double eps = c["section"]["void_fraction_mesh"].get<double>();
   const double re = c["parameters"]["reynolds"].get<double>();
-  const double gradient = rho * (last_value(case_dir, "pBedBottom") - last_value(case_dir, "pBedTop")) / (zh - zl);
-  const double overall = rho * (last_value(case_dir, "pInlet") - last_value(case_dir, "pOutlet"));
+  const std::vector<double> bottom = series(case_dir, "pBedBottom"), top = series(case_dir, "pBedTop");
+  const std::size_t n = std::min(bottom.size(), top.size());
+  auto bed_gradient = [&](std::size_t k) { return rho * (bottom[k] - top[k]) / (zh - zl); };
+  const double gradient = bed_gradient(n - 1);
+  // Convergence of the quantity itself: its change over the last tenth of the iterations.
+  const double change = std::abs(gradient - bed_gradient(n - 1 - (n - 1) / 10)) / std::abs(gradient);
+  const double overall = rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
   const double es = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps, a), eps, rho, u, d);
-  const double flow = last_value(case_dir, "flowRate");
+  const double flow = series(case_dir, "flowRate").back();
   return {{"time_s", time},
           {"iterations", iterations},
           {"converged", converged},
           {"final_initial_residual", {{"U", res_u}, {"p", res_p}}},
           {"pressure_gradient_bed_pa_m", gradient},
+          {"pressure_gradient_change_last_tenth", change},
           {"pressure_drop_inlet_outlet_pa", overall},
           {"flow_rate_m3_s", flow},
+          {"flow_rate_relative_error", flow / (u * c["inlet_area_m2"].get<double>()) - 1.0},
           {"eisfeld_schnitzlein_pa_m", es},
           {"ratio_to_eisfeld_schnitzlein", gradient / es},
           {"void_fraction_section", eps}};

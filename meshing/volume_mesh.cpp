@@ -251,7 +251,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     tries.push_back(p.algorithm == VolumeMeshParams::Algorithm::hxt ? VolumeMeshParams::Algorithm::delaunay
                                                                      : VolumeMeshParams::Algorithm::hxt);
   nlohmann::json attempts = nlohmann::json::array();
-  std::string failure;
+  std::string failure;  // one sentence per attempt
   for (const auto algorithm : tries) {
     const auto t0 = std::chrono::steady_clock::now();
     progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), surface.triangles.size()));
@@ -268,7 +268,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       gmsh::model::mesh::generate(3);
     } catch (const std::string& e) {  // gmsh's API throws its last error message
       attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e}});
-      failure = fmt::format("{} failed: {}", algorithm_name(algorithm), e);
+      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), e);
       continue;
     }
     const auto t1 = std::chrono::steady_clock::now();
@@ -278,7 +278,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       out.mesh = extract_poly_mesh();
     } catch (const std::exception& e) {
       attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e.what()}});
-      failure = fmt::format("{} gave an invalid mesh: {}", algorithm_name(algorithm), e.what());
+      failure += fmt::format("{} gave an invalid mesh: {}. ", algorithm_name(algorithm), e.what());
       continue;
     }
     out.quality = cell_quality(out.mesh);
@@ -321,7 +321,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
       near += fmt::format("{}particle {} ({} cells)", k ? ", " : "", worst[k].first, worst[k].second);
     if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, nearest);
-    failure = fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
+    failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
                           "most near {}; cells written to {}",
                           algorithm_name(algorithm), bad.size(), out.mesh.cells, out.quality.max_non_orthogonality_deg,
@@ -329,9 +329,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                           out.quality.max_aspect_ratio, p.gate.max_aspect_ratio,
                           out.quality.min_volume / (d_ref * d_ref * d_ref), p.gate.min_volume_d3, near,
                           bad_cells_path.string());
+    failure += ". ";
   }
   throw std::runtime_error("volume mesh: no algorithm passed the quality gate. " + failure +
-                           ". Refine the surface near contacts ([surface] contact_edge_length_d), widen the gaps "
+                           "Refine the surface near contacts ([surface] contact_edge_length_d), widen the gaps "
                            "([contacts]) or relax [mesh.gate]");
 }
 

@@ -1,0 +1,45 @@
+#include "analysis/pressure_drop.hpp"
+
+#include <gtest/gtest.h>
+
+namespace bedforge::analysis {
+namespace {
+
+// f_p = F (1 - eps) / eps^3 at eps = 0.40: the check values of ../shared/reference/correlations.md
+// (section 3), given there to four significant figures.
+double f_p(double f, double eps) { return f * (1.0 - eps) / (eps * eps * eps); }
+
+TEST(PressureDrop, EisfeldSchnitzleinMatchesThePublishedCheckValues) {
+  const double eps = 0.40;
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(1.0, eps, 5.0), eps), 1308.0, 0.5);
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(10.0, eps, 5.0), eps), 143.1, 0.05);
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(100.0, eps, 5.0), eps), 26.60, 0.005);
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(1.0, eps, 10.0), eps), 1083.0, 0.5);
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(10.0, eps, 10.0), eps), 120.3, 0.05);
+  EXPECT_NEAR(f_p(eisfeld_schnitzlein_f(100.0, eps, 10.0), eps), 24.10, 0.005);
+}
+
+TEST(PressureDrop, ErgunMatchesThePublishedCheckValues) {
+  const double eps = 0.40;
+  EXPECT_NEAR(f_p(ergun_f(1.0, eps), eps), 860.2, 0.05);
+  EXPECT_NEAR(f_p(ergun_f(10.0, eps), eps), 100.8, 0.05);
+  EXPECT_NEAR(f_p(ergun_f(100.0, eps), eps), 24.84, 0.005);
+}
+
+TEST(PressureDrop, WallCorrectionVanishesInAWideBed) {
+  // a -> infinity: A_w -> 1, B_w -> 0.87^2; the viscous term becomes Carman-like 154 / Re_m.
+  const double eps = 0.4, re = 0.01;
+  const double f = eisfeld_schnitzlein_f(re, eps, 1e9);
+  EXPECT_NEAR(f, 154.0 * (1.0 - eps) / re + 1.0 / (0.87 * 0.87), 1e-6 * f);
+}
+
+TEST(PressureDrop, GradientHasTheUnitsOfTheDefinition) {
+  // dp/L = f_p rho u^2 / d: doubling the density doubles it, doubling d halves it at fixed f.
+  const double g = pressure_gradient(100.0, 0.4, 1000.0, 0.01, 0.003);
+  EXPECT_NEAR(g, 100.0 * 0.6 / 0.064 * 1000.0 * 1e-4 / 0.003, 1e-9 * g);
+  EXPECT_NEAR(pressure_gradient(100.0, 0.4, 2000.0, 0.01, 0.003), 2.0 * g, 1e-9 * g);
+  EXPECT_NEAR(pressure_gradient(100.0, 0.4, 1000.0, 0.01, 0.006), 0.5 * g, 1e-9 * g);
+}
+
+}  // namespace
+}  // namespace bedforge::analysis

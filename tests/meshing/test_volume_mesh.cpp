@@ -1,0 +1,118 @@
+// gmsh volume meshes of small beds: the cells fill exactly the surface they were made from,
+// every patch keeps its triangles, and a mesh failing the gate is located and written out.
+#include "meshing/volume_mesh.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "meshing/fluid_surface.hpp"
+#include "meshing/surface_checks.hpp"
+
+using namespace bedforge;
+using namespace bedforge::meshing;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Four spheres of d = 1 in a tube of a = 3.2: a column of three touching on the axis, one
+// touching the middle one, 0.1 d from the wall.
+Bed small_bed() {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(1.6);
+  for (int k = 0; k < 3; ++k) b.centres.emplace_back(0.0, 0.0, 0.5 + k), b.diameters.push_back(1.0);
+  b.centres.emplace_back(0.0, 1.0, 1.5), b.diameters.push_back(1.0);
+  return b;
+}
+
+FluidSurface coarse_surface(const Bed& b) {
+  SurfaceParams p;
+  p.edge_length_d = 0.2;
+  p.contact_edge_length_d = 0.05;
+  return build_fluid_surface(b, p);
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("bedforge_volume_" + std::to_string(::getpid())) / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::vector<int> patch_counts(const TriangleMesh& s, const PolyMesh& m) {
+  std::vector<int> diff;
+  for (const auto& p : m.patches) {
+    const int k = static_cast<int>(std::find(s.patches.begin(), s.patches.end(), p.name) - s.patches.begin());
+    diff.push_back(p.size - static_cast<int>(std::count(s.patch.begin(), s.patch.end(), k)));
+  }
+  return diff;
+}
+
+}  // namespace
+
+TEST(VolumeMesh, CellsFillTheSurfaceAndKeepEveryPatch) {
+  const Bed b = small_bed();
+  const FluidSurface s = coarse_surface(b);
+  const fs::path dir = scratch("fill");
+  Progress quiet("mesh", false);
+  const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, {}, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
+  // The tets' volume is the enclosed volume of the surface (same boundary triangles), to round-off.
+  const double enclosed = check_surface(s.fluid, 0).volume;
+  EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
+  EXPECT_GT(vm.quality.min_volume, 0.0);
+  // Every surface triangle is a boundary face of its own patch, none added or lost.
+  ASSERT_EQ(vm.mesh.patches.size(), 4u);
+  for (int d : patch_counts(s.fluid, vm.mesh)) EXPECT_EQ(d, 0);
+  EXPECT_EQ(vm.mesh.patches[0].name, "inlet");
+  EXPECT_EQ(vm.mesh.patches[3].type, "wall");
+  EXPECT_LE(vm.quality.max_non_orthogonality_deg, QualityGate{}.max_non_orthogonality_deg);
+  // What gmsh wrote reads back as the same mesh.
+  const PolyMesh again = read_msh(dir / "fluid.msh");
+  EXPECT_EQ(again.cells, vm.mesh.cells);
+  EXPECT_EQ(again.faces.size(), vm.mesh.faces.size());
+  EXPECT_FALSE(fs::exists(dir / "bad_cells.vtk"));
+}
+
+TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
+  const Bed b = small_bed();
+  const FluidSurface s = coarse_surface(b);
+  const fs::path dir = scratch("gate");
+  VolumeMeshParams p;
+  p.gate.max_non_orthogonality_deg = 5.0;  // no tetrahedral mesh meets this
+  Progress quiet("mesh", false);
+  try {
+    build_volume_mesh(s.fluid, b, 1.0, p, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
+    FAIL() << "a gate of 5 degrees passed";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("hxt"), std::string::npos) << msg;       // both algorithms were tried,
+    EXPECT_NE(msg.find("delaunay"), std::string::npos) << msg;  // the fallback last
+    EXPECT_NE(msg.find("near particle"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("bad_cells.vtk"), std::string::npos) << msg;
+  }
+  std::ifstream vtk(dir / "bad_cells.vtk");
+  std::stringstream text;
+  text << vtk.rdbuf();
+  EXPECT_NE(text.str().find("DATASET UNSTRUCTURED_GRID"), std::string::npos);
+  EXPECT_NE(text.str().find("SCALARS nearest_particle"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+}
+
+TEST(VolumeMesh, AnAnnulusMeshesWithItsInnerWall) {
+  Bed b;
+  b.container = std::make_shared<Annulus>(2.0, 0.75);
+  for (int k = 0; k < 4; ++k) {
+    const double t = k * 1.5707963267948966;
+    b.centres.emplace_back(1.375 * std::cos(t), 1.375 * std::sin(t), 0.5 + 0.4 * k);
+    b.diameters.push_back(1.0);
+  }
+  const FluidSurface s = coarse_surface(b);
+  Progress quiet("mesh", false);
+  const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, {}, {}, {}, quiet);
+  for (int d : patch_counts(s.fluid, vm.mesh)) EXPECT_EQ(d, 0);
+  const double enclosed = check_surface(s.fluid, 0).volume;
+  EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
+}
