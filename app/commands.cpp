@@ -147,10 +147,7 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
   const double exact = j["fluid_volume_exact_m3"].get<double>();
   j["fluid_volume_mesh_m3"] = check.volume;
   if (!check.manifold || !check.closed || check.self_intersecting) {
-    std::string where;
-    for (std::size_t k = 0; k < std::min<std::size_t>(5, check.defects.size()); ++k)
-      where += fmt::format(" ({:.4g}, {:.4g}, {:.4g}) m used by {} triangles;", check.defects[k].at.x(),
-                           check.defects[k].at.y(), check.defects[k].at.z(), check.defects[k].triangles);
+    const std::string where = meshing::describe_defects(check);
     throw std::runtime_error(fmt::format("the fluid surface is not valid ({}); {} defective edges, first at{} please "
                                          "report it with the bed",
                                          check.to_json().dump(), check.defects.size(), where));
@@ -594,6 +591,14 @@ int run_command_line(int argc, char** argv) {
     section.finish();
     const meshing::TriangleMesh surface =
         meshing::read_stl_ascii_by_patch(read_file(d / "fluid.stl"), (d / "fluid.stl").string());
+    // A surface edited or made elsewhere: gmsh needs it closed, so say where it is not.
+    const meshing::SurfaceCheck check = meshing::check_surface(surface, 0);
+    if (!check.closed || !check.manifold) {
+      const std::string where = meshing::describe_defects(check);
+      throw InputError(fmt::format("{}: the surface is not closed ({} defective edges, first at{}); a volume needs a "
+                                   "closed surface: rebuild it with `bedforge surface`",
+                                   (d / "fluid.stl").string(), check.defects.size(), where));
+    }
     const nlohmann::json& stage = report.data().contains("stages") ? report.data()["stages"] : nlohmann::json();
     double exact = std::numeric_limits<double>::quiet_NaN();
     if (stage.contains("surface") && stage["surface"].contains("fluid_volume_exact_m3"))

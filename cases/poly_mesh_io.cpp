@@ -56,7 +56,7 @@ void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& 
     out << foam_header("vectorField", loc, "points", note, binary);
     static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double));
     write_list(out, m.points, binary, [](std::string& b, const Eigen::Vector3d& p) {
-      fmt::format_to(std::back_inserter(b), "({:.12g} {:.12g} {:.12g})", p.x(), p.y(), p.z());
+      fmt::format_to(std::back_inserter(b), "({:.17g} {:.17g} {:.17g})", p.x(), p.y(), p.z());  // round-trips exactly
     });
   }
   {

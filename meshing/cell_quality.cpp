@@ -19,7 +19,7 @@ CellQuality cell_quality(const PolyMesh& m) {
   q.aspect_ratio.assign(m.cells, 0.0);
   q.non_orthogonality_histogram.assign(9, 0);
   std::vector<Eigen::Vector3d> sum_mag_area(m.cells, Eigen::Vector3d::Zero());
-  double sum_angle = 0.0;
+  double sum_cos = 0.0;
 
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     const auto& t = m.faces[f];
@@ -36,7 +36,7 @@ CellQuality cell_quality(const PolyMesh& m) {
       d = cc[nei] - cc[own];
       const double c = std::clamp(d.dot(area) / (d.norm() * area.norm() + kRootVSmall), -1.0, 1.0);
       const double angle = std::acos(c) * 180.0 / std::numbers::pi;
-      sum_angle += angle;
+      sum_cos += c;
       q.max_non_orthogonality_deg = std::max(q.max_non_orthogonality_deg, angle);
       if (angle > 70.0) ++q.faces_over_70_deg;
       ++q.non_orthogonality_histogram[std::min(8, static_cast<int>(angle / 10.0))];
@@ -69,7 +69,9 @@ CellQuality cell_quality(const PolyMesh& m) {
     q.min_volume = std::min(q.min_volume, q.volume[c]);
     q.total_volume += q.volume[c];
   }
-  if (!m.neighbour.empty()) q.mean_non_orthogonality_deg = sum_angle / static_cast<double>(m.neighbour.size());
+  // checkMesh's "average" is the angle of the mean cosine, not the mean angle.
+  if (!m.neighbour.empty())
+    q.mean_non_orthogonality_deg = std::acos(sum_cos / static_cast<double>(m.neighbour.size())) * 180.0 / std::numbers::pi;
   return q;
 }
 

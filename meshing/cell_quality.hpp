@@ -30,7 +30,7 @@ struct CellQuality {
   std::vector<double> aspect_ratio;           // per cell
   std::vector<double> volume;                 // per cell, m^3
 
-  double max_non_orthogonality_deg = 0.0, mean_non_orthogonality_deg = 0.0;  // over internal faces
+  double max_non_orthogonality_deg = 0.0, mean_non_orthogonality_deg = 0.0;  // internal faces; mean as checkMesh: acos(mean cos)
   long faces_over_70_deg = 0;                  // checkMesh's "severely non-orthogonal"
   double max_skewness = 0.0, max_aspect_ratio = 0.0;
   double min_volume = 0.0, total_volume = 0.0;  // m^3

@@ -1,5 +1,7 @@
 #include "meshing/surface_checks.hpp"
 
+#include <fmt/format.h>
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/manifoldness.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
@@ -73,6 +75,14 @@ SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) 
     out.self_intersecting = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
   }
   return out;
+}
+
+std::string describe_defects(const SurfaceCheck& check, std::size_t count) {
+  std::string where;
+  for (std::size_t k = 0; k < std::min(count, check.defects.size()); ++k)
+    where += fmt::format(" ({:.4g}, {:.4g}, {:.4g}) m used by {} triangles;", check.defects[k].at.x(),
+                         check.defects[k].at.y(), check.defects[k].at.z(), check.defects[k].triangles);
+  return where;
 }
 
 }  // namespace bedforge::meshing

@@ -29,4 +29,7 @@ struct SurfaceCheck {
 
 SurfaceCheck check_surface(const TriangleMesh& mesh, long self_intersection_limit);
 
+// "(x, y, z) m used by k triangles;" for the first `count` defective edges, for error messages.
+std::string describe_defects(const SurfaceCheck& check, std::size_t count = 5);
+
 }  // namespace bedforge::meshing

@@ -331,7 +331,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                           bad_cells_path.string());
     failure += ". ";
   }
-  throw std::runtime_error("volume mesh: no algorithm passed the quality gate. " + failure +
+  throw ConvergenceError("volume mesh: no algorithm passed the quality gate. " + failure +
                            "Refine the surface near contacts ([surface] contact_edge_length_d), widen the gaps "
                            "([contacts]) or relax [mesh.gate]");
 }

@@ -1,0 +1,129 @@
+// The OpenFOAM case as a user gets it from bedforge, checked by OpenFOAM itself (Debian's
+// `openfoam`; these tests are skipped when its programs are not on PATH).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/cli.hpp"
+
+namespace fs = std::filesystem;
+using namespace cli_test;
+
+namespace {
+
+bool have_openfoam() { return shell("command -v checkMesh").status == 0; }
+
+Result check_mesh(const fs::path& case_dir) {
+  return shell("cd " + case_dir.string() + " && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} checkMesh");
+}
+
+// A bed of 12 spheres in a = 3: a cheap mesh that has every patch.
+fs::path meshed_bed(const std::string& name) {
+  const fs::path dir = fresh_dir(name);
+  EXPECT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
+  EXPECT_EQ(bedforge("--quiet surface " + dir.string() + " --edge-length-d 0.1").status, 0);
+  const Result r = bedforge("--quiet mesh " + dir.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  return dir;
+}
+
+}  // namespace
+
+TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const fs::path out = fresh_dir("default");
+  const Result r = bedforge("run scenes/default.toml -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("analysis: eps whole"), std::string::npos) << r.output;
+  for (const char* f : {"case/Allrun", "case/Allclean", "case/constant/polyMesh/faces", "case/0/U", "case/0/p",
+                        "case/system/decomposeParDict", "case/bedforge/scene.toml", "case/bedforge/bed.csv"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const Result c = check_mesh(out / "case");
+  EXPECT_NE(c.output.find("Mesh OK."), std::string::npos) << c.output;
+  // The mesh encloses what the surface enclosed: the same volume error against the exact volume.
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  const auto& stages = report["stages"];
+  EXPECT_NEAR(stages["mesh"]["fluid_volume_relative_error"].get<double>(),
+              stages["surface"]["fluid_volume_relative_error"].get<double>(), 1e-9);
+}
+
+TEST(OpenFoamCase, BinaryAndAsciiCasesAreTheSameMeshToCheckMesh) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const fs::path dir = meshed_bed("formats");
+  ASSERT_EQ(bedforge("--quiet case " + dir.string() + " --format ascii").status, 0);
+  const Result ascii = check_mesh(dir / "case");
+  ASSERT_NE(ascii.output.find("Mesh OK."), std::string::npos) << ascii.output;
+  ASSERT_EQ(bedforge("--quiet case " + dir.string() + " --overwrite").status, 0);
+  const Result binary = check_mesh(dir / "case");
+  ASSERT_NE(binary.output.find("Mesh OK."), std::string::npos) << binary.output;
+  // checkMesh's statistics (cells, faces, volumes, quality) agree line for line after the header.
+  auto stats = [](const std::string& s) { return s.substr(s.find("Mesh stats"), s.find("End") - s.find("Mesh stats")); };
+  EXPECT_EQ(stats(ascii.output), stats(binary.output));
+  // The mesh stage's own quality figures are checkMesh's, computed the same way.
+  auto number_after = [&](const std::string& key) {
+    const auto at = binary.output.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(binary.output.substr(at + key.size()));
+  };
+  const auto q = nlohmann::json::parse(read(dir / "report.json"))["stages"]["mesh"]["quality"];
+  EXPECT_NEAR(q["max_non_orthogonality_deg"].get<double>(), number_after("Mesh non-orthogonality Max:"), 1e-6);
+  EXPECT_NEAR(q["mean_non_orthogonality_deg"].get<double>(), number_after("average:"), 1e-6);
+  EXPECT_NEAR(q["max_skewness"].get<double>(), number_after("Max skewness ="), 1e-6);
+  EXPECT_NEAR(q["max_aspect_ratio"].get<double>(), number_after("Max aspect ratio ="), 1e-6);
+  EXPECT_EQ(q["faces_over_70_deg"].get<long>(), static_cast<long>(number_after("(> 70 degrees) faces:")));
+}
+
+TEST(OpenFoamCase, AnExistingCaseIsNotOverwrittenUnlessAsked) {
+  const fs::path dir = meshed_bed("exists");
+  ASSERT_EQ(bedforge("--quiet case " + dir.string()).status, 0);
+  const auto before = fs::last_write_time(dir / "case/0/U");
+  const Result again = bedforge("case " + dir.string());
+  EXPECT_EQ(again.status, 2) << again.output;
+  EXPECT_NE(again.output.find("--overwrite"), std::string::npos) << again.output;
+  EXPECT_EQ(fs::last_write_time(dir / "case/0/U"), before);
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+}
+
+TEST(OpenFoamCase, ACaseWithoutAMeshAndAMeshWithoutAClosedSurfaceAreRefused) {
+  const fs::path dir = fresh_dir("no_mesh");
+  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 -o " + dir.string()).status, 0);
+  const Result no_mesh = bedforge("case " + dir.string());
+  EXPECT_EQ(no_mesh.status, 2) << no_mesh.output;
+  EXPECT_NE(no_mesh.output.find("fluid.msh"), std::string::npos) << no_mesh.output;
+  EXPECT_FALSE(fs::exists(dir / "case"));
+  // An STL with one facet cut out: the mesh stage names the file and where it is open.
+  ASSERT_EQ(bedforge("--quiet surface " + dir.string() + "").status, 0);
+  std::string stl = read(dir / "fluid.stl");
+  const auto facet = stl.find("  facet normal");
+  stl.erase(facet, stl.find("endfacet", facet) + 9 - facet);
+  std::ofstream(dir / "fluid.stl") << stl;
+  const Result open = bedforge("mesh " + dir.string());
+  EXPECT_EQ(open.status, 2) << open.output;
+  EXPECT_NE(open.output.find("not closed"), std::string::npos) << open.output;
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+}
+
+TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
+  // scenes/examples/small_bed_flow.toml: a = 4, N = 40, 0.1 d mesh, Re_p = 1, on two cores.
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam) not on PATH";
+  const fs::path out = fresh_dir("flow");
+  const Result r = bedforge("run scenes/examples/small_bed_flow.toml -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  const auto& c = report["stages"]["case"];
+  const auto& flow = c["flow"];
+  // Converged: SIMPLE met its residual targets, and the pressure gradient stopped moving.
+  EXPECT_TRUE(flow["converged"].get<bool>()) << flow.dump();
+  EXPECT_LE(flow["final_initial_residual"]["p"].get<double>(), c["parameters"]["residual_p"].get<double>());
+  EXPECT_LE(flow["final_initial_residual"]["U"].get<double>(), c["parameters"]["residual_u"].get<double>());
+  EXPECT_LT(flow["pressure_gradient_change_last_tenth"].get<double>(), 1e-3);
+  // Mass conservation: what leaves is what the inlet velocity brings.
+  EXPECT_LT(std::abs(flow["flow_rate_relative_error"].get<double>()), 1e-3);
+  // Eisfeld & Schnitzlein at the section's void fraction: particle-resolved CFD commonly
+  // lands within +-20 % of it, the correlation's own scatter (correlations.md, grade C).
+  const double ratio = flow["ratio_to_eisfeld_schnitzlein"].get<double>();
+  EXPECT_GT(ratio, 0.8) << flow.dump();
+  EXPECT_LT(ratio, 1.2) << flow.dump();
+}
