@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets bedforge up on Debian 12 and then runs what is asked:
-#   bash tools/setup.sh demo   install what is missing, build, pack and analyse scenes/default.toml
+#   bash tools/setup.sh demo   install what is missing, build, run scenes/default.toml (bed to OpenFOAM case)
 #   bash tools/setup.sh test   install what is missing, build, run the whole test suite
 #   bash tools/setup.sh        install what is missing and build
 # apt-get runs only when a package is absent. Run as root, or as a user with sudo.
@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev libtbb-dev
-          libgtest-dev python3-numpy python3-matplotlib)
+          gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -20,6 +20,9 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+# OpenFOAM's programs abort without it (sourcing its etc/bashrc does not work on Debian).
+export WM_PROJECT_DIR="${WM_PROJECT_DIR:-/usr/share/openfoam}"
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
