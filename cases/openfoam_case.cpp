@@ -270,7 +270,8 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
                       "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
                       "    writeObj            no;\n}\n"));
-      const double loc_r = 0.5 * (g.outer_radius + g.inner_radius) + 1e-3 * g.d_ref;
+      // Off the background grid's planes (snappyHexMesh cannot place a point on a cell face).
+      const double loc_r = 0.5 * (g.outer_radius + g.inner_radius) + 0.0123 * g.d_ref, loc_y = 0.0371 * g.d_ref;
       std::string regions, levels;
       for (const auto& patch : mesh.patches) {
         const bool wall = patch.type == "wall";
@@ -289,7 +290,7 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
                                   "    refinementSurfaces\n    {{\n        fluid\n        {{\n            level (0 0);\n"
                                   "            regions\n            {{\n{}            }}\n        }}\n    }}\n"
                                   "    resolveFeatureAngle 30;\n    refinementRegions {{}}\n"
-                                  "    locationInMesh ({:.9g} 0 {:.9g});\n    allowFreeStandingZoneFaces true;\n}}\n\n"
+                                  "    locationInMesh ({:.9g} {:.9g} {:.9g});\n    allowFreeStandingZoneFaces true;\n}}\n\n"
                                   "snapControls\n{{\n    nSmoothPatch 3;\n    tolerance 2.0;\n    nSolveIter 30;\n    nRelaxIter 5;\n"
                                   "    nFeatureSnapIter 10;\n    implicitFeatureSnap false;\n    explicitFeatureSnap true;\n"
                                   "    multiRegionFeatureSnap false;\n}}\n\n"
@@ -298,9 +299,9 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
                                   "    nRelaxIter 3;\n    nSmoothSurfaceNormals 1;\n    nSmoothNormals 3;\n    nSmoothThickness 10;\n"
                                   "    maxFaceThicknessRatio 0.5;\n    maxThicknessToMedialRatio 0.3;\n    minMedialAxisAngle 90;\n"
                                   "    nBufferCellsNoExtrude 0;\n    nLayerIter 50;\n}}\n\n"
-                                  "meshQualityControls\n{{\n    #includeEtc \"caseDicts/meshQualityDict\"\n}}\n\n"
+                                  "meshQualityControls\n{{\n    #includeEtc \"caseDicts/meshQualityDict\"\n    nSmoothScale 4;\n    errorReduction 0.75;\n}}\n\n"
                                   "mergeTolerance 1e-6;\n",
-                                  regions, p.snappy_level, levels, loc_r, 0.5 * (g.inlet_z + std::min(0.0, g.outlet_z)))));
+                                  regions, p.snappy_level, levels, loc_r, loc_y, 0.5 * g.inlet_z + 0.0117 * g.d_ref)));
     }
     fs::rename(tmp, case_dir);
   } catch (...) {

@@ -127,3 +127,18 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   EXPECT_GT(ratio, 0.8) << flow.dump();
   EXPECT_LT(ratio, 1.2) << flow.dump();
 }
+
+TEST(OpenFoamCase, TheSnappyHexMeshRouteGivesAMeshCheckMeshPasses) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (snappyHexMesh) not on PATH";
+  const fs::path dir = meshed_bed("snappy");
+  ASSERT_EQ(bedforge("--quiet case " + dir.string() + " --snappy").status, 0);
+  const Result r = shell("cd " + (dir / "case").string() +
+                         " && export WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} && blockMesh && "
+                         "surfaceFeatureExtract && snappyHexMesh -overwrite && checkMesh");
+  ASSERT_EQ(r.status, 0) << r.output.substr(r.output.size() > 3000 ? r.output.size() - 3000 : 0);
+  EXPECT_NE(r.output.find("Mesh OK."), std::string::npos);
+  // The STL's named solids became the patches the 0/ files and function objects refer to.
+  const std::string boundary = read(dir / "case/constant/polyMesh/boundary");
+  for (const char* patch : {"inlet", "outlet", "wall", "particles"})
+    EXPECT_NE(boundary.find(std::string("    ") + patch + "\n"), std::string::npos) << patch << "\n" << boundary;
+}
