@@ -203,9 +203,8 @@ void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CasePa
   for (const auto& x : mesh.points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
   g.bed_top = analysis::bed_height(bed);
   const fs::path case_dir = dir / "case";
-  if (overwrite && fs::exists(case_dir)) fs::remove_all(case_dir);
   const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
-  nlohmann::json j = cases::write_case(case_dir, mesh, g, p, note, scene_toml, bed_to_csv(bed, prov), fluid_stl);
+  nlohmann::json j = cases::write_case(case_dir, overwrite, mesh, g, p, note, scene_toml, bed_to_csv(bed, prov), fluid_stl);
   std::string line = fmt::format("case: {} cells in {}, Re_p {}, u {:.3g} m/s, bed section eps {:.4f}",
                                  mesh.cells, case_dir.string(), p.reynolds, j["velocity_m_s"].get<double>(),
                                  j["section"]["void_fraction_mesh"].get<double>());
@@ -281,8 +280,7 @@ int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool w
   files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
   if (run_analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
 #ifdef BEDFORGE_HAVE_CGAL
-  if (scene.wants("case") && !overwrite && fs::exists(dir / "case"))  // before hours of work, not after
-    throw InputError(fmt::format("{} exists; remove it or pass --overwrite", (dir / "case").string()));
+  if (scene.wants("case")) cases::refuse_existing_case(dir / "case", overwrite);  // before the long stages, not after
   std::shared_ptr<const meshing::FluidSurface> surface;
   if (scene.needs_surface())
     surface = add_surface(pack.bed, scene.surface, kVersion, scene.wants("stl") || scene.case_params.snappy, report,

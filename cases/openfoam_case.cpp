@@ -12,6 +12,7 @@
 
 #include "analysis/pressure_drop.hpp"
 #include "cases/poly_mesh_io.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
 namespace bedforge::cases {
@@ -67,11 +68,7 @@ BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, dou
 namespace {
 
 void write_text(const fs::path& path, const std::string& text, bool executable = false) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw std::runtime_error("cannot write " + path.string());
-  out.close();
+  write_file_atomically(path, text);
   if (executable)
     fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add);
 }
@@ -158,11 +155,15 @@ const char* kAllclean =
 
 }  // namespace
 
-nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mesh, const CaseGeometry& g,
-                          const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                          const std::string& bed_csv, const std::string& fluid_stl) {
-  if (fs::exists(case_dir))
-    throw InputError(fmt::format("{} exists; remove it or ask to overwrite (--overwrite)", case_dir.string()));
+void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
+  if (!overwrite && fs::exists(case_dir))
+    throw InputError(fmt::format("{} exists; remove it or pass --overwrite", case_dir.string()));
+}
+
+nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
+                          const CaseGeometry& g, const CaseParams& p, const std::string& note,
+                          const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl) {
+  refuse_existing_case(case_dir, overwrite);
   std::random_device rd;
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
@@ -303,6 +304,7 @@ nlohmann::json write_case(const fs::path& case_dir, const meshing::PolyMesh& mes
                                   "mergeTolerance 1e-6;\n",
                                   regions, p.snappy_level, levels, loc_r, loc_y, 0.5 * g.inlet_z + 0.0117 * g.d_ref)));
     }
+    fs::remove_all(case_dir);  // the old case goes only once the new one is complete
     fs::rename(tmp, case_dir);
   } catch (...) {
     std::error_code ec;

@@ -47,14 +47,18 @@ struct BedSection {
 };
 BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d);
 
-// Writes the whole case into `case_dir` (which must not exist; it is built under a temporary
-// name and renamed at the end): constant/polyMesh, 0/U, 0/p, transport and turbulence
+// InputError when `case_dir` exists and `overwrite` is false (checked again by write_case;
+// callers check first to refuse before the long stages).
+void refuse_existing_case(const std::filesystem::path& case_dir, bool overwrite);
+
+// Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
+// an existing case is replaced (only with `overwrite`) once the new one is complete: constant/polyMesh, 0/U, 0/p, transport and turbulence
 // properties, controlDict with pressure and flow function objects, fvSchemes, fvSolution,
 // decomposeParDict, Allrun, Allclean, and the records `bedforge/scene.toml` and
 // `bedforge/bed.csv`. Returns the case's report entry.
-nlohmann::json write_case(const std::filesystem::path& case_dir, const meshing::PolyMesh& mesh, const CaseGeometry& g,
-                          const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                          const std::string& bed_csv, const std::string& fluid_stl);
+nlohmann::json write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
+                          const CaseGeometry& g, const CaseParams& p, const std::string& note,
+                          const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl);
 
 // Runs `case_dir/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and reads
 // back the solver's convergence and the pressure drop, compared with Eisfeld & Schnitzlein at

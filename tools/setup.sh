@@ -28,7 +28,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
 
 case "${1:-}" in
-  demo) ./build/bedforge run scenes/default.toml -o out/default ;;
+  demo) ./build/bedforge run scenes/default.toml -o out/default --overwrite ;;  # rerunnable: replaces out/default/case
   test) ctest --test-dir build --output-on-failure -j"$(nproc)" ;;
   "") ;;
   *) echo "setup: unknown action '$1'; allowed: demo, test, or nothing" >&2; exit 2 ;;
