@@ -1,10 +1,55 @@
 #include "packer/contact_forces.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "core/parallel.hpp"
 
 namespace bedforge::packer {
+
+namespace {
+
+// Sum over the listed neighbours of sphere i of overlap * unit normal; returns the elastic
+// energy share and raises max_pair. Two passes over chunks of the list: first, without a
+// branch, the neighbours that touch (about half the listed ones, a pattern no branch predictor
+// follows); then the square roots and divisions for those only. Measured on a packed bed this
+// halves the time of a one-pass loop. Templated on periodicity so walls on every side (the
+// common case) carry no wrap-around in the innermost loop.
+template <bool kPeriodic>
+double gather_pairs(const Spheres& s, const NeighbourList& nl, const Periodicity& per, std::size_t i,
+                    Eigen::Vector3d& push, double& max_pair) {
+  const Eigen::Vector3d xi = s.x[i];
+  const double ri = s.r[i];
+  auto separation = [&](int j) { return kPeriodic ? per.separation(xi, s.x[j]) : Eigen::Vector3d(xi - s.x[j]); };
+  constexpr std::size_t kChunk = 64;
+  int touching[kChunk];
+  double e = 0.0;
+  push.setZero();
+  const std::span<const int> list = nl.of(i);
+  for (std::size_t first = 0; first < list.size(); first += kChunk) {
+    const std::size_t last = std::min(list.size(), first + kChunk);
+    std::size_t m = 0;
+    for (std::size_t k = first; k < last; ++k) {
+      const int j = list[k];
+      const double reach = ri + s.r[j];
+      touching[m] = j;
+      m += separation(j).squaredNorm() < reach * reach;
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+      const int j = touching[k];
+      const Eigen::Vector3d d = separation(j);
+      const double dist = d.norm(), overlap = ri + s.r[j] - dist;
+      push += dist > 0.0 ? Eigen::Vector3d(overlap / dist * d)  // coincident centres: apart along z, by index
+                         : Eigen::Vector3d(0.0, 0.0, static_cast<std::size_t>(j) < i ? overlap : -overlap);
+      e += 0.25 * overlap * overlap;  // each pair is seen from both spheres
+      max_pair = std::max(max_pair, overlap);
+    }
+  }
+  return e;
+}
+
+}  // namespace
 
 void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Container& c, Contacts& out) {
   const std::size_t n = s.size();
@@ -12,25 +57,13 @@ void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Containe
   std::vector<double> energy(n);
   double max_pair = 0.0, max_wall = 0.0;
   const Periodicity per = c.periodicity();
+  const bool periodic = per.lx > 0.0 || per.ly > 0.0;
 #pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall)
   for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Vector3d push = Eigen::Vector3d::Zero();
-    double e = 0.0;
-    const Eigen::Vector3d& xi = s.x[i];
-    for (int j : nl.of(i)) {
-      const Eigen::Vector3d d = per.separation(xi, s.x[j]);
-      const double reach = s.r[i] + s.r[j], dist2 = d.squaredNorm();
-      if (dist2 >= reach * reach) continue;  // most listed pairs do not touch: skip the sqrt
-      const double dist = std::sqrt(dist2);
-      const double overlap = reach - dist;
-      const Eigen::Vector3d n_ij =
-          dist > 0.0 ? Eigen::Vector3d(d / dist) : Eigen::Vector3d(0, 0, static_cast<std::size_t>(j) < i ? 1.0 : -1.0);
-      push += overlap * n_ij;
-      e += 0.25 * overlap * overlap;  // each pair is seen from both spheres
-      max_pair = std::max(max_pair, overlap);
-    }
+    Eigen::Vector3d push;
+    double e = periodic ? gather_pairs<true>(s, nl, per, i, push, max_pair) : gather_pairs<false>(s, nl, per, i, push, max_pair);
     WallContact walls[Container::kMaxWallContacts];
-    const int nw = c.wall_contacts(xi, s.r[i], walls);
+    const int nw = c.wall_contacts(s.x[i], s.r[i], walls);
     for (int k = 0; k < nw; ++k) {
       push += walls[k].overlap * walls[k].normal;
       e += 0.5 * walls[k].overlap * walls[k].overlap;
