@@ -22,6 +22,7 @@
 #include "cases/openfoam_case.hpp"
 #include "meshing/fluid_surface.hpp"
 #include "meshing/stl_io.hpp"
+#include "meshing/vtp_io.hpp"
 #include "meshing/surface_checks.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
@@ -162,6 +163,9 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
   files.add_writer("bed.stl", [built, version](std::ostream& out) {
     meshing::write_stl_binary(out, built->bed, -1, "bedforge " + version + " bed solid");
   });
+  files.add_writer("fluid.vtp", [built, version](std::ostream& out) {
+    meshing::write_vtp(out, built->fluid, "bedforge " + version + " fluid-domain surface, lengths in m");
+  });
   }
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;
@@ -211,6 +215,7 @@ void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CasePa
   if (p.run) {
     const nlohmann::json flow = cases::run_case(case_dir, j);
     j["flow"] = flow;
+    if (p.run_snappy) line += fmt::format("; snappyHexMesh made {} cells", flow["mesh"].value("cells", 0L));
     line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = {:.3f} x "
                         "Eisfeld & Schnitzlein",
                         flow["converged"].get<bool>() ? "converged" : "NOT converged", flow["iterations"].get<long>(),
@@ -435,7 +440,7 @@ int run_command_line(int argc, char** argv) {
 
 #ifdef BEDFORGE_HAVE_CGAL
   CLI::App* surface = app.add_subcommand("surface", "treat contacts and build the fluid-domain surface of DIR/bed.csv: "
-                                                    "writes fluid.stl (a named solid per patch), fluid_PATCH.stl, bed.stl");
+                                                    "writes fluid.stl (a named solid per patch), fluid_PATCH.stl, bed.stl, fluid.vtp");
   surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
   std::optional<std::string> treatment, wall_treatment;
   std::optional<double> shrink_factor, enlarge_factor, bridge_diameter_d, bridge_gap_d, cap_gap_d, edge_length_d,
@@ -471,7 +476,7 @@ int run_command_line(int argc, char** argv) {
   case_cmd->add_option("dir", dir, "directory holding fluid.msh (as written by mesh)")->required();
   std::optional<double> reynolds;
   std::optional<long long> processors, iterations;
-  std::optional<std::string> case_format;
+  std::optional<std::string> case_format, run_mesh;
   bool run_flow = false, snappy = false;
   case_cmd->add_option("--reynolds", reynolds,
                        "FLOAT in (0,1000], particle Reynolds number of the superficial velocity (sets case.reynolds); "
@@ -482,6 +487,9 @@ int run_command_line(int argc, char** argv) {
   case_cmd->add_option("--format", case_format, "binary|ascii, polyMesh and field format (sets case.format); default binary");
   case_cmd->add_flag("--snappy", snappy, "also write the snappyHexMesh set-up, used by Allrun -snappy (sets case.snappy)");
   case_cmd->add_flag("--run", run_flow, "run Allrun and add the pressure drop to the report (sets case.run)");
+  case_cmd->add_option("--run-mesh", run_mesh,
+                       "gmsh|snappy, the mesh --run solves on: gmsh's, or snappyHexMesh's made first by Allrun "
+                       "-snappy (needs --snappy; sets case.run_mesh); default gmsh");
   case_cmd->add_flag("--overwrite", overwrite, "replace DIR/case when it exists");
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
@@ -563,6 +571,7 @@ int run_command_line(int argc, char** argv) {
     if (case_format) override_key(table, "case.format", *case_format);
     if (snappy) override_key(table, "case.snappy", true);
     if (run_flow) override_key(table, "case.run", true);
+    if (run_mesh) override_key(table, "case.run_mesh", *run_mesh);
     SceneSection section(table["case"].as_table(), "case");
     const cases::CaseParams params = cases::read_case_params(section);
     section.finish();

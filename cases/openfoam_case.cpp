@@ -35,6 +35,10 @@ CaseParams read_case_params(SceneSection& s) {
   p.snappy_level = static_cast<int>(s.integer("snappy_level", p.snappy_level, 0, 6));
   p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
   p.run = s.boolean("run", p.run);
+  p.run_snappy = s.choice("run_mesh", "gmsh", {"gmsh", "snappy"}) == "snappy";
+  if (p.run_snappy && !p.snappy)
+    throw InputError("case.run_mesh = \"snappy\" without case.snappy = true: there is no snappyHexMesh set-up to "
+                     "run; allowed: run_mesh = \"gmsh\", or snappy = true");
   return p;
 }
 
@@ -46,7 +50,7 @@ nlohmann::json to_json(const CaseParams& p) {
           {"format", p.binary ? "binary" : "ascii"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
-          {"run", p.run}};
+          {"run", p.run},                   {"run_mesh", p.run_snappy ? "snappy" : "gmsh"}};
 }
 
 BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d) {
@@ -112,7 +116,7 @@ std::string allrun(bool snappy) {
   std::string s =
       "#!/bin/sh\n"
       "# Runs the case: ./Allrun (serial) or ./Allrun -np N (decomposePar, mpirun, reconstructPar).\n";
-  if (snappy) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh.\n";
+  if (snappy) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh (on N processes with -np N).\n";
   s += "cd \"${0%/*}\" || exit 1\n"
        "export WM_PROJECT_DIR=\"${WM_PROJECT_DIR:-/usr/share/openfoam}\"\n"
        "np=1\nsnappy=0\n"
@@ -127,19 +131,30 @@ std::string allrun(bool snappy) {
        "run() { log=\"log.$1\"; echo \"running $*\"; \"$@\" > \"$log\" 2>&1 || { echo \"$1 failed, see $log\" >&2; exit 1; }; }\n"
        "# Open MPI refuses root unless told (containers, CI).\n"
        "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1\n";
+  s += "decompose() {\n"
+       "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
+       "        -e \"s/^    n .*/    n               (1 1 $np);/\" system/decomposeParDict\n"
+       "    run decomposePar -force \"$@\"\n"
+       "}\n"
+       "# mpirun logs to log.mpirun: give each parallel run its own log.\n"
+       "parallel() { run mpirun -np \"$np\" \"$@\" -parallel; mv log.mpirun \"log.$1\"; }\n";
   if (snappy)
     s += "if [ \"$snappy\" = 1 ]; then\n"
          "    run blockMesh\n"
          "    run surfaceFeatureExtract\n"
-         "    run snappyHexMesh -overwrite\n"
+         "    if [ \"$np\" -gt 1 ]; then\n"
+         "        decompose -copyZero  # the background mesh's patches are not the fields' patches\n"
+         "        parallel snappyHexMesh -overwrite\n"
+         "        run reconstructParMesh -constant\n"
+         "        rm -rf processor*\n"
+         "    else\n"
+         "        run snappyHexMesh -overwrite\n"
+         "    fi\n"
          "    run checkMesh\n"
          "fi\n";
   s += "if [ \"$np\" -gt 1 ]; then\n"
-       "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
-       "        -e \"s/^    n .*/    n               (1 1 $np);/\" system/decomposeParDict\n"
-       "    run decomposePar -force\n"
-       "    run mpirun -np \"$np\" simpleFoam -parallel\n"
-       "    mv log.mpirun log.simpleFoam\n"
+       "    decompose\n"
+       "    parallel simpleFoam\n"
        "    run reconstructPar -latestTime\n"
        "else\n"
        "    run simpleFoam\n"
@@ -346,7 +361,9 @@ std::vector<double> series(const fs::path& case_dir, const std::string& name) {
 nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
   const auto t0 = std::chrono::steady_clock::now();
   const int np = c["parameters"]["processors"].get<int>();
-  const std::string cmd = fmt::format("'{}/Allrun' -np {} > '{}/log.Allrun' 2>&1", case_dir.string(), np, case_dir.string());
+  const bool snappy = c["parameters"]["run_mesh"].get<std::string>() == "snappy";
+  const std::string cmd = fmt::format("'{}/Allrun' -np {}{} > '{}/log.Allrun' 2>&1", case_dir.string(), np,
+                                      snappy ? " -snappy" : "", case_dir.string());
   if (std::system(cmd.c_str()) != 0)
     throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
                                          case_dir.string()));
@@ -380,7 +397,14 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
   const double overall = rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
   const double es = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps, a), eps, rho, u, d);
   const double flow = series(case_dir, "flowRate").back();
+  nlohmann::json mesh = {{"mesher", snappy ? "snappyHexMesh" : "gmsh"}};
+  if (snappy) {  // the cells snappyHexMesh made, as its checkMesh counted them
+    std::ifstream check(case_dir / "log.checkMesh");
+    while (std::getline(check, line))
+      if (const auto at = line.find("cells:"); at != std::string::npos) mesh["cells"] = std::atol(line.c_str() + at + 6);
+  }
   return {{"time_s", time},
+          {"mesh", mesh},
           {"iterations", iterations},
           {"converged", converged},
           {"final_initial_residual", {{"U", res_u}, {"p", res_p}}},

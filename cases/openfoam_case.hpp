@@ -28,6 +28,7 @@ struct CaseParams {
   int snappy_level = 2;                 // refinement levels at particles and walls
   double section_exclude_d = 0.5;       // bed section for the pressure drop: floor + this to bed top - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
+  bool run_snappy = false;              // run_mesh = "snappy": the run meshes with snappyHexMesh first (needs snappy)
 };
 CaseParams read_case_params(SceneSection& s);
 nlohmann::json to_json(const CaseParams& p);
