@@ -1,0 +1,236 @@
+#!/usr/bin/python3
+"""Volume mesh and OpenFOAM case: pressure drop against run time, the snappyHexMesh route side by
+side, and the whole pipeline at scale; writes docs/mesh_case_benchmark.md, .json and .png.
+
+    /usr/bin/python3 tools/benchmark_mesh_case.py                    # every section (about an hour on 2 cores)
+    /usr/bin/python3 tools/benchmark_mesh_case.py --only sizes       # some sections, keep the others' results
+    /usr/bin/python3 tools/benchmark_mesh_case.py --edges 0.2 0.15   # other surface edge lengths (d)
+
+sizes:  a = 5, N = 500 (seed 1), bridges, packed once; for each surface edge length (the mesh
+        follows the surface, refined 3x where contacts meet) a real `bedforge run` to a case that
+        simpleFoam solves on 2 processes (Re_p = 1, water). Per level: cells, time per stage,
+        checkMesh, dp/L over the bed section against Eisfeld & Schnitzlein at the section's own
+        meshed void fraction, and against the finest level.
+snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
+        the same way: cells, time, checkMesh, dp/L.
+scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
+        case, with the time and peak memory of every stage.
+Times are the stages' own (report.json), peak memory is /usr/bin/time's.
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
+DOCS = os.path.join(ROOT, "docs")
+RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
+SECTIONS = ["sizes", "snappy", "scale"]
+ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
+
+
+def scene(a, n, treatment, edge, run):
+    return f"""[container]
+type = "cylinder"
+diameter_d = {a}
+[particles]
+count = {n}
+diameter_m = 0.003
+[packing]
+seed = 1
+[contacts]
+treatment = "{treatment}"
+[surface]
+edge_length_d = {edge}
+contact_edge_length_d = {edge / 3:.4g}
+[mesh]
+algorithm = "hxt"
+[case]
+reynolds = 1.0
+processors = 2
+run = {"true" if run else "false"}
+[outputs]
+files = ["positions", "case"]
+"""
+
+
+def timed(cmd):
+    """Runs cmd; returns (wall s, peak MB, stdout)."""
+    out = subprocess.run(["/usr/bin/time", "-f", "TIME %e %M"] + cmd, capture_output=True, text=True, env=ENV)
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{out.stdout}\n{out.stderr}")
+    wall, kb = out.stderr.strip().splitlines()[-1].split()[1:]
+    return float(wall), int(kb) / 1024.0, out.stdout
+
+
+def check_mesh(case):
+    """checkMesh on a case: (Mesh OK?, cells, max non-orthogonality, max skewness, s)."""
+    wall, _, log = timed(["checkMesh", "-case", case])
+    cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
+    non_ortho = float(re.search(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log).group(1))
+    skew = float(re.search(r"Max skewness = ([0-9.eE+-]+)", log).group(1))
+    return "Mesh OK." in log, cells, non_ortho, skew, wall
+
+
+def stage_times(report):
+    return {k: v["time_s"] for k, v in report["stages"].items() if "time_s" in v}
+
+
+def sizes(tmp, edges):
+    rows = []
+    for edge in edges:
+        path = os.path.join(tmp, f"bridge_{edge}")
+        open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True))
+        wall, mb, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+        rep = json.load(open(os.path.join(path, "report.json")))
+        ok, cells, non_ortho, skew, _ = check_mesh(os.path.join(path, "case"))
+        flow = rep["stages"]["case"]["flow"]
+        rows.append({"route": "gmsh", "edge_d": edge, "cells": cells, "wall_s": wall, "peak_mb": mb,
+                     "stages_s": stage_times(rep), "solve_s": flow["time_s"], "mesh_ok": ok,
+                     "max_non_orthogonality": non_ortho, "max_skewness": skew,
+                     "iterations": flow["iterations"], "converged": flow["converged"],
+                     "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "es_pa_m": flow["eisfeld_schnitzlein_pa_m"],
+                     "ratio_es": flow["ratio_to_eisfeld_schnitzlein"], "eps_section": flow["void_fraction_section"],
+                     "flow_rate_error": flow["flow_rate_relative_error"],
+                     "volume_error": rep["stages"]["mesh"]["fluid_volume_relative_error"]})
+        print(rows[-1], flush=True)
+        if edge == min(edges):
+            shutil.copytree(path, os.path.join(tmp, "finest"), dirs_exist_ok=True)
+    finest = min(rows, key=lambda r: r["edge_d"])["dp_dz_pa_m"]
+    for r in rows:
+        r["ratio_finest"] = r["dp_dz_pa_m"] / finest
+    return rows
+
+
+def snappy(tmp):
+    path = os.path.join(tmp, "finest")
+    wall, mb, _ = timed([BEDFORGE, "--quiet", "case", path, "--snappy", "--run", "--run-mesh", "snappy", "--processors",
+                      "2", "--overwrite"])
+    rep = json.load(open(os.path.join(path, "report.json")))
+    flow = rep["stages"]["case"]["flow"]
+    case = os.path.join(path, "case")
+    ok, cells, non_ortho, skew, _ = check_mesh(case)
+    snappy_log = open(os.path.join(case, "log.snappyHexMesh")).read()
+    meshing = float(re.search(r"Finished meshing in = ([0-9.eE+-]+) s", snappy_log).group(1))
+    row = {"route": "snappy", "cells": cells, "wall_s": wall, "peak_mb": mb, "snappy_s": meshing,
+           "solve_s": flow["time_s"] - meshing, "mesh_ok": ok, "max_non_orthogonality": non_ortho,
+           "max_skewness": skew, "iterations": flow["iterations"], "converged": flow["converged"],
+           "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "es_pa_m": flow["eisfeld_schnitzlein_pa_m"],
+           "ratio_es": flow["ratio_to_eisfeld_schnitzlein"], "flow_rate_error": flow["flow_rate_relative_error"]}
+    print(row, flush=True)
+    return row
+
+
+def scale(tmp):
+    path = os.path.join(tmp, "scale")
+    open(path + ".toml", "w").write(scene(10, 4000, "shrink", 0.1, False))
+    wall, mb, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    rep = json.load(open(os.path.join(path, "report.json")))
+    ok, cells, non_ortho, skew, check_s = check_mesh(os.path.join(path, "case"))
+    row = {"wall_s": wall, "peak_mb": mb, "stages_s": stage_times(rep), "cells": cells, "mesh_ok": ok,
+           "check_mesh_s": check_s, "max_non_orthogonality": non_ortho, "max_skewness": skew,
+           "mesh_attempts": rep["stages"]["mesh"].get("attempts")}
+    print(row, flush=True)
+    return row
+
+
+def write(results):
+    json.dump(results, open(RESULTS, "w"), indent=1)
+    lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
+             "Made by `/usr/bin/python3 tools/benchmark_mesh_case.py` on the 2-core machine of the CI "
+             "(Debian 12, gmsh 4.8 HXT, OpenFOAM v1912 simpleFoam on 2 MPI processes). Water, Re_p = 1, "
+             "d = 3 mm; dp/L is measured between the bed-section planes (0.5 d above the floor and below "
+             "the bed top); Eisfeld & Schnitzlein (2001) is evaluated at that section's meshed void "
+             "fraction and aspect ratio; *finest* is the finest gmsh level.", ""]
+    if "sizes" in results:
+        lines += ["## a = 5, N = 500, bridges: mesh size against the pressure drop", "",
+                  "| surface edge (d) | cells | surface s | mesh s | case s | simpleFoam s (its) | checkMesh | "
+                  "max non-ortho | dp/L (Pa/m) | / E&S | / finest | eps section | peak MB |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in results["sizes"]:
+            st = r["stages_s"]
+            lines.append(f"| {r['edge_d']} | {r['cells']} | {st.get('surface', 0):.1f} | {st.get('mesh', 0):.1f} | "
+                         f"{st['case'] - r['solve_s']:.1f} | {r['solve_s']:.0f} ({r['iterations']}"
+                         f"{'' if r['converged'] else ', not converged'}) | {'OK' if r['mesh_ok'] else 'FAILED'} | "
+                         f"{r['max_non_orthogonality']:.1f} | {r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | "
+                         f"{r['ratio_finest']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
+        lines += ["", "![dp against run time](mesh_case_convergence.png)", ""]
+        plot(results)
+    if "snappy" in results:
+        r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
+        lines += ["## The same bed by the snappyHexMesh route", "",
+                  "| route | cells | meshing s | simpleFoam s (its) | checkMesh | max non-ortho | max skewness | "
+                  "dp/L (Pa/m) | / E&S |", "|---|---|---|---|---|---|---|---|---|"]
+        if g:
+            lines.append(f"| gmsh (edge {g['edge_d']} d) | {g['cells']} | {g['stages_s'].get('mesh', 0):.0f} | "
+                         f"{g['solve_s']:.0f} ({g['iterations']}) | {'OK' if g['mesh_ok'] else 'FAILED'} | "
+                         f"{g['max_non_orthogonality']:.1f} | {g['max_skewness']:.2f} | {g['dp_dz_pa_m']:.4g} | "
+                         f"{g['ratio_es']:.3f} |")
+        lines.append(f"| snappyHexMesh (2 processes) | {r['cells']} | {r['snappy_s']:.0f} | {r['solve_s']:.0f} "
+                     f"({r['iterations']}) | {'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
+                     f"{r['max_skewness']:.2f} | {r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} |")
+        lines.append("")
+    if "scale" in results:
+        r = results["scale"]
+        st = r["stages_s"]
+        lines += ["## Scale: a = 10, N = 4000, scene to case (default settings: shrink, 0.1 d)", "",
+                  "| stage | time (s) |", "|---|---|"]
+        lines += [f"| {k} | {v:.1f} |" for k, v in st.items()]
+        lines += [f"| whole command (wall) | {r['wall_s']:.1f} |", "",
+                  f"{r['cells']} cells, peak memory {r['peak_mb'] / 1024:.1f} GB, checkMesh "
+                  f"{'Mesh OK' if r['mesh_ok'] else 'FAILED'} (max non-orthogonality {r['max_non_orthogonality']:.1f}, "
+                  f"max skewness {r['max_skewness']:.2f}; checkMesh itself {r['check_mesh_s']:.0f} s). "
+                  f"Mesh stage attempts: {json.dumps(r['mesh_attempts'])}.", ""]
+    open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
+
+
+def plot(results):
+    rows = sorted(results["sizes"], key=lambda r: r["edge_d"])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    total = [sum(r["stages_s"].values()) for r in rows]
+    ax.plot(total, [r["ratio_es"] for r in rows], "o-", label="gmsh route")
+    for t, r in zip(total, rows):
+        ax.annotate(f"{r['edge_d']} d, {r['cells'] / 1e6:.2f} M cells", (t, r["ratio_es"]), fontsize=8,
+                    textcoords="offset points", xytext=(4, 4))
+    if "snappy" in results:
+        s = results["snappy"]
+        ax.plot([s["wall_s"]], [s["ratio_es"]], "s", label="snappyHexMesh route")
+    ax.axhline(1.0, color="grey", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel("run time, scene to solved case (s)")
+    ax.set_ylabel("dp/L over Eisfeld & Schnitzlein")
+    ax.set_title("a = 5, N = 500, bridges, Re_p = 1")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "mesh_case_convergence.png"), dpi=120)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS)
+    ap.add_argument("--edges", type=float, nargs="+", default=[0.2, 0.15, 0.1])
+    args = ap.parse_args()
+    results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
+    with tempfile.TemporaryDirectory() as tmp:
+        if "sizes" in args.only or "snappy" in args.only:
+            results["sizes"] = sizes(tmp, args.edges)
+            write(results)
+        if "snappy" in args.only:
+            results["snappy"] = snappy(tmp)
+            write(results)
+        if "scale" in args.only:
+            results["scale"] = scale(tmp)
+            write(results)
+
+
+if __name__ == "__main__":
+    main()
