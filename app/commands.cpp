@@ -155,17 +155,17 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
   }
   j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
   if (write_files) {
-  files.add_writer("fluid.stl", [built](std::ostream& out) { meshing::write_stl_ascii_by_patch(out, built->fluid); });
-  for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
-    files.add_writer("fluid_" + fs.fluid.patches[k] + ".stl", [built, k, version](std::ostream& out) {
-      meshing::write_stl_binary(out, built->fluid, static_cast<int>(k), "bedforge " + version + " " + built->fluid.patches[k]);
+    files.add_writer("fluid.stl", [built](std::ostream& out) { meshing::write_stl_ascii_by_patch(out, built->fluid); });
+    for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
+      files.add_writer("fluid_" + fs.fluid.patches[k] + ".stl", [built, k, version](std::ostream& out) {
+        meshing::write_stl_binary(out, built->fluid, static_cast<int>(k), "bedforge " + version + " " + built->fluid.patches[k]);
+      });
+    files.add_writer("bed.stl", [built, version](std::ostream& out) {
+      meshing::write_stl_binary(out, built->bed, -1, "bedforge " + version + " bed solid");
     });
-  files.add_writer("bed.stl", [built, version](std::ostream& out) {
-    meshing::write_stl_binary(out, built->bed, -1, "bedforge " + version + " bed solid");
-  });
-  files.add_writer("fluid.vtp", [built, version](std::ostream& out) {
-    meshing::write_vtp(out, built->fluid, "bedforge " + version + " fluid-domain surface, lengths in m");
-  });
+    files.add_writer("fluid.vtp", [built, version](std::ostream& out) {
+      meshing::write_vtp(out, built->fluid, "bedforge " + version + " fluid-domain surface, lengths in m");
+    });
   }
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;

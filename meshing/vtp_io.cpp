@@ -10,12 +10,17 @@ namespace bedforge::meshing {
 
 namespace {
 
-// One block of appended data: its byte count, then the bytes.
+// Bytes of one block of appended data: its UInt64 byte count, then the values.
 template <class T>
-void append_block(std::string& data, const std::vector<T>& values) {
+std::size_t block_bytes(const std::vector<T>& values) {
+  return sizeof(std::uint64_t) + values.size() * sizeof(T);
+}
+
+template <class T>
+void write_block(std::ostream& out, const std::vector<T>& values) {
   const std::uint64_t bytes = values.size() * sizeof(T);
-  data.append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
-  data.append(reinterpret_cast<const char*>(values.data()), bytes);
+  out.write(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+  out.write(reinterpret_cast<const char*>(values.data()), static_cast<std::streamsize>(bytes));
 }
 
 }  // namespace
@@ -32,12 +37,9 @@ void write_vtp(std::ostream& out, const TriangleMesh& m, const std::string& comm
     offsets.push_back(static_cast<std::int64_t>(3 * (k + 1)));
   }
   const std::vector<std::int32_t> patch(m.patch.begin(), m.patch.end());
-  std::string data;
-  std::vector<std::size_t> at;  // offset of each block, in the order the XML names them
-  at.push_back(data.size()), append_block(data, patch);
-  at.push_back(data.size()), append_block(data, xyz);
-  at.push_back(data.size()), append_block(data, connectivity);
-  at.push_back(data.size()), append_block(data, offsets);
+  // Offset of each block in the appended section, in the order they are written below.
+  const std::size_t at[4] = {0, block_bytes(patch), block_bytes(patch) + block_bytes(xyz),
+                             block_bytes(patch) + block_bytes(xyz) + block_bytes(connectivity)};
 
   std::string names;
   for (std::size_t p = 0; p < m.patches.size(); ++p) names += fmt::format("  patch {} = {}\n", p, m.patches[p]);
@@ -63,7 +65,10 @@ void write_vtp(std::ostream& out, const TriangleMesh& m, const std::string& comm
                      "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n</Polys>\n",
                      at[2], at[3])
       << "</Piece>\n</PolyData>\n<AppendedData encoding=\"raw\">\n_";
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  write_block(out, patch);
+  write_block(out, xyz);
+  write_block(out, connectivity);
+  write_block(out, offsets);
   out << "\n</AppendedData>\n</VTKFile>\n";
 }
 
