@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "analysis/bed_analysis.hpp"
+#include "analysis/contact_statistics.hpp"
 #include "analysis/void_fraction.hpp"
 #include "app/scene.hpp"
 #include "core/atomic_file.hpp"
@@ -67,6 +68,31 @@ struct Outputs {
   std::vector<std::pair<std::string, fs::path>> made;
 };
 
+// An imported bed is checked before any stage builds on it: a centre outside the container or
+// below the floor means the file's frame or unit is not the one the scene gives. Overlaps are
+// measured and reported, not refused: the surface stage says which treatment can handle them.
+nlohmann::json check_imported(const Bed& bed, const std::string& file) {
+  const double d = sauter_mean(bed.diameters);
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const double r = 0.5 * bed.diameters[i];
+    WallContact walls[Container::kMaxWallContacts];
+    const int nw = bed.container->wall_contacts(bed.centres[i], r, walls);
+    double worst = 0.0;
+    for (int k = 0; k < nw; ++k) worst = std::max(worst, walls[k].overlap);
+    const auto& c = bed.centres[i];
+    if (worst > r || c.z() < 0.0)
+      throw InputError(fmt::format("{}: sphere {} (centre {:.6g}, {:.6g}, {:.6g} m) lies {} the {}; allowed: centres "
+                                   "inside the container, above the floor at z = 0 (check packing.units, "
+                                   "packing.origin_m and [container])",
+                                   file, i + 1, c.x(), c.y(), c.z(), c.z() < 0.0 ? "below the floor of" : "outside",
+                                   bed.container->kind()));
+  }
+  const analysis::ContactStatistics cs = analysis::contact_statistics(bed, 0.0);
+  return {{"max_pair_overlap_d", cs.max_pair_overlap / d},
+          {"max_wall_overlap_d", cs.max_wall_overlap / d},
+          {"max_floor_penetration_d", cs.max_floor_penetration / d}};
+}
+
 // Packing stage: the packed (or imported) bed and its report entry.
 struct PackStage {
   Bed bed;
@@ -77,11 +103,17 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   const auto t0 = std::chrono::steady_clock::now();
   PackStage out;
   if (scene.algorithm == "import") {
-    ImportedBed imported = read_bed_text(scene.import_file, scene.import_to_metres);
+    ImportedBed imported = scene.import.read();
     out.bed = std::move(imported.bed);
     out.bed.container = scene.container;
-    out.report = {{"algorithm", "import"}, {"file", scene.import_file.string()}, {"to_metres", scene.import_to_metres},
+    const auto& o = scene.import.origin_m;
+    out.report = {{"algorithm", "import"},
+                  {"file", scene.import.file.string()},
+                  {"format", scene.table["packing"]["format"].value_or(std::string("xyzd"))},
+                  {"to_metres", scene.import.to_metres},
+                  {"origin_m", {o.x(), o.y(), o.z()}},
                   {"header", imported.header}};
+    out.report["overlaps"] = check_imported(out.bed, scene.import.file.string());
   } else {
     Progress progress("pack", console.progress);
     packer::PackResult r =
@@ -99,7 +131,9 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   const auto& vf = out.report["void_fraction"];
   std::string line;
   if (scene.algorithm == "import") {
-    line = fmt::format("import: {} spheres from {}", out.bed.size(), scene.import_file.string());
+    line = fmt::format("import: {} spheres from {}, max overlap {:.2g} d (wall {:.2g} d)", out.bed.size(),
+                       scene.import.file.string(), out.report["overlaps"]["max_pair_overlap_d"].get<double>(),
+                       out.report["overlaps"]["max_wall_overlap_d"].get<double>());
   } else if (scene.algorithm == "monte-carlo") {
     line = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {} of {} "
                        "shakes settled, no overlap",
@@ -419,10 +453,18 @@ int run_command_line(int argc, char** argv) {
   pack->add_option("-o,--output", dir, "output directory (created if missing)")->required();
   overrides.add_to(*pack);
 
-  std::string import_file, units = "m";
-  CLI::App* imp = app.add_subcommand("import", "bring in a bed of x y z d rows (e.g. from a DEM code), like pack");
-  imp->add_option("file", import_file, "text/CSV file, one sphere per row: x y z d")->required();
+  std::string import_file, units = "m", format = "xyzd";
+  std::vector<double> origin;
+  CLI::App* imp = app.add_subcommand("import", "bring in a bed made elsewhere (a DEM code's output), like pack");
+  imp->add_option("file", import_file, "the bed file, in the format --format names")->required();
+  imp->add_option("--format", format,
+                  "xyzd|lammps-dump|yade: rows x y z d; a LAMMPS/LIGGGHTS text dump (last snapshot, columns x y z "
+                  "and radius or diameter); Yade's export.text (x y z r); default xyzd");
   imp->add_option("--units", units, "m|cm|mm|um, length unit of the file; default m");
+  imp->add_option("--origin-m", origin,
+                  "FLOAT FLOAT FLOAT, metres: the point of the file's frame on the container axis at the floor, moved "
+                  "to bedforge's origin; default 0 0 0")
+      ->expected(3);
   imp->add_option("--scene", scene_file, "TOML scene file for [container] and [analysis]");
   imp->add_option("-o,--output", dir, "output directory (created if missing)")->required();
   overrides.add_to(*imp);
@@ -520,6 +562,8 @@ int run_command_line(int argc, char** argv) {
       override_key(table, "packing.algorithm", std::string("import"));
       override_key(table, "packing.file", std::filesystem::absolute(import_file).string());
       override_key(table, "packing.units", units);
+      override_key(table, "packing.format", format);
+      if (!origin.empty()) override_key(table, "packing.origin_m", toml::array{origin[0], origin[1], origin[2]});
     }
     overrides.apply(table);
     const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file,

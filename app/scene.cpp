@@ -66,10 +66,16 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   SceneSection particles = root.sub("particles");
   if (sc.algorithm == "import") {
     const auto file = packing.optional_string("file");
-    if (!file) throw InputError("packing.file is required when packing.algorithm = \"import\": a text file of x y z d rows");
-    sc.import_file = std::filesystem::path(*file).is_relative() ? base_dir / *file : std::filesystem::path(*file);
-    sc.import_to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
-    imported = read_bed_text(sc.import_file, sc.import_to_metres);
+    if (!file)
+      throw InputError("packing.file is required when packing.algorithm = \"import\": a bed file (see packing.format)");
+    sc.import.file = std::filesystem::path(*file).is_relative() ? base_dir / *file : std::filesystem::path(*file);
+    sc.import.format = bed_file_format(packing.choice("format", "xyzd", {"xyzd", "lammps-dump", "yade"}));
+    sc.import.to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
+    const std::vector<double> origin = packing.numbers("origin_m", Range{});
+    if (!origin.empty() && origin.size() != 3)
+      throw InputError(fmt::format("packing.origin_m has {} values; allowed: [x, y, z] in metres", origin.size()));
+    if (origin.size() == 3) sc.import.origin_m = {origin[0], origin[1], origin[2]};
+    imported = sc.import.read();
     d_ref = sauter_mean(imported.bed.diameters);
     d_max = *std::max_element(imported.bed.diameters.begin(), imported.bed.diameters.end());
     sc.count = static_cast<long long>(imported.bed.size());

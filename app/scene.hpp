@@ -10,6 +10,7 @@
 
 #include "analysis/bed_analysis.hpp"
 #include "core/container.hpp"
+#include "core/dem_import.hpp"
 #include "core/size_distribution.hpp"
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
@@ -36,8 +37,14 @@ struct Scene {
   std::uint64_t seed = 1;
   packer::SoftSphereParams soft_sphere;
   packer::MonteCarloParams monte_carlo;
-  std::filesystem::path import_file;  // algorithm = "import": x y z d rows
-  double import_to_metres = 1.0;
+  // algorithm = "import": a bed file (packing.file, format, units, origin_m), read by read().
+  struct Import {
+    std::filesystem::path file;
+    BedFileFormat format = BedFileFormat::xyzd;
+    double to_metres = 1.0;
+    Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+    ImportedBed read() const { return read_bed_file(file, format, to_metres, origin_m); }
+  } import;
 
   // [particles] (not used by "import")
   SizeDistribution sizes;

@@ -132,6 +132,50 @@ TEST(CommandLine, ImportedBedIsAnalysed) {
   EXPECT_LT(a["overlaps"]["max_pair_overlap_d"].get<double>(), 1e-3);  // printed with 6 digits
 }
 
+// A bed packed here, written out as LIGGGHTS would (millimetres, the container axis at x = 50 mm,
+// radius column), comes back as the same bed: same void fraction, same overlaps. With the
+// origin left out its spheres lie outside the container, which is refused by name.
+TEST(CommandLine, LiggghtsDumpIsImportedIntoTheSameBed) {
+  const fs::path packed = fresh_dir("to_dump"), out = fresh_dir("from_dump"), wrong = fresh_dir("from_dump_wrong");
+  ASSERT_EQ(bedforge("pack --aspect-ratio 4 --count 60 --diameter-m 0.002 -o " + packed.string()).status, 0);
+  std::ifstream in(packed / "bed.csv");
+  std::vector<std::array<double, 4>> rows;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 'x') continue;
+    std::array<double, 4> v;
+    char comma;
+    std::stringstream(line) >> v[0] >> comma >> v[1] >> comma >> v[2] >> comma >> v[3];
+    rows.push_back(v);
+  }
+  const fs::path dump = out.parent_path() / "bed.liggghts";
+  std::ofstream d(dump);
+  d << "ITEM: TIMESTEP\n200000\nITEM: NUMBER OF ATOMS\n" << rows.size() << "\nITEM: BOX BOUNDS ff ff ff\n";
+  d << "40 60\n-10 10\n0 30\nITEM: ATOMS id type x y z vx vy vz radius\n";
+  d.precision(17);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    d << i + 1 << " 1 " << rows[i][0] * 1e3 + 50.0 << ' ' << rows[i][1] * 1e3 << ' ' << rows[i][2] * 1e3 << " 0 0 0 "
+      << rows[i][3] * 0.5e3 << '\n';
+  d.close();
+  const Result r = bedforge("import " + dump.string() + " --format lammps-dump --units mm --origin-m 0.05 0 0 " +
+                            "--container-diameter-m 0.008 -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto original = nlohmann::json::parse(read(packed / "report.json"))["stages"]["pack"];
+  const auto imported = nlohmann::json::parse(read(out / "report.json"))["stages"]["pack"];
+  EXPECT_EQ(imported["spheres"], 60);
+  EXPECT_EQ(imported["header"]["timestep"], 200000);
+  EXPECT_NEAR(imported["void_fraction"]["whole_bed"].get<double>(), original["void_fraction"]["whole_bed"].get<double>(),
+              1e-9);
+  EXPECT_NEAR(imported["overlaps"]["max_pair_overlap_d"].get<double>(), original["max_pair_overlap_d"].get<double>(),
+              1e-6);
+
+  const Result bad = bedforge("import " + dump.string() + " --format lammps-dump --units mm " +
+                              "--container-diameter-m 0.008 -o " + wrong.string());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("lies outside the cylinder"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("packing.origin_m"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(wrong / "bed.csv"));
+}
+
 TEST(CommandLine, BadInputIsRejectedByName) {
   expect_rejected("pack --aspect-ratio 3 --count 0", "particles.count");
   expect_rejected("pack --aspect-ratio 3 --count -5", "particles.count");
