@@ -304,22 +304,61 @@ std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh&
 
 Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, scene.to_json()}; }
 
+// The pack stage's cache key: the sections that decide the bed (container, particles, packing),
+// the version that packs it and, for an imported bed, the file's content.
+std::string pack_key(const Scene& scene) {
+  const nlohmann::json sc = scene.to_json();
+  nlohmann::json inputs = {{"version", kVersion}};
+  for (const char* section : {"container", "particles", "packing"})
+    if (sc.contains(section)) inputs[section] = sc[section];
+  if (scene.algorithm == "import") inputs["file_key"] = stage_key(read_file(scene.import.file));
+  return stage_key(inputs);
+}
+
+// The bed an earlier run left in DIR, when its pack stage had the same key and its bed.csv is
+// there (bed.csv keeps 17 digits, so the bed read back is the bed packed).
+std::optional<PackStage> reusable_pack(const fs::path& dir, const std::string& key, const Scene& scene,
+                                       const Console& console) {
+  if (!fs::exists(dir / "report.json") || !fs::exists(dir / "bed.csv")) return std::nullopt;
+  const nlohmann::json old = Report::load_or_new(dir).data();
+  if (!old.contains("stages") || !old["stages"].contains("pack") || old["stages"]["pack"].value("cache_key", "") != key)
+    return std::nullopt;
+  PackStage out;
+  out.bed = read_bed_text(dir / "bed.csv", 1.0).bed;
+  out.bed.container = scene.container;
+  out.report = old["stages"]["pack"];
+  out.report["reused"] = true;
+  console.line(fmt::format("pack: reused the bed in {} (container, particles and packing unchanged; --force packs "
+                           "again)",
+                           dir.string()));
+  return out;
+}
+
 // `run`, `pack` and `import`: a scene (file plus overrides) into DIR. `run` follows the scene's
 // outputs; `pack` and `import` always write the bed and leave the analysis to `analyse`.
-int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool write_positions, bool overwrite,
-              const Console& console) {
-  PackStage pack = pack_stage(scene, console);
-  Report report;  // a new bed makes every earlier result in DIR stale
+struct RunOptions {
+  bool analysis = false;   // write the analysis (profiles, contacts)
+  bool positions = true;   // write bed.csv
+  bool overwrite = false;  // replace DIR/case
+  bool force = false;      // pack again even when DIR holds the bed of an unchanged scene
+};
+
+int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, const Console& console) {
+  const std::string key = pack_key(scene);
+  std::optional<PackStage> reused = opt.force ? std::nullopt : reusable_pack(dir, key, scene, console);
+  PackStage pack = reused ? std::move(*reused) : pack_stage(scene, console);
+  pack.report["cache_key"] = key;
+  Report report;  // results of other stages in DIR may belong to another bed: start afresh
   report.set_provenance(kVersion, scene.to_json(), scene.seed);
   report.set_stage("pack", pack.report);
   Outputs files;
   const Provenance prov = provenance_of(scene);
-  if (write_positions) files.add("bed.csv", bed_to_csv(pack.bed, prov));
+  if (opt.positions) files.add("bed.csv", bed_to_csv(pack.bed, prov));
   if (scene.wants("vtp")) files.add("bed.vtp", bed_to_vtp(pack.bed, prov));
   files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
-  if (run_analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
+  if (opt.analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
 #ifdef BEDFORGE_HAVE_CGAL
-  if (scene.wants("case")) cases::refuse_existing_case(dir / "case", overwrite);  // before the long stages, not after
+  if (scene.wants("case")) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages, not after
   std::shared_ptr<const meshing::FluidSurface> surface;
   if (scene.needs_surface())
     surface = add_surface(pack.bed, scene.surface, kVersion, scene.wants("stl") || scene.case_params.snappy, report,
@@ -336,7 +375,8 @@ int run_scene(const Scene& scene, const fs::path& dir, bool run_analysis, bool w
 #ifdef BEDFORGE_HAVE_GMSH
   if (scene.wants("case"))
     add_case(mesh->mesh, pack.bed, scene.case_params, prov, read_file(dir / "scene.toml"),
-             scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir, overwrite, report, console);
+             scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir, opt.overwrite, report,
+             console);
 #endif
   report.save(dir);
   return 0;
@@ -444,13 +484,18 @@ int run_command_line(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "run the stages a scene's [outputs] need; writes into -o DIR");
   run->add_option("scene", scene_file, "TOML scene file")->required();
   run->add_option("-o,--output", dir, "output directory (created if missing)")->required();
-  bool overwrite = false;
+  bool overwrite = false, force = false;
   run->add_flag("--overwrite", overwrite, "replace DIR/case when the scene asks for a case and it exists");
+  const char* force_help =
+      "pack again even when DIR holds the bed of a scene with the same container, particles and packing (and the "
+      "same bedforge version), which is otherwise reused";
+  run->add_flag("--force", force, force_help);
   overrides.add_to(*run);
 
   CLI::App* pack = app.add_subcommand("pack", "pack spheres: writes DIR/bed.csv, bed.vtp, scene.toml, report.json");
   pack->add_option("--scene", scene_file, "TOML scene file to start from; options below override it");
   pack->add_option("-o,--output", dir, "output directory (created if missing)")->required();
+  pack->add_flag("--force", force, force_help);
   overrides.add_to(*pack);
 
   std::string import_file, units = "m", format = "xyzd";
@@ -568,8 +613,8 @@ int run_command_line(int argc, char** argv) {
     overrides.apply(table);
     const Scene scene = read_scene(table, scene_file.empty() ? "command line" : scene_file,
                                    scene_file.empty() ? fs::path() : fs::path(scene_file).parent_path());
-    if (*run) return run_scene(scene, dir, scene.wants("analysis"), scene.wants("positions"), overwrite, console);
-    return run_scene(scene, dir, false, true, false, console);
+    if (*run) return run_scene(scene, dir, {scene.wants("analysis"), scene.wants("positions"), overwrite, force}, console);
+    return run_scene(scene, dir, {false, true, false, force}, console);
   }
 
   // analyse, surface, mesh or case on DIR

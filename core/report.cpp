@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cstdint>
+
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
@@ -36,6 +38,12 @@ void Report::set_stage(const std::string& name, nlohmann::json stage) {
 
 void Report::save(const std::filesystem::path& dir) const {
   write_file_atomically(dir / "report.json", data_.dump(2) + "\n");
+}
+
+std::string stage_key(const nlohmann::json& inputs) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const unsigned char c : inputs.dump()) h = (h ^ c) * 0x100000001b3ULL;
+  return fmt::format("{:016x}", h);
 }
 
 }  // namespace bedforge

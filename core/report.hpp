@@ -22,4 +22,10 @@ class Report {
   nlohmann::json data_ = nlohmann::json::object();
 };
 
+// A stage's cache key: a 64-bit FNV-1a hash, as 16 hex digits, of `inputs` written as compact
+// JSON (objects keep their keys sorted, so equal inputs give equal text). A stage passes its own
+// scene sections, the program version and its upstream stage's key, so a change anywhere
+// upstream changes it.
+std::string stage_key(const nlohmann::json& inputs);
+
 }  // namespace bedforge

@@ -176,6 +176,50 @@ TEST(CommandLine, LiggghtsDumpIsImportedIntoTheSameBed) {
   EXPECT_FALSE(fs::exists(wrong / "bed.csv"));
 }
 
+// The sphere rows of a bed.csv (its header records the scene, which may differ).
+std::string bed_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string rows;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line[0] != '#') rows += line + "\n";
+  return rows;
+}
+
+// A run into a directory that holds the bed of the same container, particles and packing reuses
+// it; a change there packs again, and --force packs again whatever changed, into the same bed.
+TEST(CommandLine, UnchangedPackingIsReusedAndForceRepacks) {
+  const std::string base =
+      "[container]\ndiameter_d = 4\n[particles]\ncount = 50\ndiameter_m = 0.001\n[outputs]\n"
+      "files = [\"positions\", \"analysis\"]\n";
+  const fs::path dir = fresh_dir("reuse");
+  const Result first = bedforge("run " + scene("a.toml", base + "[analysis]\nradial_bin_d = 0.05\n").string() +
+                                " -o " + dir.string());
+  ASSERT_EQ(first.status, 0) << first.output;
+  const std::string rows = bed_rows(dir / "bed.csv");
+  const auto key = nlohmann::json::parse(read(dir / "report.json"))["stages"]["pack"]["cache_key"];
+
+  const Result analysis_only = bedforge("run " + scene("b.toml", base + "[analysis]\nradial_bin_d = 0.1\n").string() +
+                                        " -o " + dir.string());
+  ASSERT_EQ(analysis_only.status, 0) << analysis_only.output;
+  EXPECT_NE(analysis_only.output.find("pack: reused"), std::string::npos) << analysis_only.output;
+  EXPECT_EQ(bed_rows(dir / "bed.csv"), rows);
+  const auto report = nlohmann::json::parse(read(dir / "report.json"));
+  EXPECT_EQ(report["stages"]["pack"]["cache_key"], key);
+  EXPECT_EQ(report["scene"]["analysis"]["radial_bin_d"], 0.1);  // the analysis ran with the new scene
+
+  const Result forced = bedforge("run " + scene("b.toml", base + "[analysis]\nradial_bin_d = 0.1\n").string() +
+                                 " -o " + dir.string() + " --force");
+  ASSERT_EQ(forced.status, 0) << forced.output;
+  EXPECT_EQ(forced.output.find("pack: reused"), std::string::npos) << forced.output;
+  EXPECT_EQ(bed_rows(dir / "bed.csv"), rows);  // same scene and seed: the same bed, bit for bit
+
+  const Result more = bedforge("run " + scene("c.toml", base + "[packing]\nseed = 2\n").string() + " -o " +
+                               dir.string());
+  ASSERT_EQ(more.status, 0) << more.output;
+  EXPECT_EQ(more.output.find("pack: reused"), std::string::npos) << more.output;
+  EXPECT_NE(bed_rows(dir / "bed.csv"), rows);
+}
+
 TEST(CommandLine, BadInputIsRejectedByName) {
   expect_rejected("pack --aspect-ratio 3 --count 0", "particles.count");
   expect_rejected("pack --aspect-ratio 3 --count -5", "particles.count");
