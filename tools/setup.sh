@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev libtbb-dev
-          gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib)
+          gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib clang libclang-rt-14-dev libomp-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -29,7 +29,14 @@ cmake --build build -j"$(nproc)"
 
 case "${1:-}" in
   demo) ./build/bedforge run scenes/default.toml -o out/default --overwrite ;;  # rerunnable: replaces out/default/case
-  test) ctest --test-dir build --output-on-failure -j"$(nproc)" ;;
+  test)
+    ctest --test-dir build --output-on-failure -j"$(nproc)"
+    # The fuzz targets: clang with libFuzzer and sanitizers, packer and importers only (which
+    # also proves that build works without CGAL, gmsh and OpenFOAM); 30 s each.
+    cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBEDFORGE_FUZZ=ON \
+          -DBEDFORGE_WITH_CGAL=OFF -DBEDFORGE_BUILD_TESTS=OFF >/dev/null
+    cmake --build build-fuzz -j"$(nproc)"
+    ctest --test-dir build-fuzz --output-on-failure ;;
   "") ;;
   *) echo "setup: unknown action '$1'; allowed: demo, test, or nothing" >&2; exit 2 ;;
 esac
