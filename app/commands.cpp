@@ -103,8 +103,8 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   const auto t0 = std::chrono::steady_clock::now();
   PackStage out;
   if (scene.algorithm == "import") {
-    ImportedBed imported = scene.import.read();
-    out.bed = std::move(imported.bed);
+    const ImportedBed& imported = *scene.import.bed;
+    out.bed = imported.bed;
     out.bed.container = scene.container;
     const auto& o = scene.import.origin_m;
     out.report = {{"algorithm", "import"},

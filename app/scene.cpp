@@ -62,7 +62,6 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   mc.finish();
 
   double d_ref = 0.0, d_max = 0.0;
-  ImportedBed imported;
   SceneSection particles = root.sub("particles");
   if (sc.algorithm == "import") {
     const auto file = packing.optional_string("file");
@@ -75,10 +74,12 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
     if (!origin.empty() && origin.size() != 3)
       throw InputError(fmt::format("packing.origin_m has {} values; allowed: [x, y, z] in metres", origin.size()));
     if (origin.size() == 3) sc.import.origin_m = {origin[0], origin[1], origin[2]};
-    imported = sc.import.read();
-    d_ref = sauter_mean(imported.bed.diameters);
-    d_max = *std::max_element(imported.bed.diameters.begin(), imported.bed.diameters.end());
-    sc.count = static_cast<long long>(imported.bed.size());
+    sc.import.bed = std::make_shared<const ImportedBed>(
+        read_bed_file(sc.import.file, sc.import.format, sc.import.to_metres, sc.import.origin_m));
+    const std::vector<double>& diameters = sc.import.bed->bed.diameters;
+    d_ref = sauter_mean(diameters);
+    d_max = *std::max_element(diameters.begin(), diameters.end());
+    sc.count = static_cast<long long>(diameters.size());
   } else {
     sc.count = particles.integer("count", 0, 1, 100'000'000);
     if (!particles.has("count")) throw InputError("particles.count is required: the number of spheres, an integer >= 1");
@@ -90,10 +91,10 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   packing.finish();
 
   SceneSection container = root.sub("container");
-  if (table.contains("container") || !imported.bed.container) {
+  if (table.contains("container") || !sc.import.bed || !sc.import.bed->bed.container) {
     sc.container = read_container(container, d_ref, d_max);
   } else {
-    sc.container = imported.bed.container;
+    sc.container = sc.import.bed->bed.container;
   }
   container.finish();
 

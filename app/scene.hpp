@@ -37,13 +37,14 @@ struct Scene {
   std::uint64_t seed = 1;
   packer::SoftSphereParams soft_sphere;
   packer::MonteCarloParams monte_carlo;
-  // algorithm = "import": a bed file (packing.file, format, units, origin_m), read by read().
+  // algorithm = "import": a bed file (packing.file, format, units, origin_m), read once by
+  // read_scene, which needs its diameters for the container.
   struct Import {
     std::filesystem::path file;
     BedFileFormat format = BedFileFormat::xyzd;
     double to_metres = 1.0;
     Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
-    ImportedBed read() const { return read_bed_file(file, format, to_metres, origin_m); }
+    std::shared_ptr<const ImportedBed> bed;
   } import;
 
   // [particles] (not used by "import")

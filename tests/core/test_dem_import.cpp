@@ -7,8 +7,10 @@
 #include <fstream>
 
 #include "core/error.hpp"
+#include "support/input_error.hpp"
 
 using namespace bedforge;
+using input_error_test::error_of;
 namespace fs = std::filesystem;
 
 namespace {
@@ -20,16 +22,6 @@ fs::path write(const std::string& name, const std::string& text) {
   return d / name;
 }
 
-// The message of the InputError `f` throws ("" when it throws none).
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // A LAMMPS/LIGGGHTS `dump custom` snapshot of two spheres: the first in box-scaled coordinates
 // when `scaled`, the radius column after the coordinates as LIGGGHTS writes it.
@@ -83,20 +75,18 @@ TEST(DemImport, LammpsDiameterColumnIsTakenAsIs) {
 
 TEST(DemImport, BrokenDumpsAreRefusedWithTheLine) {
   const std::string head = "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff ff\n0 1\n0 1\n0 1\n";
-  EXPECT_NE(error_of([&] { read_lammps_dump(write("nor.dump", head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 1\n"), 1); })
-                .find("neither radius nor diameter"),
-            std::string::npos);
-  EXPECT_NE(error_of([&] { read_lammps_dump(write("cut.dump", head + "ITEM: ATOMS id x y z radius\n1 0 0 0 1\n"), 1); })
-                .find("cut short"),
-            std::string::npos);
-  EXPECT_NE(error_of([&] { read_lammps_dump(write("nan.dump", head + "ITEM: ATOMS x y z radius\n0 0 nan 1\n0 0 1 1\n"), 1); })
-                .find("nan.dump:10: z = 'nan'"),
-            std::string::npos);
-  EXPECT_NE(error_of([&] { read_lammps_dump(write("neg.dump", head + "ITEM: ATOMS x y z radius\n0 0 0 -1\n0 0 1 1\n"), 1); })
-                .find("diameter -2; allowed: > 0"),
-            std::string::npos);
-  EXPECT_NE(error_of([&] { read_lammps_dump(write("text.dump", "x y z d\n0 0 0 1\n"), 1); }).find("no snapshot"),
-            std::string::npos);
+  const struct {
+    const char* name;
+    std::string text, message;
+  } cases[] = {
+      {"nor.dump", head + "ITEM: ATOMS id x y z\n1 0 0 0\n2 0 0 1\n", "neither radius nor diameter"},
+      {"cut.dump", head + "ITEM: ATOMS id x y z radius\n1 0 0 0 1\n", "cut short"},
+      {"nan.dump", head + "ITEM: ATOMS x y z radius\n0 0 nan 1\n0 0 1 1\n", "nan.dump:10: z = 'nan'"},
+      {"neg.dump", head + "ITEM: ATOMS x y z radius\n0 0 0 -1\n0 0 1 1\n", "diameter -2; allowed: > 0"},
+      {"text.dump", "x y z d\n0 0 0 1\n", "no snapshot"},
+  };
+  for (const auto& c : cases)
+    EXPECT_NE(error_of([&] { read_lammps_dump(write(c.name, c.text), 1); }).find(c.message), std::string::npos) << c.name;
 }
 
 TEST(DemImport, YadeTextGivesRadiiAndHonoursItsFormatLine) {

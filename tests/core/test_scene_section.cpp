@@ -3,23 +3,15 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "support/input_error.hpp"
 
 using namespace bedforge;
+using input_error_test::error_of;
 
 namespace {
 
 toml::table parse(const char* text) { return parse_scene_text(text, "test.toml"); }
 
-// The message of the InputError thrown by f, or "" when none is thrown.
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 }  // namespace
 
