@@ -233,13 +233,13 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
   j["time_s"] = time;
   const auto& vf = j["void_fraction"];
   out.summary = fmt::format(
-      "analysis: eps whole {:.4f}, central slab {}, Z bulk {}, max overlap {:.2g} d, residual {:.2g}, {:.2f} s",
+      "analysis: eps whole {:.4f}, central slab {}, Z bulk {}, max overlap {:.2g} d, residual {:.2g}",
       vf["whole_bed"].get<double>(),
       vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()),
       j["coordination"]["bulk_mean_without_rattlers"].is_null()
           ? std::string("n/a")
           : fmt::format("{:.2f}", j["coordination"]["bulk_mean_without_rattlers"].get<double>()),
-      cs.max_pair_overlap / sc.d_min, cs.residual_rms, time);
+      cs.max_pair_overlap / sc.d_min, cs.residual_rms);
   j["summary"] = out.summary;
   return out;
 }

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "core/report.hpp"
+#include "core/stage_meter.hpp"
 #include "core/version.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
@@ -43,6 +44,15 @@ struct Console {
     if (!quiet) std::printf("%s\n", s.c_str());
   }
 };
+
+// Ends a stage: its time and peak memory into `stage`, appended to its one-line summary, which
+// is stored and printed.
+void finish_stage(nlohmann::json& stage, const StageMeter& meter, const std::string& line, const Console& console) {
+  meter.record(stage);
+  stage["summary"] = fmt::format("{}, {:.2f} s, {:.0f} MB", line, stage["time_s"].get<double>(),
+                                 stage["peak_memory_mb"].get<double>());
+  console.line(stage["summary"].get<std::string>());
+}
 
 // Files of one run, written together at the end so a failure leaves nothing half-made.
 // Large files are streamed by a writer at that point instead of held as a string.
@@ -100,7 +110,7 @@ struct PackStage {
 };
 
 PackStage pack_stage(const Scene& scene, const Console& console) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageMeter meter;
   PackStage out;
   if (scene.algorithm == "import") {
     const ImportedBed& imported = *scene.import.bed;
@@ -126,8 +136,6 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   out.report["spheres"] = out.bed.size();
   out.report["container_m"] = out.bed.container->to_json();
   out.report["void_fraction"] = analysis::void_fraction_summary(out.bed, scene.analysis);
-  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.report["time_s"] = time;
   const auto& vf = out.report["void_fraction"];
   std::string line;
   if (scene.algorithm == "import") {
@@ -148,20 +156,19 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
                        out.report["iterations"].get<long>(), out.report["max_pair_overlap_d"].get<double>(),
                        out.report["overlap_tolerance_d"].get<double>(), out.report["force_residual_rms"].get<double>());
   }
-  line += fmt::format(", eps {:.4f} (central {}), {:.2f} s", vf["whole_bed"].get<double>(),
-                      vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()),
-                      time);
-  out.report["summary"] = line;
-  console.line(line);
+  line += fmt::format(", eps {:.4f} (central {})", vf["whole_bed"].get<double>(),
+                      vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()));
+  finish_stage(out.report, meter, line, console);
   return out;
 }
 
 void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report& report, Outputs& files,
                   const Console& console) {
+  const StageMeter meter;
   analysis::AnalysisResult a = analysis::analyse_bed(bed, params);
   for (auto& [name, csv] : a.csv_files) files.add(name, csv);
+  finish_stage(a.report, meter, a.summary, console);
   report.set_stage("analysis", a.report);
-  console.line(a.summary);
 }
 
 #ifdef BEDFORGE_HAVE_CGAL
@@ -170,14 +177,14 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
 std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const meshing::SurfaceParams& p,
                                                          const std::string& version, bool write_files, Report& report,
                                                          Outputs& files, const Console& console) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageMeter meter;
   auto built = std::make_shared<meshing::FluidSurface>(meshing::build_fluid_surface(bed, p));
   meshing::FluidSurface& fs = *built;
-  const auto t1 = std::chrono::steady_clock::now();
+  const double built_at = meter.seconds();
   const meshing::SurfaceCheck check = meshing::check_surface(fs.fluid, p.self_intersection_limit);
   nlohmann::json& j = fs.report;
-  j["time_build_s"] = std::chrono::duration<double>(t1 - t0).count();
-  j["time_check_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  j["time_build_s"] = built_at;
+  j["time_check_s"] = meter.seconds() - built_at;
   j["check"] = check.to_json();
   const double exact = j["fluid_volume_exact_m3"].get<double>();
   j["fluid_volume_mesh_m3"] = check.volume;
@@ -201,20 +208,17 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
       meshing::write_vtp(out, built->fluid, "bedforge " + version + " fluid-domain surface, lengths in m");
     });
   }
-  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  j["time_s"] = time;
-  j["summary"] = fmt::format(
+  const std::string line = fmt::format(
       "surface ({}, {} contacts treated): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, "
-      "min angle {:.1f} deg, smallest gap {:.3g} d, {:.2f} s",
+      "min angle {:.1f} deg, smallest gap {:.3g} d",
       j["parameters"]["treatment"].get<std::string>(),
       j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"]["particle_wall"].get<long>(),
       j["triangles"].get<std::size_t>(),
       check.self_intersections_checked ? "no self-intersection" : "self-intersections not checked",
       j["fluid_volume_relative_error"].get<double>(), j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
-      std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()),
-      time);
-  console.line(j["summary"].get<std::string>());
+      std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()));
+  finish_stage(j, meter, line, console);
   report.set_stage("surface", j);
   return built;
 }
@@ -223,7 +227,7 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
 void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CaseParams& p, const Provenance& prov,
               const std::string& scene_toml, const std::string& fluid_stl, const fs::path& dir, bool overwrite,
               Report& report, const Console& console) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageMeter meter;
   cases::CaseGeometry g;
   g.d_ref = sauter_mean(bed.diameters);
   if (const auto* ann = dynamic_cast<const Annulus*>(bed.container.get())) {
@@ -258,11 +262,7 @@ void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CasePa
                         flow["pressure_gradient_bed_pa_m"].get<double>(),
                         flow["ratio_to_eisfeld_schnitzlein"].get<double>());
   }
-  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  j["time_s"] = time;
-  line += fmt::format(", {:.2f} s", time);
-  j["summary"] = line;
-  console.line(line);
+  finish_stage(j, meter, line, console);
   report.set_stage("case", j);
 }
 #endif
@@ -273,7 +273,7 @@ std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh&
                                                     const Bed& bed, const meshing::VolumeMeshParams& p,
                                                     bool write_msh, const fs::path& dir, Report& report,
                                                     Outputs& files, const Console& console) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageMeter meter;
   fs::create_directories(dir);
   const fs::path msh = write_msh ? dir / ".fluid.partial.msh"  /* gmsh picks the format by extension */ : fs::path();
   if (write_msh) files.add_made("fluid.msh", msh);
@@ -286,17 +286,14 @@ std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh&
   j["parameters"] = meshing::to_json(p);
   j["fluid_volume_exact_m3"] = exact_volume;
   j["fluid_volume_relative_error"] = (vm->quality.total_volume - exact_volume) / exact_volume;
-  const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  j["time_s"] = time;
   const auto& q = j["quality"];
-  j["summary"] = fmt::format(
+  const std::string line = fmt::format(
       "mesh ({}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
-      "max aspect ratio {:.1f}, volume error {:.2e}, {:.0f} MB, {:.2f} s",
+      "max aspect ratio {:.1f}, volume error {:.2e}",
       j["algorithm"].get<std::string>(), vm->mesh.cells, q["max_non_orthogonality_deg"].get<double>(),
       q["mean_non_orthogonality_deg"].get<double>(), q["faces_over_70_deg"].get<long>(), q["max_skewness"].get<double>(),
-      q["max_aspect_ratio"].get<double>(), j["fluid_volume_relative_error"].get<double>(),
-      j["peak_memory_mb"].get<double>(), time);
-  console.line(j["summary"].get<std::string>());
+      q["max_aspect_ratio"].get<double>(), j["fluid_volume_relative_error"].get<double>());
+  finish_stage(j, meter, line, console);
   report.set_stage("mesh", j);
   return vm;
 }
@@ -315,19 +312,38 @@ std::string pack_key(const Scene& scene) {
   return stage_key(inputs);
 }
 
-// The bed an earlier run left in DIR, when its pack stage had the same key and its bed.csv is
-// there (bed.csv keeps 17 digits, so the bed read back is the bed packed).
-std::optional<PackStage> reusable_pack(const fs::path& dir, const std::string& key, const Scene& scene,
-                                       const Console& console) {
-  if (!fs::exists(dir / "report.json") || !fs::exists(dir / "bed.csv")) return std::nullopt;
-  const nlohmann::json old = Report::load_or_new(dir).data();
-  if (!old.contains("stages") || !old["stages"].contains("pack") || old["stages"]["pack"].value("cache_key", "") != key)
-    return std::nullopt;
+// A later stage's cache key: its own scene sections and the key of the stage it builds on.
+std::string downstream_key(const Scene& scene, const std::string& upstream_key, std::initializer_list<const char*> sections) {
+  const nlohmann::json sc = scene.to_json();
+  nlohmann::json inputs = {{"upstream", upstream_key}};
+  for (const char* section : sections) inputs[section] = sc.contains(section) ? sc[section] : nlohmann::json();
+  return stage_key(inputs);
+}
+
+// The report entry of stage `name` an earlier run left in DIR, when it was made with the same
+// key and the files it wrote (`files`) are still there; null otherwise.
+nlohmann::json reusable_stage(const nlohmann::json& previous, const fs::path& dir, const std::string& name,
+                              const std::string& key, const std::vector<std::string>& files) {
+  if (!previous.contains("stages") || !previous["stages"].contains(name)) return nullptr;
+  const nlohmann::json& stage = previous["stages"][name];
+  if (stage.value("cache_key", "") != key) return nullptr;
+  for (const auto& f : files)
+    if (!fs::exists(dir / f)) return nullptr;
+  nlohmann::json out = stage;
+  out["reused"] = true;
+  return out;
+}
+
+// The bed an earlier run left in DIR, when its pack stage had the same key (bed.csv keeps 17
+// digits, so the bed read back is the bed packed).
+std::optional<PackStage> reusable_pack(const nlohmann::json& previous, const fs::path& dir, const std::string& key,
+                                       const Scene& scene, const Console& console) {
+  nlohmann::json stage = reusable_stage(previous, dir, "pack", key, {"bed.csv"});
+  if (stage.is_null()) return std::nullopt;
   PackStage out;
   out.bed = read_bed_text(dir / "bed.csv", 1.0).bed;
   out.bed.container = scene.container;
-  out.report = old["stages"]["pack"];
-  out.report["reused"] = true;
+  out.report = std::move(stage);
   console.line(fmt::format("pack: reused the bed in {} (container, particles and packing unchanged; --force packs "
                            "again)",
                            dir.string()));
@@ -344,8 +360,12 @@ struct RunOptions {
 };
 
 int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, const Console& console) {
+  // Stage results an earlier run left in DIR are reused when their keys match: each key hashes
+  // the stage's scene sections and the key of the stage before, so a change reaches downstream.
+  const nlohmann::json previous =
+      opt.force || !fs::exists(dir / "report.json") ? nlohmann::json() : Report::load_or_new(dir).data();
   const std::string key = pack_key(scene);
-  std::optional<PackStage> reused = opt.force ? std::nullopt : reusable_pack(dir, key, scene, console);
+  std::optional<PackStage> reused = reusable_pack(previous, dir, key, scene, console);
   PackStage pack = reused ? std::move(*reused) : pack_stage(scene, console);
   pack.report["cache_key"] = key;
   Report report;  // results of other stages in DIR may belong to another bed: start afresh
@@ -359,22 +379,54 @@ int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, co
   if (opt.analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
 #ifdef BEDFORGE_HAVE_CGAL
   if (scene.wants("case")) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages, not after
+  const std::string surface_key = downstream_key(scene, key, {"contacts", "surface"});
+  const bool write_stl = scene.wants("stl") || scene.case_params.snappy;
+#ifdef BEDFORGE_HAVE_GMSH
+  // The mesh is reused from DIR/fluid.msh, written when the scene's outputs name `mesh`.
+  const std::string mesh_key = downstream_key(scene, surface_key, {"mesh"});
+  const nlohmann::json mesh_reused =
+      scene.needs_mesh() ? reusable_stage(previous, dir, "mesh", mesh_key, {"fluid.msh"}) : nlohmann::json();
+#else
+  const nlohmann::json mesh_reused;
+#endif
+  // The surface is reused only when no mesh is built from it: a mesh is made from the surface
+  // in memory, never from its STL read back.
+  nlohmann::json surface_reused;
+  if (scene.needs_surface() && (!scene.needs_mesh() || !mesh_reused.is_null()))
+    surface_reused = reusable_stage(previous, dir, "surface", surface_key,
+                                    write_stl ? std::vector<std::string>{"fluid.stl", "bed.stl", "fluid.vtp"}
+                                              : std::vector<std::string>{});
   std::shared_ptr<const meshing::FluidSurface> surface;
-  if (scene.needs_surface())
-    surface = add_surface(pack.bed, scene.surface, kVersion, scene.wants("stl") || scene.case_params.snappy, report,
-                          files, console);
+  if (!surface_reused.is_null()) {
+    console.line(fmt::format("surface: reused the surface in {} (bed, [contacts] and [surface] unchanged)", dir.string()));
+    report.set_stage("surface", surface_reused);
+  } else if (write_stl || (scene.needs_mesh() && mesh_reused.is_null())) {
+    surface = add_surface(pack.bed, scene.surface, kVersion, write_stl, report, files, console);
+    nlohmann::json entry = report.data()["stages"]["surface"];
+    entry["cache_key"] = surface_key;
+    report.set_stage("surface", entry);
+  }
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
-  std::shared_ptr<const meshing::VolumeMesh> mesh;
-  if (scene.needs_mesh())
-    mesh = add_mesh(surface->fluid, surface->report["fluid_volume_exact_m3"].get<double>(), pack.bed, scene.mesh,
-                    scene.wants("mesh"), dir, report, files, console);
+  std::shared_ptr<const meshing::PolyMesh> mesh;
+  if (!mesh_reused.is_null()) {
+    console.line(fmt::format("mesh: reused {} (surface and [mesh] unchanged)", (dir / "fluid.msh").string()));
+    mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
+    report.set_stage("mesh", mesh_reused);
+  } else if (scene.needs_mesh()) {
+    auto vm = add_mesh(surface->fluid, surface->report["fluid_volume_exact_m3"].get<double>(), pack.bed, scene.mesh,
+                       scene.wants("mesh"), dir, report, files, console);
+    mesh = std::shared_ptr<const meshing::PolyMesh>(vm, &vm->mesh);
+    nlohmann::json entry = report.data()["stages"]["mesh"];
+    entry["cache_key"] = mesh_key;
+    report.set_stage("mesh", entry);
+  }
   surface.reset();  // the case needs the volume mesh only
 #endif
   files.write(dir);
 #ifdef BEDFORGE_HAVE_GMSH
   if (scene.wants("case"))
-    add_case(mesh->mesh, pack.bed, scene.case_params, prov, read_file(dir / "scene.toml"),
+    add_case(*mesh, pack.bed, scene.case_params, prov, read_file(dir / "scene.toml"),
              scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir, opt.overwrite, report,
              console);
 #endif

@@ -14,6 +14,8 @@
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/report.hpp"
+#include "core/stage_meter.hpp"
 
 namespace bedforge::cases {
 
@@ -368,21 +370,31 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
     throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
                                          case_dir.string()));
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Convergence: SIMPLE's own message, the iteration count and the last initial residuals.
+  // Convergence: SIMPLE's own message and, per iteration, the initial residuals (the largest of
+  // U's components, p's first solve) and the elapsed time.
   std::ifstream log(case_dir / "log.simpleFoam");
   std::string line;
-  long iterations = 0;
-  bool converged = false, p_seen = false;
-  double res_u = 0.0, res_p = 0.0;  // first initial residual of p and largest of U's components, last iteration
+  struct Iteration {
+    double res_u = 0.0, res_p = 0.0, time_s = 0.0;
+    bool p_seen = false;
+  };
+  std::vector<Iteration> its;
+  bool converged = false;
   while (std::getline(log, line)) {
-    if (line.rfind("Time = ", 0) == 0) ++iterations, p_seen = false, res_u = 0.0;
+    if (line.rfind("Time = ", 0) == 0) its.emplace_back();
     if (line.find("SIMPLE solution converged") != std::string::npos) converged = true;
+    if (its.empty()) continue;
+    Iteration& it = its.back();
+    if (line.rfind("ExecutionTime = ", 0) == 0) it.time_s = std::atof(line.c_str() + 16);
     const auto at = line.find("Initial residual = ");
     if (at == std::string::npos) continue;
     const double r = std::atof(line.c_str() + at + 19);
-    if (line.find("Solving for U") != std::string::npos) res_u = std::max(res_u, r);
-    if (line.find("Solving for p,") != std::string::npos && !p_seen) res_p = r, p_seen = true;
+    if (line.find("Solving for U") != std::string::npos) it.res_u = std::max(it.res_u, r);
+    if (line.find("Solving for p,") != std::string::npos && !it.p_seen) it.res_p = r, it.p_seen = true;
   }
+  if (its.empty()) throw std::runtime_error(fmt::format("{}/log.simpleFoam holds no iteration", case_dir.string()));
+  const long iterations = static_cast<long>(its.size());
+  const double res_u = its.back().res_u, res_p = its.back().res_p;
   const double rho = c["parameters"]["density_kg_m3"].get<double>(), u = c["velocity_m_s"].get<double>();
   const double d = c["d_ref_m"].get<double>(), a = c["aspect_ratio"].get<double>();
   const double zl = c["section"]["z_low_m"].get<double>(), zh = c["section"]["z_high_m"].get<double>();
@@ -403,9 +415,19 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
     while (std::getline(check, line))
       if (const auto at = line.find("cells:"); at != std::string::npos) mesh["cells"] = std::atol(line.c_str() + at + 6);
   }
+  // Convergence history: the residuals and the bed's pressure gradient against the solver's time.
+  nlohmann::json history = nlohmann::json::array();
+  for (std::size_t k = 0; k < its.size(); ++k) {
+    nlohmann::json point = {{"iteration", k + 1}, {"time_s", its[k].time_s}, {"residual_U", its[k].res_u},
+                            {"residual_p", its[k].res_p}};
+    if (k < n) point["pressure_gradient_bed_pa_m"] = bed_gradient(k);
+    history.push_back(std::move(point));
+  }
   return {{"time_s", time},
+          {"solver_peak_memory_mb", children_peak_memory_mb()},
           {"mesh", mesh},
           {"iterations", iterations},
+          {"history", thin_history(history)},
           {"converged", converged},
           {"final_initial_residual", {{"U", res_u}, {"p", res_p}}},
           {"pressure_gradient_bed_pa_m", gradient},

@@ -46,4 +46,12 @@ std::string stage_key(const nlohmann::json& inputs) {
   return fmt::format("{:016x}", h);
 }
 
+nlohmann::json thin_history(const nlohmann::json& history, std::size_t max_points) {
+  nlohmann::json h = nlohmann::json::array();
+  const std::size_t n = history.size(), stride = n > max_points ? (n + max_points - 1) / max_points : 1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (i % stride == 0 || i + 1 == n) h.push_back(history[i]);
+  return h;
+}
+
 }  // namespace bedforge

@@ -28,4 +28,9 @@ class Report {
 // upstream changes it.
 std::string stage_key(const nlohmann::json& inputs);
 
+// A convergence history (an array of points, each a stage's error measures against elapsed
+// time) thinned to at most `max_points` evenly spaced points, the last one kept, so a report
+// stays small however long the run.
+nlohmann::json thin_history(const nlohmann::json& history, std::size_t max_points = 300);
+
 }  // namespace bedforge

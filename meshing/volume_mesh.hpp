@@ -24,6 +24,7 @@ struct VolumeMeshParams {
   bool fallback = true;                  // retry with the other algorithm when the gate fails
   double max_size_d = 0.25;              // largest cell edge, away from every surface
   bool optimize = true;                  // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio)
+  int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
   int threads = 0;                       // 0: every core
   QualityGate gate;
 };

@@ -7,18 +7,9 @@
 
 #include "core/error.hpp"
 #include "core/progress.hpp"
+#include "core/report.hpp"
 
 namespace bedforge::packer {
-
-// `history` thinned to at most `max_points` evenly spaced points (the last one kept), so a
-// report stays small however long the run.
-inline nlohmann::json thin_history(const nlohmann::json& history, std::size_t max_points = 300) {
-  nlohmann::json h = nlohmann::json::array();
-  const std::size_t n = history.size(), stride = n > max_points ? (n + max_points - 1) / max_points : 1;
-  for (std::size_t i = 0; i < n; ++i)
-    if (i % stride == 0 || i + 1 == n) h.push_back(history[i]);
-  return h;
-}
 
 // Book-keeping shared by the packing modes: the iteration budget, per-stage iterations and
 // time, the convergence history (error measure against elapsed time) and recovery events.

@@ -47,6 +47,62 @@ TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
   const auto& stages = report["stages"];
   EXPECT_NEAR(stages["mesh"]["fluid_volume_relative_error"].get<double>(),
               stages["surface"]["fluid_volume_relative_error"].get<double>(), 1e-9);
+  // Every stage reports its time and its own peak memory, in the report and in its summary line.
+  for (const char* stage : {"pack", "analysis", "surface", "mesh", "case"}) {
+    EXPECT_GT(stages[stage]["peak_memory_mb"].get<double>(), 0.0) << stage;
+    EXPECT_GE(stages[stage]["time_s"].get<double>(), 0.0) << stage;
+    EXPECT_NE(stages[stage]["summary"].get<std::string>().find(" MB"), std::string::npos) << stage;
+  }
+  // The mesh is far larger than the bed: a peak memory per stage, not the process's so far.
+  EXPECT_LT(stages["pack"]["peak_memory_mb"].get<double>(), stages["mesh"]["peak_memory_mb"].get<double>());
+  // The optimiser's history: quality after generation, then after each pass, ending at the
+  // quality the stage reports.
+  const auto& attempt = stages["mesh"]["attempts"].back();
+  const auto& history = attempt["history"];
+  ASSERT_GE(history.size(), 2u) << attempt.dump();
+  EXPECT_EQ(history[0]["pass"], 0);
+  for (std::size_t k = 1; k < history.size(); ++k)
+    EXPECT_GT(history[k]["time_s"].get<double>(), history[k - 1]["time_s"].get<double>());
+  EXPECT_EQ(history.back()["max_non_orthogonality_deg"], stages["mesh"]["quality"]["max_non_orthogonality_deg"]);
+  EXPECT_LT(history.back()["max_aspect_ratio"].get<double>(), history[0]["max_aspect_ratio"].get<double>());
+}
+
+// Changing only the case settings reuses the mesh (and the surface and bed under it); changing
+// the mesh settings meshes again from a surface built again.
+TEST(OpenFoamCase, ChangingOnlyTheCaseReusesTheMesh) {
+  const std::string base =
+      "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n[surface]\nedge_length_d = 0.15\n"
+      "[outputs]\nfiles = [\"positions\", \"stl\", \"mesh\", \"case\"]\n";
+  const fs::path dir = fresh_dir("reuse_mesh"), scenes = fresh_dir("reuse_mesh_scenes");
+  fs::create_directories(scenes);
+  auto run = [&](const std::string& name, const std::string& extra) {
+    std::ofstream(scenes / name) << base << extra;
+    return bedforge("run " + (scenes / name).string() + " -o " + dir.string() + " --overwrite");
+  };
+  const Result first = run("a.toml", "[case]\nreynolds = 1.0\n");
+  ASSERT_EQ(first.status, 0) << first.output;
+  const auto msh_time = fs::last_write_time(dir / "fluid.msh");
+  const auto cells = nlohmann::json::parse(read(dir / "report.json"))["stages"]["mesh"]["cells"];
+
+  const Result case_only = run("b.toml", "[case]\nreynolds = 2.0\n");
+  ASSERT_EQ(case_only.status, 0) << case_only.output;
+  EXPECT_NE(case_only.output.find("mesh: reused"), std::string::npos) << case_only.output;
+  EXPECT_NE(case_only.output.find("surface: reused"), std::string::npos) << case_only.output;
+  EXPECT_EQ(fs::last_write_time(dir / "fluid.msh"), msh_time);
+  auto report = nlohmann::json::parse(read(dir / "report.json"));
+  EXPECT_TRUE(report["stages"]["mesh"].value("reused", false));
+  EXPECT_EQ(report["stages"]["mesh"]["cells"], cells);
+  EXPECT_EQ(report["stages"]["case"]["parameters"]["reynolds"], 2.0);  // the case itself was written again
+  EXPECT_NE(read(dir / "case/constant/polyMesh/owner").find("nCells:" + cells.dump()), std::string::npos);
+
+  const Result new_mesh = run("c.toml", "[case]\nreynolds = 2.0\n[mesh]\nmax_size_d = 0.2\n");
+  ASSERT_EQ(new_mesh.status, 0) << new_mesh.output;
+  EXPECT_EQ(new_mesh.output.find("mesh: reused"), std::string::npos) << new_mesh.output;
+  EXPECT_EQ(new_mesh.output.find("surface: reused"), std::string::npos) << new_mesh.output;
+  EXPECT_NE(new_mesh.output.find("pack: reused"), std::string::npos) << new_mesh.output;
+  report = nlohmann::json::parse(read(dir / "report.json"));
+  EXPECT_FALSE(report["stages"]["mesh"].value("reused", false));
+  EXPECT_EQ(report["stages"]["mesh"]["parameters"]["max_size_d"], 0.2);
 }
 
 TEST(OpenFoamCase, BinaryAndAsciiCasesAreTheSameMeshToCheckMesh) {
@@ -124,6 +180,16 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   EXPECT_LE(flow["final_initial_residual"]["p"].get<double>(), c["parameters"]["residual_p"].get<double>());
   EXPECT_LE(flow["final_initial_residual"]["U"].get<double>(), c["parameters"]["residual_u"].get<double>());
   EXPECT_LT(flow["pressure_gradient_change_last_tenth"].get<double>(), 1e-3);
+  // The solve's history ends at the final residuals, its time never runs backwards, and the
+  // residuals fell from where they started.
+  const auto& history = flow["history"];
+  ASSERT_GE(history.size(), 2u);
+  EXPECT_EQ(history.back()["iteration"], flow["iterations"]);
+  EXPECT_EQ(history.back()["residual_p"], flow["final_initial_residual"]["p"]);
+  for (std::size_t k = 1; k < history.size(); ++k)
+    EXPECT_GE(history[k]["time_s"].get<double>(), history[k - 1]["time_s"].get<double>());
+  EXPECT_LT(history.back()["residual_p"].get<double>(), history[0]["residual_p"].get<double>());
+  EXPECT_GT(flow["solver_peak_memory_mb"].get<double>(), 0.0);
   // Mass conservation: what leaves is what the inlet velocity brings.
   EXPECT_LT(std::abs(flow["flow_rate_relative_error"].get<double>()), 1e-3);
   // Eisfeld & Schnitzlein at the section's void fraction: particle-resolved CFD commonly

@@ -1,0 +1,28 @@
+#pragma once
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+namespace bedforge {
+
+// Run time and peak memory of one stage. Starting a meter resets the kernel's high-water mark
+// of the process's resident memory (Linux: /proc/self/clear_refs), so the peak a stage reports
+// is its own and not that of an earlier, larger stage. Where the reset is refused the process
+// peak so far is reported, and `peak_memory_scope` says so.
+class StageMeter {
+ public:
+  StageMeter();
+  double seconds() const;
+  // Peak resident memory since the meter started, MB (2^20 bytes).
+  double peak_memory_mb() const;
+  // Writes time_s, peak_memory_mb and peak_memory_scope ("stage" or "process") into `stage`.
+  void record(nlohmann::json& stage) const;
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+  bool reset_ = false;
+};
+
+// Largest peak resident memory of the child processes waited for so far (OpenFOAM's solvers), MB.
+double children_peak_memory_mb();
+
+}  // namespace bedforge
