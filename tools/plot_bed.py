@@ -6,7 +6,8 @@
 DIR holds what `bedforge run` or `bedforge analyse` wrote: the wall profiles (radial_profile*.csv,
 wall_profile_*.csv, with their centre distributions and line-intersection versions),
 axial_profile.csv and report.json. Writes a PNG per wall profile,
-DIR/axial_profile.png and, when the report has a packer history, DIR/convergence.png.
+DIR/axial_profile.png and DIR/convergence.png: the convergence history of every iterative stage
+the report holds (packer, mesh optimiser, flow solve), error against elapsed time.
 """
 import json
 import os
@@ -52,22 +53,53 @@ def main(d):
         ax.plot(ax_["void_fraction"], ax_["z_d"], "k-")
         ax.set_xlabel("void fraction"), ax.set_ylabel("height z/d"), ax.grid(alpha=0.3)
         fig.tight_layout(), fig.savefig(os.path.join(d, "axial_profile.png"), dpi=110), plt.close(fig)
-    history = report.get("stages", {}).get("pack", {}).get("history", [])
-    if history:
-        fig, ax = plt.subplots(figsize=(7, 4))
-        t = [h["time_s"] for h in history]
-        if "mass_centre_d" in history[0]:  # Monte Carlo: settling of the mass centre
-            ax.plot(t, [h["mass_centre_d"] for h in history], label="mass centre / d")
-            ax.plot(t, [h["acceptance"] for h in history], label="acceptance")
+    plot_convergence(report, os.path.join(d, "convergence.png"))
+
+
+def plot_convergence(report, path):
+    """One panel per iterative stage the report holds (packer, mesh optimiser, flow solve): its
+    error measures against elapsed time, so a user sees what each extra second bought."""
+    stages = report.get("stages", {})
+    panels = []
+    pack = stages.get("pack", {}).get("history", [])
+    if pack:
+        panels.append(("pack", pack))
+    for attempt in stages.get("mesh", {}).get("attempts", []):
+        if attempt.get("history"):
+            panels.append((f"mesh optimiser ({attempt['algorithm']})", attempt["history"]))
+    flow = stages.get("case", {}).get("flow", {}).get("history", [])
+    if flow:
+        panels.append(("flow solve (simpleFoam)", flow))
+    if not panels:
+        return
+    fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 4), squeeze=False)
+    for ax, (name, h) in zip(axes[0], panels):
+        t = [p["time_s"] for p in h]
+        floor = lambda key: [max(p[key], 1e-12) for p in h]  # noqa: E731 (log axes)
+        if "mass_centre_d" in h[0]:  # Monte Carlo: settling of the mass centre
+            ax.plot(t, [p["mass_centre_d"] for p in h], label="mass centre / d")
+            ax.plot(t, [p["acceptance"] for p in h], label="acceptance")
             ax.set_yscale("log")
-        else:
-            ax.semilogy(t, [max(h["max_pair_overlap_d"], 1e-9) for h in history], label="max pair overlap / d_min")
-            ax.semilogy(t, [max(h["max_wall_overlap_d"], 1e-9) for h in history], label="max wall overlap / d_min")
-            if "force_residual_rms" in history[0]:
-                ax.semilogy(t, [max(h["force_residual_rms"], 1e-9) for h in history],
-                            label="rms force residual / weight")
-        ax.set_xlabel("elapsed time (s)"), ax.legend(fontsize=8), ax.grid(alpha=0.3)
-        fig.tight_layout(), fig.savefig(os.path.join(d, "convergence.png"), dpi=110), plt.close(fig)
+        elif "max_pair_overlap_d" in h[0]:  # soft-sphere packer
+            ax.semilogy(t, floor("max_pair_overlap_d"), label="max pair overlap / d_min")
+            ax.semilogy(t, floor("max_wall_overlap_d"), label="max wall overlap / d_min")
+            if "force_residual_rms" in h[0]:
+                ax.semilogy(t, floor("force_residual_rms"), label="rms force residual / weight")
+        elif "max_non_orthogonality_deg" in h[0]:  # mesh optimiser, a point per pass
+            ax.semilogy(t, floor("max_aspect_ratio"), "o-", label="max aspect ratio")
+            ax.semilogy(t, floor("max_skewness"), "s-", label="max skewness")
+            ax.semilogy(t, floor("max_non_orthogonality_deg"), "^-", label="max non-orthogonality (deg)")
+            ax.semilogy(t, [p["cells_failing_gate"] + 1e-1 for p in h], "x--", label="cells failing the gate (+0.1)")
+        else:  # flow solve
+            ax.semilogy(t, floor("residual_U"), label="initial residual U")
+            ax.semilogy(t, floor("residual_p"), label="initial residual p")
+            final = h[-1].get("pressure_gradient_bed_pa_m")
+            if final:
+                ax.semilogy(t, [max(abs(p.get("pressure_gradient_bed_pa_m", final) / final - 1), 1e-12) for p in h],
+                            label="|dp/L / final - 1|")
+        ax.set_title(name, fontsize=9), ax.set_xlabel("elapsed time (s)"), ax.legend(fontsize=7), ax.grid(alpha=0.3)
+    fig.tight_layout(), fig.savefig(path, dpi=110), plt.close(fig)
+
 
 if __name__ == "__main__":
     if len(sys.argv) != 2:
