@@ -38,6 +38,12 @@ void Report::set_stage(const std::string& name, nlohmann::json stage) {
 
 void Report::save(const std::filesystem::path& dir) const {
   write_file_atomically(dir / "report.json", data_.dump(2) + "\n");
+  std::string text = fmt::format("bedforge {}, seed {}\n", data_.value("bedforge_version", std::string("?")),
+                                 data_.contains("seed") ? data_["seed"].dump() : std::string("none"));
+  if (data_.contains("stages"))
+    for (const char* stage : {"pack", "analysis", "surface", "mesh", "case"})  // pipeline order
+      if (data_["stages"].contains(stage)) text += data_["stages"][stage].value("summary", std::string()) + "\n";
+  write_file_atomically(dir / "summary.txt", text);
 }
 
 std::string stage_key(const nlohmann::json& inputs) {

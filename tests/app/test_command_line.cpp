@@ -40,7 +40,8 @@ TEST(CommandLine, PackWritesBedReportSceneAndRecordsProvenance) {
   const Result r = bedforge("pack --aspect-ratio 3 --count 40 --seed 5 --diameter-m 0.002 -o " + out.string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("pack (soft-sphere accelerated): 40 spheres"), std::string::npos) << r.output;
-  for (const char* f : {"bed.csv", "bed.vtp", "report.json", "scene.toml"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  for (const char* f : {"bed.csv", "bed.vtp", "report.json", "summary.txt", "scene.toml"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
   const std::string csv = read(out / "bed.csv");
   EXPECT_NE(csv.find("# version: "), std::string::npos);
   EXPECT_NE(csv.find("# seed: 5"), std::string::npos);
@@ -50,8 +51,14 @@ TEST(CommandLine, PackWritesBedReportSceneAndRecordsProvenance) {
   EXPECT_EQ(report["scene"]["particles"]["count"], 40);
   EXPECT_FALSE(report["bedforge_version"].get<std::string>().empty());
   const auto& pack = report["stages"]["pack"];
-  for (const char* k : {"iterations", "time_s", "max_pair_overlap_d", "force_residual_rms", "void_fraction", "summary"})
+  for (const char* k : {"iterations", "time_s", "max_pair_overlap_d", "force_residual_rms", "void_fraction", "summary",
+                        "peak_memory_mb"})
     EXPECT_TRUE(pack.contains(k)) << k;
+  // The human summary beside the JSON: the version and seed, then the stage's printed line.
+  const std::string summary = read(out / "summary.txt");
+  EXPECT_NE(summary.find(report["bedforge_version"].get<std::string>() + ", seed 5"), std::string::npos) << summary;
+  EXPECT_NE(summary.find(pack["summary"].get<std::string>()), std::string::npos) << summary;
+  EXPECT_NE(r.output.find(pack["summary"].get<std::string>()), std::string::npos) << r.output;
   // The same command gives the same bed.
   const fs::path again = fresh_dir("pack_again");
   ASSERT_EQ(bedforge("pack --aspect-ratio 3 --count 40 --seed 5 --diameter-m 0.002 -o " + again.string()).status, 0);

@@ -1,0 +1,243 @@
+#!/usr/bin/python3
+"""Error against run time, one Pareto plot per stage; writes docs/error_vs_time.md, .json and
+docs/pareto_*.png.
+
+    /usr/bin/python3 tools/benchmark_error_vs_time.py                  # every section (about 10 minutes on 2 cores)
+    /usr/bin/python3 tools/benchmark_error_vs_time.py --only surface   # some sections, keep the others' results
+
+packer:   a = 5, N = 500, seeds 1-5, the overlap tolerance swept in both modes. Error of a setting:
+          its seed-mean central void fraction and radial profile (0-3 d from the wall) against those
+          of the tightest setting (accelerated, 1e-5 d); the seed-to-seed standard error of the mean
+          is the floor below which no setting can be told apart.
+surface:  one bed (a = 5, N = 500, seed 1, default contacts), the surface edge length swept (contact
+          edge a third of it): volume error against the exact treated geometry and chordal deviation,
+          against the stage's time.
+mesh:     mesh and CFD from docs/mesh_case_benchmark.json (tools/benchmark_mesh_case.py, which takes
+          an hour): dp/L over the bed against the finest mesh and against Eisfeld & Schnitzlein,
+          against the time of surface + mesh + solve.
+Times are the stages' own (report.json), one run at a time.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from bedforge_files import read_csv  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
+DOCS = os.path.join(ROOT, "docs")
+RESULTS = os.path.join(DOCS, "error_vs_time.json")
+SECTIONS = ["packer", "surface", "mesh"]
+ENV = dict(os.environ, OMP_NUM_THREADS="2")
+SEEDS = range(1, 6)
+SWEEP = {"accelerated": [3e-3, 1e-3, 3e-4, 1e-4, 1e-5], "faithful": [1e-3, 1e-4]}
+REFERENCE = ("accelerated", 1e-5)
+EDGES = [0.2, 0.15, 0.1, 0.07, 0.05]  # 0.3 d is refused with shrink: wall facets cut into the 0.005 d wall gap
+PROFILE_RANGE_D = 3.0
+
+
+def bedforge(*args):
+    subprocess.run([BEDFORGE, "--quiet", *args], check=True, env=ENV)
+
+
+def report(d):
+    return json.load(open(os.path.join(d, "report.json")))
+
+
+def packer_section(work):
+    runs = []
+    for mode, tolerances in SWEEP.items():
+        for tol in tolerances:
+            for seed in SEEDS:
+                scene = os.path.join(work, "scene.toml")
+                open(scene, "w").write(f"""[container]
+diameter_d = 5
+[particles]
+count = 500
+diameter_m = 0.001
+[packing]
+seed = {seed}
+[packing.soft_sphere]
+mode = "{mode}"
+overlap_tolerance_d = {tol}
+[outputs]
+files = ["positions", "analysis"]
+""")
+                out = os.path.join(work, f"{mode}_{tol}_{seed}")
+                bedforge("run", scene, "-o", out)
+                r = report(out)["stages"]
+                prof = read_csv(os.path.join(out, "radial_profile.csv"))
+                keep = prof["wall_distance_d"] <= PROFILE_RANGE_D
+                runs.append({"mode": mode, "tolerance_d": tol, "seed": seed, "time_s": r["pack"]["time_s"],
+                             "iterations": r["pack"]["iterations"],
+                             "eps_central": r["analysis"]["void_fraction"]["central_slab"],
+                             "profile": prof["void_fraction"][keep].tolist()})
+                print(mode, tol, seed, f"{r['pack']['time_s']:.2f} s", flush=True)
+    # Seed means, and their distance from the tightest setting's.
+    groups = {}
+    for r in runs:
+        groups.setdefault((r["mode"], r["tolerance_d"]), []).append(r)
+    ref = groups[REFERENCE]
+    ref_eps = np.mean([r["eps_central"] for r in ref])
+    ref_prof = np.mean([r["profile"] for r in ref], axis=0)
+    noise_eps = np.std([r["eps_central"] for r in ref], ddof=1) / np.sqrt(len(ref))
+    noise_prof = np.sqrt(np.mean(np.var([r["profile"] for r in ref], axis=0, ddof=1))) / np.sqrt(len(ref))
+    points = []
+    for (mode, tol), rs in groups.items():
+        prof = np.mean([r["profile"] for r in rs], axis=0)
+        points.append({"mode": mode, "tolerance_d": tol, "time_s": float(np.mean([r["time_s"] for r in rs])),
+                       "iterations": float(np.mean([r["iterations"] for r in rs])),
+                       "eps_central": float(np.mean([r["eps_central"] for r in rs])),
+                       "eps_error": float(abs(np.mean([r["eps_central"] for r in rs]) - ref_eps)),
+                       "profile_rms_error": float(np.sqrt(np.mean((prof - ref_prof) ** 2)))})
+    return {"points": points, "noise_eps": float(noise_eps), "noise_profile": float(noise_prof), "seeds": len(SEEDS)}
+
+
+def surface_section(work):
+    bed = os.path.join(work, "bed")
+    bedforge("pack", "--aspect-ratio", "5", "--count", "500", "--seed", "1", "--diameter-m", "0.003", "-o", bed)
+    points = []
+    for e in EDGES:
+        d = os.path.join(work, f"surface_{e}")
+        shutil.copytree(bed, d)
+        bedforge("surface", d, "--edge-length-d", str(e), "--contact-edge-length-d", f"{e / 3:.4g}")
+        s = report(d)["stages"]["surface"]
+        points.append({"edge_d": e, "time_s": s["time_s"], "triangles": s["triangles"],
+                       "volume_error": abs(s["fluid_volume_relative_error"]), "chordal_d": s["chordal_deviation_d"],
+                       "min_angle_deg": s["min_angle_deg"], "peak_memory_mb": s["peak_memory_mb"]})
+        print("surface", e, f"{s['time_s']:.1f} s", flush=True)
+        shutil.rmtree(d)
+    return {"points": points}
+
+
+def mesh_section():
+    src = json.load(open(os.path.join(DOCS, "mesh_case_benchmark.json")))
+    points = []
+    for r in src["sizes"]:
+        st = r["stages_s"]
+        points.append({"edge_d": r["edge_d"], "cells": r["cells"], "time_s": st["surface"] + st["mesh"] + st["case"],
+                       "mesh_time_s": st["surface"] + st["mesh"], "error_finest": abs(r["ratio_finest"] - 1),
+                       "error_es": abs(r["ratio_es"] - 1), "ratio_es": r["ratio_es"]})
+    return {"points": points}
+
+
+def pareto(ax, xs, ys, labels, **kw):
+    order = np.argsort(xs)
+    ax.loglog(np.array(xs)[order], np.array(ys)[order], **kw)
+    for x, y, t in zip(xs, ys, labels):
+        ax.annotate(t, (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+
+
+def plots(R):
+    if "packer" in R:
+        P = R["packer"]
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+        for ax, key, noise, what in ((axes[0], "eps_error", P["noise_eps"], "|central eps - tightest|"),
+                                     (axes[1], "profile_rms_error", P["noise_profile"],
+                                      f"rms radial profile difference (0-{PROFILE_RANGE_D:g} d)")):
+            for mode, style in (("accelerated", "o-"), ("faithful", "s-")):
+                pts = [p for p in P["points"] if p["mode"] == mode and (mode, p["tolerance_d"]) != REFERENCE]
+                pareto(ax, [p["time_s"] for p in pts], [max(p[key], 1e-6) for p in pts],
+                       [f"{p['tolerance_d']:g}" for p in pts], marker=style[0], label=mode)
+            ax.axhline(noise, color="gray", ls="--", label="seed-to-seed standard error")
+            ax.set_xlabel("packing time per bed (s)"), ax.set_ylabel(what), ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=7)
+        fig.suptitle("packer, a = 5, N = 500: error against time (labels: overlap tolerance / d)", fontsize=9)
+        fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_packer.png"), dpi=110), plt.close(fig)
+    if "surface" in R:
+        pts = R["surface"]["points"]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        labels = [f"{p['edge_d']:g} d" for p in pts]
+        pareto(ax, [p["time_s"] for p in pts], [p["volume_error"] for p in pts], labels, marker="o",
+               label="fluid volume error")
+        pareto(ax, [p["time_s"] for p in pts], [p["chordal_d"] for p in pts], labels, marker="s",
+               label="chordal deviation / d")
+        ax.set_xlabel("surface stage time (s)"), ax.grid(alpha=0.3, which="both"), ax.legend(fontsize=7)
+        ax.set_title("surface, a = 5, N = 500, shrink (labels: edge length)", fontsize=9)
+        fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_surface.png"), dpi=110), plt.close(fig)
+    if "mesh" in R:
+        pts = R["mesh"]["points"]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        labels = [f"{p['edge_d']:g} d, {p['cells'] / 1e6:.2f}M" for p in pts]
+        coarser = [p for p in pts if p["error_finest"] > 0]
+        pareto(ax, [p["time_s"] for p in coarser], [p["error_finest"] for p in coarser],
+               [f"{p['edge_d']:g} d" for p in coarser], marker="o", label="|dp/L / finest - 1|")
+        pareto(ax, [p["time_s"] for p in pts], [p["error_es"] for p in pts], labels, marker="s",
+               label="|dp/L / Eisfeld & Schnitzlein - 1|")
+        ax.set_xlabel("surface + mesh + simpleFoam time (s)"), ax.grid(alpha=0.3, which="both"), ax.legend(fontsize=7)
+        ax.set_title("mesh and CFD, a = 5, N = 500, bridges, Re_p = 1", fontsize=9)
+        fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_mesh_case.png"), dpi=110), plt.close(fig)
+
+
+def write_report(R):
+    L = ["# Error against run time, stage by stage", "",
+         "Made by `/usr/bin/python3 tools/benchmark_error_vs_time.py` on the 2-core machine of the CI; "
+         "each stage's accuracy knob swept on a fixed scene, error against the stage's own time. "
+         "What each run spends and reaches on the user's own scene is in its report (`history` of every "
+         "iterative stage; `tools/plot_bed.py DIR` draws it).", ""]
+    if "packer" in R:
+        P = R["packer"]
+        L += ["## Packer: overlap tolerance and mode", "",
+              f"a = 5, N = 500, {P['seeds']} seeds per setting. Error = distance of the seed-mean central void "
+              f"fraction and radial profile from those of the tightest setting (accelerated, 1e-5 d). Seed-to-seed "
+              f"standard error of that mean: {P['noise_eps']:.4f} (void fraction), {P['noise_profile']:.4f} "
+              "(profile): errors below these are noise.", "",
+              "| mode | overlap tolerance (d) | time per bed (s) | iterations | central eps | error eps | "
+              "error profile (rms) |", "|---|---|---|---|---|---|---|"]
+        for p in sorted(P["points"], key=lambda p: (p["mode"], -p["tolerance_d"])):
+            L.append(f"| {p['mode']} | {p['tolerance_d']:g} | {p['time_s']:.2f} | {p['iterations']:.0f} | "
+                     f"{p['eps_central']:.4f} | {p['eps_error']:.4f} | {p['profile_rms_error']:.4f} |")
+        L += ["", "![packer](pareto_packer.png)", ""]
+    if "surface" in R:
+        L += ["## Surface: edge length", "", "One bed (a = 5, N = 500, seed 1, d = 3 mm), `shrink` (the default), "
+              "contact edge a third of the edge length.", "",
+              "| edge (d) | triangles | time (s) | peak MB | volume error | chordal deviation (d) | min angle (deg) |",
+              "|---|---|---|---|---|---|---|"]
+        for p in R["surface"]["points"]:
+            L.append(f"| {p['edge_d']:g} | {p['triangles']} | {p['time_s']:.1f} | {p['peak_memory_mb']:.0f} | "
+                     f"{p['volume_error']:.2e} | {p['chordal_d']:.2e} | {p['min_angle_deg']:.1f} |")
+        L += ["", "![surface](pareto_surface.png)", ""]
+    if "mesh" in R:
+        L += ["## Mesh and CFD: mesh size", "", "From [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, "
+              "N = 500, bridges, Re_p = 1, simpleFoam on 2 processes); the mesh size follows the surface edge.", "",
+              "| surface edge (d) | cells | surface + mesh (s) | with the solve (s) | dp/L / finest | dp/L / E&S |",
+              "|---|---|---|---|---|---|"]
+        for p in R["mesh"]["points"]:
+            L.append(f"| {p['edge_d']:g} | {p['cells']} | {p['mesh_time_s']:.0f} | {p['time_s']:.0f} | "
+                     f"{1 - p['error_finest']:.3f} | {p['ratio_es']:.3f} |")
+        L += ["", "![mesh and CFD](pareto_mesh_case.png)", ""]
+    L += ["Why the defaults are what they are, read from these curves: [defaults.md](defaults.md).", ""]
+    open(os.path.join(DOCS, "error_vs_time.md"), "w").write("\n".join(L))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS,
+                    help="sections to run; the others are kept from docs/error_vs_time.json")
+    args = ap.parse_args()
+    if not os.path.exists(BEDFORGE):
+        raise SystemExit("build/bedforge is missing: run `bash tools/setup.sh` first")
+    R = json.load(open(RESULTS)) if os.path.exists(RESULTS) and args.only != SECTIONS else {}
+    with tempfile.TemporaryDirectory(prefix="bedforge_pareto_") as work:
+        if "packer" in args.only:
+            R["packer"] = packer_section(work)
+        if "surface" in args.only:
+            R["surface"] = surface_section(work)
+    if "mesh" in args.only:
+        R["mesh"] = mesh_section()
+    json.dump(R, open(RESULTS, "w"), indent=1)
+    plots(R)
+    write_report(R)
+
+
+if __name__ == "__main__":
+    main()
