@@ -378,14 +378,20 @@ int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, co
   files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
   if (opt.analysis) add_analysis(pack.bed, scene.analysis, report, files, console);
 #ifdef BEDFORGE_HAVE_CGAL
-  if (scene.wants("case")) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages, not after
   const std::string surface_key = downstream_key(scene, key, {"contacts", "surface"});
   const bool write_stl = scene.wants("stl") || scene.case_params.snappy;
 #ifdef BEDFORGE_HAVE_GMSH
-  // The mesh is reused from DIR/fluid.msh, written when the scene's outputs name `mesh`.
+  // The mesh is reused from DIR/fluid.msh, written when the scene's outputs name `mesh`; the
+  // case (with its flow results, when it was run) from DIR/case.
   const std::string mesh_key = downstream_key(scene, surface_key, {"mesh"});
   const nlohmann::json mesh_reused =
       scene.needs_mesh() ? reusable_stage(previous, dir, "mesh", mesh_key, {"fluid.msh"}) : nlohmann::json();
+  const std::string case_key = downstream_key(scene, mesh_key, {"case"});
+  const nlohmann::json case_reused = scene.wants("case") && !mesh_reused.is_null()
+                                         ? reusable_stage(previous, dir, "case", case_key, {"case/Allrun"})
+                                         : nlohmann::json();
+  if (scene.wants("case") && case_reused.is_null())
+    cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages, not after
 #else
   const nlohmann::json mesh_reused;
 #endif
@@ -402,33 +408,35 @@ int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, co
     report.set_stage("surface", surface_reused);
   } else if (write_stl || (scene.needs_mesh() && mesh_reused.is_null())) {
     surface = add_surface(pack.bed, scene.surface, kVersion, write_stl, report, files, console);
-    nlohmann::json entry = report.data()["stages"]["surface"];
-    entry["cache_key"] = surface_key;
-    report.set_stage("surface", entry);
+    report.set_cache_key("surface", surface_key);
   }
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   std::shared_ptr<const meshing::PolyMesh> mesh;
   if (!mesh_reused.is_null()) {
     console.line(fmt::format("mesh: reused {} (surface and [mesh] unchanged)", (dir / "fluid.msh").string()));
-    mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
     report.set_stage("mesh", mesh_reused);
+    if (scene.wants("case") && case_reused.is_null())
+      mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
   } else if (scene.needs_mesh()) {
     auto vm = add_mesh(surface->fluid, surface->report["fluid_volume_exact_m3"].get<double>(), pack.bed, scene.mesh,
                        scene.wants("mesh"), dir, report, files, console);
     mesh = std::shared_ptr<const meshing::PolyMesh>(vm, &vm->mesh);
-    nlohmann::json entry = report.data()["stages"]["mesh"];
-    entry["cache_key"] = mesh_key;
-    report.set_stage("mesh", entry);
+    report.set_cache_key("mesh", mesh_key);
   }
   surface.reset();  // the case needs the volume mesh only
 #endif
   files.write(dir);
 #ifdef BEDFORGE_HAVE_GMSH
-  if (scene.wants("case"))
+  if (!case_reused.is_null()) {
+    console.line(fmt::format("case: reused {} (mesh and [case] unchanged)", (dir / "case").string()));
+    report.set_stage("case", case_reused);
+  } else if (scene.wants("case")) {
     add_case(*mesh, pack.bed, scene.case_params, prov, read_file(dir / "scene.toml"),
              scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir, opt.overwrite, report,
              console);
+    report.set_cache_key("case", case_key);
+  }
 #endif
   report.save(dir);
   return 0;

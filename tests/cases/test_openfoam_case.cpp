@@ -67,8 +67,9 @@ TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
   EXPECT_LT(history.back()["max_aspect_ratio"].get<double>(), history[0]["max_aspect_ratio"].get<double>());
 }
 
-// Changing only the case settings reuses the mesh (and the surface and bed under it); changing
-// the mesh settings meshes again from a surface built again.
+// Changing only the case settings reuses the mesh (and the surface and bed under it), changing
+// nothing reuses the case as well, and changing the mesh settings meshes again from a surface
+// built again.
 TEST(OpenFoamCase, ChangingOnlyTheCaseReusesTheMesh) {
   const std::string base =
       "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n[surface]\nedge_length_d = 0.15\n"
@@ -94,6 +95,13 @@ TEST(OpenFoamCase, ChangingOnlyTheCaseReusesTheMesh) {
   EXPECT_EQ(report["stages"]["mesh"]["cells"], cells);
   EXPECT_EQ(report["stages"]["case"]["parameters"]["reynolds"], 2.0);  // the case itself was written again
   EXPECT_NE(read(dir / "case/constant/polyMesh/owner").find("nCells:" + cells.dump()), std::string::npos);
+
+  // Nothing changed: the case is reused too, so no --overwrite is needed.
+  const auto u_time = fs::last_write_time(dir / "case/0/U");
+  const Result same = bedforge("run " + (scenes / "b.toml").string() + " -o " + dir.string());
+  ASSERT_EQ(same.status, 0) << same.output;
+  EXPECT_NE(same.output.find("case: reused"), std::string::npos) << same.output;
+  EXPECT_EQ(fs::last_write_time(dir / "case/0/U"), u_time);
 
   const Result new_mesh = run("c.toml", "[case]\nreynolds = 2.0\n[mesh]\nmax_size_d = 0.2\n");
   ASSERT_EQ(new_mesh.status, 0) << new_mesh.output;
