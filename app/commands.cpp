@@ -251,7 +251,8 @@ void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CasePa
                                  mesh.cells, case_dir.string(), p.reynolds, j["velocity_m_s"].get<double>(),
                                  j["section"]["void_fraction_mesh"].get<double>());
   if (p.run) {
-    const nlohmann::json flow = cases::run_case(case_dir, j);
+    Progress progress("case", console.progress);
+    const nlohmann::json flow = cases::run_case(case_dir, j, progress);
     j["flow"] = flow;
     if (p.run_snappy) line += fmt::format("; snappyHexMesh made {} cells", flow["mesh"].value("cells", 0L));
     line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = {:.3f} x "

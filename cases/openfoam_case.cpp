@@ -2,10 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <future>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -358,15 +360,62 @@ std::vector<double> series(const fs::path& case_dir, const std::string& name) {
   return v;
 }
 
+// Where a solver run stands, from the tail of its log (only the tail is read, so polling a long
+// run stays cheap): the last `Time = N` and the last initial residuals of p and of U (its
+// largest component); zeros before them.
+struct SolverState {
+  long iteration = 0;
+  double residual_p = 0.0, residual_u = 0.0;
+};
+SolverState solver_state(const fs::path& log_path) {
+  std::ifstream log(log_path, std::ios::binary | std::ios::ate);
+  if (!log) return {};
+  const std::streamoff size = log.tellg(), tail = std::min<std::streamoff>(size, 1 << 16);
+  std::string text(static_cast<std::size_t>(tail), '\0');
+  log.seekg(size - tail);
+  log.read(text.data(), tail);
+  SolverState state;
+  if (const auto at = text.rfind("\nTime = "); at != std::string::npos) state.iteration = std::atol(text.c_str() + at + 8);
+  auto last = [&](const std::string& field) {
+    const std::string key = "Solving for " + field + ", Initial residual = ";
+    const auto at = text.rfind(key);
+    return at == std::string::npos ? 0.0 : std::atof(text.c_str() + at + key.size());
+  };
+  state.residual_p = last("p");
+  state.residual_u = std::max({last("Ux"), last("Uy"), last("Uz")});
+  return state;
+}
+
 }  // namespace
 
-nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c) {
+nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const int np = c["parameters"]["processors"].get<int>();
   const bool snappy = c["parameters"]["run_mesh"].get<std::string>() == "snappy";
   const std::string cmd = fmt::format("'{}/Allrun' -np {}{} > '{}/log.Allrun' 2>&1", case_dir.string(), np,
                                       snappy ? " -snappy" : "", case_dir.string());
-  if (std::system(cmd.c_str()) != 0)
+  // Allrun in the background; meanwhile the solver's log tells how far it is (log.mpirun while a
+  // parallel run lasts). The ETA assumes the residuals keep falling geometrically to their
+  // targets, and follows the one furthest from its target.
+  auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
+  const double target_p = c["parameters"]["residual_p"].get<double>(), target_u = c["parameters"]["residual_u"].get<double>();
+  double start_p = 0.0, start_u = 0.0;
+  while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
+    SolverState now = solver_state(case_dir / "log.simpleFoam");
+    if (now.iteration == 0) now = solver_state(case_dir / "log.mpirun");
+    if (now.iteration == 0 || now.residual_p <= 0.0 || now.residual_u <= 0.0) {
+      progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
+      continue;
+    }
+    if (start_p == 0.0) start_p = std::max(now.residual_p, 10.0 * target_p), start_u = std::max(now.residual_u, 10.0 * target_u);
+    const double done = std::min(std::log(start_p / now.residual_p) / std::log(start_p / target_p),
+                                 std::log(start_u / now.residual_u) / std::log(start_u / target_u));
+    progress.update(fmt::format("simpleFoam iteration {}, residuals U {:.1e} p {:.1e} (targets {:.0e}, {:.0e})",
+                                now.iteration, now.residual_u, now.residual_p, target_u, target_p),
+                    std::clamp(done, 0.0, 1.0));
+  }
+  progress.finish();
+  if (run.get() != 0)
     throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
                                          case_dir.string()));
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

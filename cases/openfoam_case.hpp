@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/progress.hpp"
 #include "core/scene_section.hpp"
 #include "meshing/poly_mesh.hpp"
 
@@ -63,7 +64,8 @@ nlohmann::json write_case(const std::filesystem::path& case_dir, bool overwrite,
 
 // Runs `case_dir/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and reads
 // back the solver's convergence and the pressure drop, compared with Eisfeld & Schnitzlein at
-// the section's own void fraction. std::runtime_error naming the log when the solver fails.
-nlohmann::json run_case(const std::filesystem::path& case_dir, const nlohmann::json& case_report);
+// the section's own void fraction. Shows the solver's iteration on `progress` while it runs.
+// std::runtime_error naming the log when the solver fails.
+nlohmann::json run_case(const std::filesystem::path& case_dir, const nlohmann::json& case_report, Progress& progress);
 
 }  // namespace bedforge::cases
