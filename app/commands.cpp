@@ -302,23 +302,23 @@ std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh&
 
 Provenance provenance_of(const Scene& scene) { return {kVersion, scene.seed, scene.to_json()}; }
 
-// The pack stage's cache key: the sections that decide the bed (container, particles, packing),
-// the version that packs it and, for an imported bed, the file's content.
-std::string pack_key(const Scene& scene) {
+// A stage's cache key: `inputs` (what else decides the stage: the version, an upstream stage's
+// key, a file's content) and the stage's own scene sections.
+std::string scene_stage_key(const Scene& scene, nlohmann::json inputs, std::initializer_list<const char*> sections) {
   const nlohmann::json sc = scene.to_json();
-  nlohmann::json inputs = {{"version", kVersion}};
-  for (const char* section : {"container", "particles", "packing"})
-    if (sc.contains(section)) inputs[section] = sc[section];
-  if (scene.algorithm == "import") inputs["file_key"] = stage_key(read_file(scene.import.file));
+  for (const char* section : sections) inputs[section] = sc.contains(section) ? sc[section] : nlohmann::json();
   return stage_key(inputs);
 }
 
-// A later stage's cache key: its own scene sections and the key of the stage it builds on.
+// The pack stage's: the sections that decide the bed, the version that packs it and, for an
+// imported bed, the file's content. Each later stage's builds on the key of the stage before.
+std::string pack_key(const Scene& scene) {
+  nlohmann::json inputs = {{"version", kVersion}};
+  if (scene.algorithm == "import") inputs["file_key"] = stage_key(read_file(scene.import.file));
+  return scene_stage_key(scene, inputs, {"container", "particles", "packing"});
+}
 std::string downstream_key(const Scene& scene, const std::string& upstream_key, std::initializer_list<const char*> sections) {
-  const nlohmann::json sc = scene.to_json();
-  nlohmann::json inputs = {{"upstream", upstream_key}};
-  for (const char* section : sections) inputs[section] = sc.contains(section) ? sc[section] : nlohmann::json();
-  return stage_key(inputs);
+  return scene_stage_key(scene, {{"upstream", upstream_key}}, sections);
 }
 
 // The report entry of stage `name` an earlier run left in DIR, when it was made with the same
@@ -345,8 +345,8 @@ std::optional<PackStage> reusable_pack(const nlohmann::json& previous, const fs:
   out.bed = read_bed_text(dir / "bed.csv", 1.0).bed;
   out.bed.container = scene.container;
   out.report = std::move(stage);
-  console.line(fmt::format("pack: reused the bed in {} (container, particles and packing unchanged; --force packs "
-                           "again)",
+  console.line(fmt::format("pack: reused the bed in {} (container, particles and packing unchanged; --force redoes "
+                           "it)",
                            dir.string()));
   return out;
 }
@@ -357,7 +357,7 @@ struct RunOptions {
   bool analysis = false;   // write the analysis (profiles, contacts)
   bool positions = true;   // write bed.csv
   bool overwrite = false;  // replace DIR/case
-  bool force = false;      // pack again even when DIR holds the bed of an unchanged scene
+  bool force = false;      // redo every stage, even those DIR holds for unchanged inputs
 };
 
 int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, const Console& console) {
@@ -548,8 +548,8 @@ int run_command_line(int argc, char** argv) {
   bool overwrite = false, force = false;
   run->add_flag("--overwrite", overwrite, "replace DIR/case when the scene asks for a case and it exists");
   const char* force_help =
-      "pack again even when DIR holds the bed of a scene with the same container, particles and packing (and the "
-      "same bedforge version), which is otherwise reused";
+      "redo every stage; otherwise a stage whose inputs are unchanged (its scene sections, the stage before it and "
+      "the bedforge version) is reused from DIR";
   run->add_flag("--force", force, force_help);
   overrides.add_to(*run);
 

@@ -360,30 +360,48 @@ std::vector<double> series(const fs::path& case_dir, const std::string& name) {
   return v;
 }
 
-// Where a solver run stands, from the tail of its log (only the tail is read, so polling a long
-// run stays cheap): the last `Time = N` and the last initial residuals of p and of U (its
-// largest component); zeros before them.
-struct SolverState {
-  long iteration = 0;
-  double residual_p = 0.0, residual_u = 0.0;
+// One SIMPLE iteration of a simpleFoam log: its `Time = N`, the initial residuals (the largest
+// of U's components, p's first solve) and the ExecutionTime at its end.
+struct Iteration {
+  long step = 0;
+  double res_u = 0.0, res_p = 0.0, time_s = 0.0;
+  bool p_seen = false;
 };
-SolverState solver_state(const fs::path& log_path) {
+
+// The iterations of a solver log, in order; `converged` is set when SIMPLE says so. Text before
+// the first `Time =` (or a log's tail cut mid-iteration) starts no iteration.
+std::vector<Iteration> read_iterations(std::istream& log, bool* converged = nullptr) {
+  std::vector<Iteration> its;
+  std::string line;
+  while (std::getline(log, line)) {
+    if (line.rfind("Time = ", 0) == 0) its.push_back({std::atol(line.c_str() + 7)});
+    if (converged && line.find("SIMPLE solution converged") != std::string::npos) *converged = true;
+    if (its.empty()) continue;
+    Iteration& it = its.back();
+    if (line.rfind("ExecutionTime = ", 0) == 0) it.time_s = std::atof(line.c_str() + 16);
+    const auto at = line.find("Initial residual = ");
+    if (at == std::string::npos) continue;
+    const double r = std::atof(line.c_str() + at + 19);
+    if (line.find("Solving for U") != std::string::npos) it.res_u = std::max(it.res_u, r);
+    if (line.find("Solving for p,") != std::string::npos && !it.p_seen) it.res_p = r, it.p_seen = true;
+  }
+  return its;
+}
+
+// The last finished iteration of a log being written (step 0 before there is one). Only the
+// log's tail is read, so polling a long run stays cheap.
+Iteration last_iteration(const fs::path& log_path) {
   std::ifstream log(log_path, std::ios::binary | std::ios::ate);
   if (!log) return {};
   const std::streamoff size = log.tellg(), tail = std::min<std::streamoff>(size, 1 << 16);
   std::string text(static_cast<std::size_t>(tail), '\0');
   log.seekg(size - tail);
   log.read(text.data(), tail);
-  SolverState state;
-  if (const auto at = text.rfind("\nTime = "); at != std::string::npos) state.iteration = std::atol(text.c_str() + at + 8);
-  auto last = [&](const std::string& field) {
-    const std::string key = "Solving for " + field + ", Initial residual = ";
-    const auto at = text.rfind(key);
-    return at == std::string::npos ? 0.0 : std::atof(text.c_str() + at + key.size());
-  };
-  state.residual_p = last("p");
-  state.residual_u = std::max({last("Ux"), last("Uy"), last("Uz")});
-  return state;
+  std::istringstream in(text);
+  const std::vector<Iteration> its = read_iterations(in);
+  for (auto it = its.rbegin(); it != its.rend(); ++it)
+    if (it->time_s > 0.0) return *it;  // ExecutionTime closes an iteration
+  return {};
 }
 
 }  // namespace
@@ -401,17 +419,17 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
   const double target_p = c["parameters"]["residual_p"].get<double>(), target_u = c["parameters"]["residual_u"].get<double>();
   double start_p = 0.0, start_u = 0.0;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
-    SolverState now = solver_state(case_dir / "log.simpleFoam");
-    if (now.iteration == 0) now = solver_state(case_dir / "log.mpirun");
-    if (now.iteration == 0 || now.residual_p <= 0.0 || now.residual_u <= 0.0) {
+    Iteration now = last_iteration(case_dir / "log.simpleFoam");
+    if (now.step == 0) now = last_iteration(case_dir / "log.mpirun");
+    if (now.step == 0 || now.res_p <= 0.0 || now.res_u <= 0.0) {
       progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
       continue;
     }
-    if (start_p == 0.0) start_p = std::max(now.residual_p, 10.0 * target_p), start_u = std::max(now.residual_u, 10.0 * target_u);
-    const double done = std::min(std::log(start_p / now.residual_p) / std::log(start_p / target_p),
-                                 std::log(start_u / now.residual_u) / std::log(start_u / target_u));
+    if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
+    const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),
+                                 std::log(start_u / now.res_u) / std::log(start_u / target_u));
     progress.update(fmt::format("simpleFoam iteration {}, residuals U {:.1e} p {:.1e} (targets {:.0e}, {:.0e})",
-                                now.iteration, now.residual_u, now.residual_p, target_u, target_p),
+                                now.step, now.res_u, now.res_p, target_u, target_p),
                     std::clamp(done, 0.0, 1.0));
   }
   progress.finish();
@@ -419,28 +437,10 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
     throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
                                          case_dir.string()));
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Convergence: SIMPLE's own message and, per iteration, the initial residuals (the largest of
-  // U's components, p's first solve) and the elapsed time.
+  // Convergence: SIMPLE's own message and, per iteration, the initial residuals and the time.
   std::ifstream log(case_dir / "log.simpleFoam");
-  std::string line;
-  struct Iteration {
-    double res_u = 0.0, res_p = 0.0, time_s = 0.0;
-    bool p_seen = false;
-  };
-  std::vector<Iteration> its;
   bool converged = false;
-  while (std::getline(log, line)) {
-    if (line.rfind("Time = ", 0) == 0) its.emplace_back();
-    if (line.find("SIMPLE solution converged") != std::string::npos) converged = true;
-    if (its.empty()) continue;
-    Iteration& it = its.back();
-    if (line.rfind("ExecutionTime = ", 0) == 0) it.time_s = std::atof(line.c_str() + 16);
-    const auto at = line.find("Initial residual = ");
-    if (at == std::string::npos) continue;
-    const double r = std::atof(line.c_str() + at + 19);
-    if (line.find("Solving for U") != std::string::npos) it.res_u = std::max(it.res_u, r);
-    if (line.find("Solving for p,") != std::string::npos && !it.p_seen) it.res_p = r, it.p_seen = true;
-  }
+  const std::vector<Iteration> its = read_iterations(log, &converged);
   if (its.empty()) throw std::runtime_error(fmt::format("{}/log.simpleFoam holds no iteration", case_dir.string()));
   const long iterations = static_cast<long>(its.size());
   const double res_u = its.back().res_u, res_p = its.back().res_p;
@@ -461,7 +461,7 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
   nlohmann::json mesh = {{"mesher", snappy ? "snappyHexMesh" : "gmsh"}};
   if (snappy) {  // the cells snappyHexMesh made, as its checkMesh counted them
     std::ifstream check(case_dir / "log.checkMesh");
-    while (std::getline(check, line))
+    for (std::string line; std::getline(check, line);)
       if (const auto at = line.find("cells:"); at != std::string::npos) mesh["cells"] = std::atol(line.c_str() + at + 6);
   }
   // Convergence history: the residuals and the bed's pressure gradient against the solver's time.

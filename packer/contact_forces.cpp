@@ -14,8 +14,9 @@ namespace {
 // energy share and raises max_pair. Two passes over chunks of the list: first, without a
 // branch, the neighbours that touch (about half the listed ones, a pattern no branch predictor
 // follows); then the square roots and divisions for those only. Measured on a packed bed of
-// 1e4 spheres, one thread: 106 ns per sphere against 172 for the one-pass loop. Templated on periodicity so walls on every side (the
-// common case) carry no wrap-around in the innermost loop.
+// 1e4 spheres, one thread: 106 ns per sphere against 172 for the one-pass loop. Templated on
+// periodicity so walls on every side (the common case) carry no wrap-around in the innermost
+// loop.
 template <bool kPeriodic>
 double gather_pairs(const Spheres& s, const NeighbourList& nl, const Periodicity& per, std::size_t i,
                     Eigen::Vector3d& push, double& max_pair) {

@@ -1,5 +1,11 @@
-"""Readers for the files bedforge writes, shared by the tools."""
+"""Where the tools find bedforge, and readers for the files it writes, shared by the tools."""
+import os
+
 import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))  # the program the tools run
+DOCS = os.path.join(ROOT, "docs")  # where results, tables and figures go
 
 
 def read_csv(path):

@@ -32,9 +32,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
-DOCS = os.path.join(ROOT, "docs")
+from bedforge_files import BEDFORGE, DOCS  # noqa: E402
+
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "snappy", "scale"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")

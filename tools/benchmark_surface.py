@@ -19,9 +19,8 @@ import shutil
 import subprocess
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
-DOCS = os.path.join(ROOT, "docs")
+from bedforge_files import BEDFORGE, DOCS
+
 TREATMENTS = ["shrink", "bridge", "cap", "enlarge"]
 
 

@@ -32,12 +32,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bedforge_files import read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, ROOT, read_csv  # noqa: E402
 from references import de_klerk  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
-DOCS = os.path.join(ROOT, "docs")
 SCENES = os.path.join(ROOT, "scenes", "examples")
 SECTIONS = ["fig3", "annulus", "segregation", "speed"]
 

@@ -28,12 +28,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bedforge_files import read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, read_csv  # noqa: E402
 from references import benyahia, de_klerk, dixon, jeschar, zou_yu_dense, zou_yu_loose  # noqa: E402,F401
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BEDFORGE = os.environ.get("BEDFORGE", os.path.join(ROOT, "build", "bedforge"))
-DOCS = os.path.join(ROOT, "docs")
 
 
 SECTIONS = ["paper", "eps0", "by_a", "speed"]
