@@ -618,6 +618,12 @@ int run_command_line(int argc, char** argv) {
                       "FLOAT >= 0, empty section below the bed in diameters (sets surface.inlet_length_d); default 1");
   surface->add_option("--outlet-length-d", outlet_length_d,
                       "FLOAT >= 0, empty section above the bed in diameters (sets surface.outlet_length_d); default 1");
+  std::vector<double> clip_window_d;
+  surface->add_option("--clip-window-d", clip_window_d,
+                      "FLOAT FLOAT, heights above the floor in diameters whose planes become the inlet and outlet, "
+                      "cutting the spheres there, instead of the empty sections (sets surface.clip_window_d); "
+                      "default none")
+      ->expected(2);
 
   CLI::App* case_cmd = app.add_subcommand("case", "write the OpenFOAM case DIR/case from DIR/fluid.msh (simpleFoam, "
                                                   "laminar); run it with DIR/case/Allrun [-np N]");
@@ -705,6 +711,14 @@ int run_command_line(int argc, char** argv) {
     if (contact_edge_length_d) override_key(table, "surface.contact_edge_length_d", *contact_edge_length_d);
     if (inlet_length_d) override_key(table, "surface.inlet_length_d", *inlet_length_d);
     if (outlet_length_d) override_key(table, "surface.outlet_length_d", *outlet_length_d);
+    if (!clip_window_d.empty()) {
+      override_key(table, "surface.clip_window_d", toml::array{clip_window_d[0], clip_window_d[1]});
+      // The bed's scene may give empty sections; a window given here replaces them.
+      if (auto* s = table["surface"].as_table()) {
+        if (!inlet_length_d) s->erase("inlet_length_d");
+        if (!outlet_length_d) s->erase("outlet_length_d");
+      }
+    }
     SceneSection contacts(table["contacts"].as_table(), "contacts"), surf(table["surface"].as_table(), "surface");
     const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
     contacts.finish();

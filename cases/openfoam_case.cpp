@@ -58,7 +58,8 @@ nlohmann::json to_json(const CaseParams& p) {
 }
 
 BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d) {
-  BedSection s{exclude_d * g.d_ref, g.bed_top - exclude_d * g.d_ref, 0.0};
+  // The bed between its floor and top, or the part of it a clip window kept.
+  BedSection s{std::max(0.0, g.inlet_z) + exclude_d * g.d_ref, std::min(g.bed_top, g.outlet_z) - exclude_d * g.d_ref, 0.0};
   if (s.z_high - s.z_low < 0.5 * g.d_ref)
     throw InputError(fmt::format("case.section_exclude_d = {}: leaves a bed section of {:.3g} d (bed height {:.3g} d); "
                                  "the pressure drop needs at least 0.5 d, lower it",
@@ -271,7 +272,8 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
     write_text(tmp / "bedforge/bed.csv", bed_csv);
     if (p.snappy) {
       // Background cells, refined `snappy_level` times at every surface; the fluid is the side
-      // holding a point in the empty inlet section.
+      // holding the centre of the largest tetrahedron (inside the fluid and away from its
+      // surface, also when a clip window leaves no empty section).
       const double cell = p.snappy_cell_d * g.d_ref, pad = cell, r = g.outer_radius + pad;
       const double z0 = g.inlet_z - pad, z1 = g.outlet_z + pad;
       const int nxy = std::max(1, static_cast<int>(std::ceil(2 * r / cell))),
@@ -290,8 +292,9 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
                       "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
                       "    writeObj            no;\n}\n"));
-      // Off the background grid's planes (snappyHexMesh cannot place a point on a cell face).
-      const double loc_r = 0.5 * (g.outer_radius + g.inner_radius) + 0.0123 * g.d_ref, loc_y = 0.0371 * g.d_ref;
+      const std::vector<double> volumes = meshing::cell_volumes(mesh);
+      const Eigen::Vector3d inside =
+          meshing::cell_centres(mesh)[std::max_element(volumes.begin(), volumes.end()) - volumes.begin()];
       std::string regions, levels;
       for (const auto& patch : mesh.patches) {
         const bool wall = patch.type == "wall";
@@ -321,7 +324,7 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
                                   "    nBufferCellsNoExtrude 0;\n    nLayerIter 50;\n}}\n\n"
                                   "meshQualityControls\n{{\n    #includeEtc \"caseDicts/meshQualityDict\"\n    nSmoothScale 4;\n    errorReduction 0.75;\n}}\n\n"
                                   "mergeTolerance 1e-6;\n",
-                                  regions, p.snappy_level, levels, loc_r, loc_y, 0.5 * g.inlet_z + 0.0117 * g.d_ref)));
+                                  regions, p.snappy_level, levels, inside.x(), inside.y(), inside.z())));
     }
     fs::remove_all(case_dir);  // the old case goes only once the new one is complete
     fs::rename(tmp, case_dir);

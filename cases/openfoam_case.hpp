@@ -27,7 +27,7 @@ struct CaseParams {
   bool snappy = false;                  // also write the snappyHexMesh set-up (Allrun -snappy)
   double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
   int snappy_level = 2;                 // refinement levels at particles and walls
-  double section_exclude_d = 0.5;       // bed section for the pressure drop: floor + this to bed top - this
+  double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
   bool run_snappy = false;              // run_mesh = "snappy": the run meshes with snappyHexMesh first (needs snappy)
 };

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
+#include <unordered_map>
 
 #include "analysis/intersection_volumes.hpp"
 #include "analysis/quadrature.hpp"
@@ -30,38 +32,78 @@ double segment_distance(const Eigen::Vector3d& q, const Eigen::Vector3d& a, cons
   return (q - (a + t * ab)).norm();
 }
 
-// The container's curved walls as the treatment sees them.
+// A wall of the container as the treatment sees it: a cylinder about the z axis (the fluid
+// inside it, or outside for an annulus's inner wall) or a plane n.p = k with n out of the fluid.
 struct Wall {
-  double R;
-  bool inner;  // the inner wall of an annulus: the fluid lies outside it
-  std::string name() const { return inner ? "inner wall" : "wall"; }
-  // Distance from the sphere surface (centre at radial distance rho, radius r) to the wall.
-  double gap(double rho, double r) const { return inner ? rho - R - r : R - rho - r; }
-  bool beyond(const Eigen::Vector3d& p) const {
+  std::string name;
+  int index = 0;  // into TreatedBed::wall_holes
+  bool plane = false;
+  double R = 0.0;
+  bool inner = false;
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  double k = 0.0;
+  // Distance from p to the wall, negative beyond it (in a cylinder: radially).
+  double reach(const Eigen::Vector3d& p) const {
+    if (plane) return k - n.dot(p);
     const double rho = std::hypot(p.x(), p.y());
-    return inner ? rho < R : rho > R;
+    return inner ? rho - R : R - rho;
   }
-  // Parameter t > 0 where the line p + t a (a horizontal, unit) first meets the wall; NaN if never.
+  double gap(const Eigen::Vector3d& c, double r) const { return reach(c) - r; }
+  bool beyond(const Eigen::Vector3d& p) const { return reach(p) < 0.0; }
+  // Unit direction from p to the nearest point of the wall.
+  Eigen::Vector3d towards(const Eigen::Vector3d& p) const {
+    if (plane) return n;
+    const double rho = std::hypot(p.x(), p.y());
+    const Eigen::Vector3d radial = rho > 0.0 ? Eigen::Vector3d(p.x() / rho, p.y() / rho, 0.0) : Eigen::Vector3d::UnitX();
+    return inner ? Eigen::Vector3d(-radial) : radial;
+  }
+  // Parameter t > 0 where the line p + t a (a unit; horizontal for a cylinder) first meets the
+  // wall; NaN if never.
   double hit(const Eigen::Vector3d& p, const Eigen::Vector3d& a) const {
+    if (plane) {
+      const double na = n.dot(a);
+      return na > 0.0 ? (k - n.dot(p)) / na : std::numeric_limits<double>::quiet_NaN();
+    }
     const double b = p.x() * a.x() + p.y() * a.y(), c = p.x() * p.x() + p.y() * p.y() - R * R, disc = b * b - c;
     if (disc < 0.0) return std::numeric_limits<double>::quiet_NaN();
     return inner ? -b - std::sqrt(disc) : -b + std::sqrt(disc);
   }
 };
 
+std::vector<Wall> walls_of(const Container& c) {
+  if (const auto* cyl = dynamic_cast<const Cylinder*>(&c)) return {Wall{"wall", 0, false, cyl->radius()}};
+  if (const auto* ann = dynamic_cast<const Annulus*>(&c))
+    return {Wall{"wall", 0, false, ann->outer_radius()}, Wall{"inner wall", 1, false, ann->inner_radius(), true}};
+  if (const auto* box = dynamic_cast<const Box*>(&c)) {
+    if (box->periodicity().any())
+      throw InputError("container.periodic_x/periodic_y = true: the surface stage meshes walled boxes only (a periodic "
+                       "fluid domain needs matching periodic patches, not made here); allowed: a box with walls on "
+                       "every side, a cylinder or an annulus");
+    const double hx = 0.5 * box->size_x(), hy = 0.5 * box->size_y();
+    auto side = [](const char* name, int index, Eigen::Vector3d n, double k) {
+      Wall w{name, index, true};
+      w.n = n, w.k = k;
+      return w;
+    };
+    return {side("wall at x min", 0, -Eigen::Vector3d::UnitX(), hx), side("wall at x max", 1, Eigen::Vector3d::UnitX(), hx),
+            side("wall at y min", 2, -Eigen::Vector3d::UnitY(), hy), side("wall at y max", 3, Eigen::Vector3d::UnitY(), hy)};
+  }
+  throw InputError(fmt::format("the surface stage handles cylinder, annulus and box containers; this bed's container "
+                               "is a {}",
+                               c.kind()));
+}
+
+// What a treated contact occupies in z (m): a clip plane must keep clear of it.
+using Extents = std::unordered_map<long long, std::pair<double, double>>;
+
 class Treater {
  public:
-  Treater(const Bed& bed, const SurfaceParams& p, double z0, double z1) : bed_(bed), p_(p), z0_(z0), z1_(z1) {
+  // `survey`: the extents of the contacts treated without clip planes, to leave out those
+  // beyond the planes (null without clipping).
+  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey)
+      : bed_(bed), p_(p), planes_(planes), survey_(survey), walls_(walls_of(*bed.container)) {
     d_ = sauter_mean(bed.diameters);
     edge_c_ = p.contact_edge_length_d * d_;
-    const Container& c = *bed.container;
-    if (const auto* cyl = dynamic_cast<const Cylinder*>(&c)) walls_.push_back({cyl->radius(), false});
-    else if (const auto* ann = dynamic_cast<const Annulus*>(&c))
-      walls_.push_back({ann->outer_radius(), false}), walls_.push_back({ann->inner_radius(), true});
-    else
-      throw InputError(fmt::format("the surface stage handles cylinder and annulus containers; this bed's container "
-                                   "is a {}",
-                                   c.kind()));
     scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
              : p.treatment == SurfaceParams::Treatment::enlarge ? p.enlarge_factor
                                                                 : 1.0;
@@ -69,9 +111,15 @@ class Treater {
     out_.radius.resize(n);
     out_.cuts.resize(n);
     out_.cut_names.resize(n);
+    out_.kept.resize(n);
+    out_.wall_holes.resize(walls_.size());
+    out_.planes = planes;
     cut_angle_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
+      const double z = bed.centres[i].z();
+      out_.kept[i] = !planes.clip || (z + out_.radius[i] > planes.z0 && z - out_.radius[i] < planes.z1);
+      if (!out_.kept[i]) continue;
       volume_ += 4.0 / 3.0 * kPi * std::pow(out_.radius[i], 3);
       area_ += 4.0 * kPi * out_.radius[i] * out_.radius[i];
       volume0_ += 4.0 / 3.0 * kPi * std::pow(0.5 * bed.diameters[i], 3);
@@ -86,10 +134,19 @@ class Treater {
     const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
     NeighbourList nl(std::max(tolerance, 0.0) + std::max(0.0, 1.0 - scale_) * d_max + 1e-3 * d_);
     nl.build(bed_.centres, out_.radius, *bed_.container);
+    const double wall_pad = 0.6 * p_.edge_length_d * d_;  // the wall mesh keeps its holes this clear of its ends
     for (std::size_t i = 0; i < n; ++i) {
       for (int j : nl.of(i))
-        if (static_cast<std::size_t>(j) > i) pair(i, j, nl);
-      for (const Wall& w : walls_) wall(i, w, nl);
+        if (static_cast<std::size_t>(j) > i) {
+          const Marks m = mark(i, j);
+          pair(i, j, nl);
+          record(key(i, j), m, i, j, 0.0);
+        }
+      for (const Wall& w : walls_) {
+        const Marks m = mark(i, i);
+        wall(i, w, nl);
+        record(key(i, n + w.index), m, i, i, wall_pad);
+      }
       ends(i);
     }
     for (std::size_t i = 0; i < n; ++i) check_cuts(i);
@@ -110,6 +167,8 @@ class Treater {
         {"solid_volume_exact_m3", volume_}};
     return std::move(out_);
   }
+
+  const Extents& extents() const { return extents_; }
 
  private:
   using T = SurfaceParams::Treatment;
@@ -143,12 +202,61 @@ class Treater {
     cut_angle_[i].push_back(angle);
   }
 
+  long long key(std::size_t i, std::size_t j) const { return static_cast<long long>(i) * (bed_.size() + 8) + j; }
+
+  // How much geometry there is before a contact is treated, so its extent can be taken after.
+  struct Marks {
+    std::size_t cuts_i, cuts_j, parts;
+    std::vector<std::size_t> holes;
+  };
+  Marks mark(std::size_t i, std::size_t j) const {
+    Marks m{out_.cuts[i].size(), out_.cuts[j].size(), out_.parts.size(), {}};
+    for (const auto& h : out_.wall_holes) m.holes.push_back(h.size());
+    return m;
+  }
+  // The z extent of what the contact (i, j) added since `m` (the cut caps included), widened by `pad`.
+  void record(long long k, const Marks& m, std::size_t i, std::size_t j, double pad) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    auto take = [&](const Eigen::Vector3d& q) { lo = std::min(lo, q.z()), hi = std::max(hi, q.z()); };
+    for (auto [s, from] : {std::pair{i, m.cuts_i}, std::pair{j, m.cuts_j}}) {
+      const Eigen::Vector3d& c = bed_.centres[s];
+      const double r = out_.radius[s];
+      for (std::size_t k2 = from; k2 < out_.cuts[s].size(); ++k2) {
+        const SphereCut& cut = out_.cuts[s][k2];
+        for (const auto& q : cut.loop) take(q);
+        take(c + r * cut.axis);
+        for (const Eigen::Vector3d pole : {Eigen::Vector3d(c + r * Eigen::Vector3d::UnitZ()), Eigen::Vector3d(c - r * Eigen::Vector3d::UnitZ())})
+          if (cut.removed(pole)) take(pole);
+      }
+    }
+    for (std::size_t k2 = m.parts; k2 < out_.parts.size(); ++k2)
+      for (const auto& q : out_.parts[k2].points) take(q);
+    for (std::size_t w = 0; w < m.holes.size(); ++w)
+      for (std::size_t k2 = m.holes[w]; k2 < out_.wall_holes[w].size(); ++k2)
+        for (const auto& q : out_.wall_holes[w][k2].loop) take(q);
+    if (lo <= hi) extents_[k] = {lo - pad, hi + pad};
+  }
+  // With clip planes: true when the contact (as surveyed) lies wholly beyond them, so is left
+  // out; InputError when it crosses one (the planes were placed clear of every contact).
+  bool beyond_planes(long long k, const std::string& who) const {
+    if (!survey_) return false;
+    const auto it = survey_->find(k);
+    if (it == survey_->end()) return false;
+    const auto [lo, hi] = it->second;
+    if (hi <= planes_.z0 || lo >= planes_.z1) return true;
+    if (lo < planes_.z0 || hi > planes_.z1)
+      throw InputError(fmt::format("the treated contact of {} crosses a clip plane", who));
+    return false;
+  }
+
   // A planar cut of sphere i at distance h along axis a (unit), its loop of n vertices on the
-  // circle of radius rho (given, so a bridge's loop is exactly its tube's); returns the loop's frame.
-  Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, const std::string& name) {
+  // circle of radius rho (given, so a bridge's loop is exactly its tube's) about `at` (default
+  // c + h a); returns the loop's frame.
+  Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, const std::string& name,
+                  std::optional<Eigen::Vector3d> at = std::nullopt) {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i];
-    const Frame f = Frame::along(c + h * a, a);
+    const Frame f = Frame::along(at.value_or(c + h * a), a);
     SphereCut cut;
     cut.loop = circle_loop(f, rho, n);
     cut.spacing = 2.0 * kPi * rho / n;
@@ -164,7 +272,9 @@ class Treater {
     const Eigen::Vector3d &ci = bed_.centres[i], &cj = bed_.centres[j];
     const double ri = out_.radius[i], rj = out_.radius[j], dist = (cj - ci).norm(), gap = dist - ri - rj;
     const std::string who = fmt::format("spheres {} and {}", i, j);
-    if (!(gap < treat_below(p_.treatment))) {
+    const bool treated = gap < treat_below(p_.treatment);
+    if ((treated && beyond_planes(key(i, j), who)) || !out_.kept[i] || !out_.kept[j]) return;
+    if (!treated) {
       if (p_.treatment == T::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
       return gap_left(gap, false, who);
     }
@@ -240,27 +350,28 @@ class Treater {
 
   void wall(std::size_t i, const Wall& w, const NeighbourList& nl) {
     const Eigen::Vector3d& c = bed_.centres[i];
-    const double r = out_.radius[i], rho = std::hypot(c.x(), c.y()), gap = w.gap(rho, r);
-    const std::string who = fmt::format("sphere {} and the {}", i, w.name());
+    const double r = out_.radius[i], gap = w.gap(c, r);
+    const std::string who = fmt::format("sphere {} and the {}", i, w.name);
     const T t = p_.wall_treatment;
-    if (!(gap < treat_below(t))) {
-      if (t == T::shrink && w.gap(rho, r / scale_) <= kContact * d_) ++treated_pw_;
+    const bool treated = gap < treat_below(t);
+    if ((treated && beyond_planes(key(i, bed_.size() + w.index), who)) || !out_.kept[i]) return;
+    if (!treated) {
+      if (t == T::shrink && w.gap(c, r / scale_) <= kContact * d_) ++treated_pw_;
       return gap_left(gap, true, who);
     }
     ++treated_pw_;
-    const Eigen::Vector3d radial = rho > 0.0 ? Eigen::Vector3d(c.x() / rho, c.y() / rho, 0.0) : Eigen::Vector3d::UnitX();
-    const Eigen::Vector3d a = w.inner ? Eigen::Vector3d(-radial) : radial;  // towards the wall
-    const double to_wall = w.inner ? rho - w.R : w.R - rho;                  // centre to wall along a
-    auto& holes = w.inner ? out_.inner_holes : out_.outer_holes;
+    const Eigen::Vector3d a = w.towards(c);
+    const double to_wall = w.reach(c);  // centre to wall along a
+    auto& holes = out_.wall_holes[w.index];
     if (t == T::cap) {
       const double g = p_.cap_gap_d * d_, h = to_wall - g;
       if (h <= 0.1 * r) throw InputError(fmt::format("{} overlap too deeply to be capped", who));
       const double rho_c = std::sqrt(r * r - h * h);
-      const Frame f = plane_cut(i, a, h, rho_c, ring_points(rho_c, edge_c_), "cap towards the " + w.name());
+      const Frame f = plane_cut(i, a, h, rho_c, ring_points(rho_c, edge_c_), "cap towards the " + w.name);
       out_.parts.push_back(ring_mesh(f, 0.0, rho_c, edge_c_, true, "particles"));
       area_ += kPi * rho_c * rho_c;
       double left = g;  // the disk's rim bends towards a concave wall
-      for (const auto& q : out_.cuts[i].back().loop) left = std::min(left, w.gap(std::hypot(q.x(), q.y()), 0.0));
+      for (const auto& q : out_.cuts[i].back().loop) left = std::min(left, w.reach(q));
       ++caps_;
       return gap_left(left, true, who);
     }
@@ -272,7 +383,7 @@ class Treater {
                                    p_.bridge_diameter_d, i, 2.0 * r / d_));
     const double h = std::sqrt(r * r - rb * rb);
     const int n = ring_points(rb, edge_c_);
-    const Frame f = plane_cut(i, a, h, rb, n, "bridge to the " + w.name());
+    const Frame f = plane_cut(i, a, h, rb, n, "bridge to the " + w.name);
     const GeneratorLength length = [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
     double shortest = std::numeric_limits<double>::infinity();
     for (int j = 0; j < 64; ++j) {
@@ -308,6 +419,16 @@ class Treater {
   void wall_union(std::size_t i, const Wall& w, const Eigen::Vector3d& a) {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i];
+    auto& holes = out_.wall_holes[w.index];
+    if (w.plane) {  // a circle: cut exactly
+      const double h = w.reach(c), rho = std::sqrt(r * r - h * h);
+      plane_cut(i, a, h, rho, ring_points(rho, edge_c_), "union with the " + w.name);
+      const SphereCut& cut = out_.cuts[i].back();
+      holes.push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+      wedge(kPi - std::acos(std::clamp(((cut.loop[0] - c) / r).dot(-w.n), -1.0, 1.0)));
+      ++unions_;
+      return;
+    }
     const Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ(), e2 = a.cross(e1);
     // Polar angle from a of the curve in the direction phi, by bisection.
     auto point = [&](double beta, double phi) {
@@ -338,11 +459,10 @@ class Treater {
     cut.spacing = perimeter / n;
     cut.axis = a;
     cut.removed = [w](const Eigen::Vector3d& q) { return w.beyond(q); };
-    (w.inner ? out_.inner_holes : out_.outer_holes).push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+    holes.push_back({cut.loop, cut.spacing, static_cast<int>(i)});
     const Eigen::Vector3d q = cut.loop[0];
-    const Eigen::Vector3d wall_normal = (w.inner ? 1.0 : -1.0) * Eigen::Vector3d(q.x(), q.y(), 0.0).normalized();
-    wedge(kPi - std::acos(std::clamp(((q - c) / r).dot(wall_normal), -1.0, 1.0)));
-    add_cut(i, std::move(cut), "union with the " + w.name(), beta_max);
+    wedge(kPi - std::acos(std::clamp(((q - c) / r).dot(-w.towards(q)), -1.0, 1.0)));
+    add_cut(i, std::move(cut), "union with the " + w.name, beta_max);
     const double rho = std::hypot(c.x(), c.y());
     const double inside = analysis::sphere_cylinder_volume(r, rho, c.z(), w.R, c.z() - r, c.z() + r);
     volume_ -= w.inner ? inside : 4.0 / 3.0 * kPi * r * r * r - inside;
@@ -350,14 +470,36 @@ class Treater {
     ++unions_;
   }
 
-  // Spheres must stay clear of the inlet and outlet planes.
+  // Spheres must stay clear of the inlet and outlet planes, or are cut by them when they clip.
   void ends(std::size_t i) {
-    const double z = bed_.centres[i].z(), r = out_.radius[i];
+    const double z = bed_.centres[i].z(), r = out_.radius[i], z0_ = planes_.z0, z1_ = planes_.z1;
+    if (planes_.clip) {
+      if (out_.kept[i] && z - r < z0_) clip(i, false);
+      if (out_.kept[i] && z + r > z1_) clip(i, true);
+      return;
+    }
     if (z - r <= z0_ || z + r >= z1_)
       throw InputError(fmt::format("sphere {} reaches the {} plane (surface.{}_length_d = {}); allowed: a longer "
                                    "empty section",
                                    i, z - r <= z0_ ? "inlet" : "outlet", z - r <= z0_ ? "inlet" : "outlet",
                                    z - r <= z0_ ? p_.inlet_length_d : p_.outlet_length_d));
+  }
+
+  // Sphere i cut by the inlet (outlet) clip plane: its loop, exactly in the plane, is a hole in
+  // that patch. The untreated reference loses the same cap of the untreated sphere.
+  void clip(std::size_t i, bool outlet) {
+    const Eigen::Vector3d& c = bed_.centres[i];
+    const double r = out_.radius[i], z = outlet ? planes_.z1 : planes_.z0, h = outlet ? z - c.z() : c.z() - z;
+    const Eigen::Vector3d a = outlet ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+    const double rho = std::sqrt(std::max(0.0, r * r - h * h));
+    plane_cut(i, a, h, rho, ring_points(rho, edge_c_), outlet ? "outlet clip plane" : "inlet clip plane",
+              Eigen::Vector3d(c.x(), c.y(), z));
+    const SphereCut& cut = out_.cuts[i].back();
+    (outlet ? out_.outlet_holes : out_.inlet_holes).push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+    const double r0 = 0.5 * bed_.diameters[i], H0 = std::clamp(r0 - h, 0.0, 2.0 * r0);
+    volume0_ -= cap_volume(r0, H0);
+    area0_ -= cap_area(r0, H0);
+    wedge(kPi - std::acos(std::clamp(((cut.loop[0] - c) / r).dot(-a), -1.0, 1.0)));
   }
 
   // The cuts on one sphere must not overlap: the angle between their axes must exceed the sum
@@ -379,8 +521,11 @@ class Treater {
 
   const Bed& bed_;
   const SurfaceParams& p_;
-  double z0_, z1_, d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
+  DomainPlanes planes_;
+  const Extents* survey_;
   std::vector<Wall> walls_;
+  Extents extents_;
+  double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
   TreatedBed out_;
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
   double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
@@ -390,11 +535,75 @@ class Treater {
   std::vector<std::vector<double>> cut_angle_;  // per sphere and cut, see add_cut
 };
 
+// The height within `shift` of `asked` nearest to it that lies `wanted` clear of every
+// obstacle (a z interval); failing that, the clearest one.
+struct ClipHeight {
+  double z, clearance;
+};
+ClipHeight clip_height(double asked, double shift, double wanted, const std::vector<std::pair<double, double>>& obstacles) {
+  std::vector<std::pair<double, double>> near;
+  for (const auto& o : obstacles)
+    if (o.second > asked - shift - wanted && o.first < asked + shift + wanted) near.push_back(o);
+  auto clearance = [&](double z) {
+    double c = std::numeric_limits<double>::infinity();
+    for (const auto& [lo, hi] : near) c = std::min(c, z < lo ? lo - z : z > hi ? z - hi : -std::min(z - lo, hi - z));
+    return c;
+  };
+  // Candidates: the asked height, the ends of the range, the midpoints between obstacle ends,
+  // and the points `wanted` away from each end (the nearest clear heights).
+  std::vector<double> ends{asked - shift, asked + shift}, candidates{asked, asked - shift, asked + shift};
+  for (const auto& [lo, hi] : near) ends.push_back(lo), ends.push_back(hi);
+  std::sort(ends.begin(), ends.end());
+  for (std::size_t k = 0; k + 1 < ends.size(); ++k) candidates.push_back(0.5 * (ends[k] + ends[k + 1]));
+  for (double e : ends) candidates.push_back(e - 1.001 * wanted), candidates.push_back(e + 1.001 * wanted);
+  ClipHeight best{asked, -std::numeric_limits<double>::infinity()}, nearest{asked, -1.0};
+  bool found = false;
+  for (double z : candidates) {
+    if (std::abs(z - asked) > shift) continue;
+    const double c = clearance(z);
+    if (c > best.clearance) best = {z, c};
+    if (c >= wanted && (!found || std::abs(z - asked) < std::abs(nearest.z - asked))) nearest = {z, c}, found = true;
+  }
+  return found ? nearest : best;
+}
+
 }  // namespace
 
-TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, double z0, double z1) {
+TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes) {
   if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
-  return Treater(bed, p, z0, z1).run();
+  if (!planes.clip) return Treater(bed, p, planes, nullptr).run();
+  // Survey the whole bed's contacts, place the clip planes clear of them and of every sphere's
+  // top and bottom, then treat the window.
+  const double inf = std::numeric_limits<double>::infinity();
+  Treater survey(bed, p, {-inf, inf, false}, nullptr);
+  const TreatedBed whole = survey.run();
+  const double d = sauter_mean(bed.diameters);
+  std::vector<std::pair<double, double>> obstacles;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const double z = bed.centres[i].z(), r = whole.radius[i];
+    obstacles.push_back({z - r, z - r}), obstacles.push_back({z + r, z + r});
+  }
+  for (const auto& [k, range] : survey.extents()) obstacles.push_back(range);
+  const DomainPlanes asked = planes;
+  nlohmann::json clip_report;
+  for (auto [z, name] : {std::pair<double*, const char*>{&planes.z0, "inlet"}, {&planes.z1, "outlet"}}) {
+    const ClipHeight h = clip_height(*z, p.clip_shift_d * d, p.clip_clearance_d * d, obstacles);
+    if (!(h.clearance >= p.clip_clearance_d * d))
+      throw InputError(fmt::format(
+          "surface.clip_window_d: the {} clip plane at {:.4g} d finds no height within surface.clip_shift_d = {} d "
+          "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom and every treated "
+          "contact (at best {:.3g} d, at {:.4g} d); allowed: a larger clip_shift_d, a smaller clip_clearance_d, or "
+          "a treatment that leaves no contact geometry (shrink, none)",
+          name, *z / d, p.clip_shift_d, p.clip_clearance_d, h.clearance / d, h.z / d));
+    *z = h.z;
+    clip_report[name] = {{"asked_d", (name[0] == 'i' ? asked.z0 : asked.z1) / d}, {"used_d", h.z / d},
+                         {"clearance_d", h.clearance / d}};
+  }
+  if (!(planes.z1 > planes.z0))
+    throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
+  TreatedBed out = Treater(bed, p, planes, &survey.extents()).run();
+  out.report["clip"] = clip_report;
+  return out;
 }
 
 }  // namespace bedforge::meshing

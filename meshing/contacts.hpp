@@ -11,25 +11,41 @@
 
 namespace bedforge::meshing {
 
+// The planes that bound the fluid domain below and above (m). With `clip` they cut the bed (a
+// height window of it); otherwise no sphere may reach them.
+struct DomainPlanes {
+  double z0 = 0.0, z1 = 0.0;
+  bool clip = false;
+};
+
 // The bed after its contact treatment, as pieces the surface is meshed from. Lengths in m.
 struct TreatedBed {
+  std::vector<char> kept;                         // per sphere: false when wholly outside a clip window (not meshed)
   std::vector<double> radius;                     // per sphere, after shrink or enlarge
   std::vector<std::vector<SphereCut>> cuts;       // per sphere: where its mesh stops
   std::vector<std::vector<std::string>> cut_names;  // per sphere and cut, for error messages ("sphere 7", "wall")
   std::vector<TriangleMesh> parts;                // cap disks and bridges, normals out of the solid
-  std::vector<WallHole> outer_holes, inner_holes;  // where the bed meets the walls
+  // Where the bed meets each wall of the container: cylinder {wall}, annulus {wall, inner
+  // wall}, box {x min, x max, y min, y max}; and where spheres cross the clip planes.
+  std::vector<std::vector<WallHole>> wall_holes;
+  std::vector<WallHole> inlet_holes, outlet_holes;
+  DomainPlanes planes;                            // as used: clip planes move off near-tangent spheres and contacts
   double solid_volume = 0.0;                      // exact volume of the treated solid (m^3)
   double min_wall_gap = 0.0;                      // narrowest gap left between a sphere and a wall (m)
   nlohmann::json report;                          // contacts treated, volume and area change, gaps, angles
 };
 
-// Contact treatment (section [contacts]) of `bed` in a cylinder or annulus whose fluid domain
-// runs from z0 to z1. Pairs and wall contacts closer than the treatment's gap tolerance get
+// Contact treatment (section [contacts]) of `bed` in a cylinder, annulus or walled box whose
+// fluid domain runs between `planes`. A clip plane moves (by up to surface.clip_shift_d) to the
+// height nearest the one asked for that lies surface.clip_clearance_d clear of every sphere's
+// top and bottom and of every treated contact; spheres crossing it are cut there, spheres and
+// contacts beyond it are left out. Pairs and wall contacts closer than the treatment's gap tolerance get
 // its geometry; every other gap is left as it is and the narrowest is reported. Volumes and
 // areas are exact (closed forms, or quadrature to 1e-10 for bridges to a curved wall and
 // spheres crossing one). InputError naming the particles when the treatment cannot give a
 // valid solid: contacts left touching, overlaps too deep, a bridge through a third sphere, a
-// sphere or bridge reaching the inlet or outlet plane, cuts on one sphere that overlap.
-TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, double z0, double z1);
+// sphere or bridge reaching an unclipped inlet or outlet plane, no clear height for a clip
+// plane, cuts on one sphere that overlap, a periodic box.
+TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes);
 
 }  // namespace bedforge::meshing

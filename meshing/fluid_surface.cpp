@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <numbers>
+#include <tuple>
 
 #include "analysis/void_fraction.hpp"
 #include "core/error.hpp"
@@ -49,6 +51,22 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
+  if (const std::vector<double> w = s.numbers("clip_window_d", Range::non_negative()); !w.empty()) {
+    if (w.size() != 2 || !(w[1] > w[0]))
+      throw InputError(fmt::format("surface.clip_window_d = [{}]: allowed: two heights above the floor in diameters, "
+                                   "bottom below top, e.g. [2.0, 8.0]",
+                                   fmt::join(w, ", ")));
+    for (const char* k : {"inlet_length_d", "outlet_length_d"})
+      if (s.has(k))
+        throw InputError(fmt::format("surface.{} with surface.clip_window_d: a clipped domain begins and ends at the "
+                                     "window's planes; allowed: one of the two",
+                                     k));
+    p.clip = true;
+    p.clip_bottom_d = w[0];
+    p.clip_top_d = w[1];
+  }
+  p.clip_shift_d = s.number("clip_shift_d", p.clip_shift_d, Range::closed(0.0, 1.0));
+  p.clip_clearance_d = s.number("clip_clearance_d", p.clip_clearance_d, Range::closed(0.0, 0.1));
   p.self_intersection_limit = s.integer("self_intersection_limit", p.self_intersection_limit, 0, 1'000'000'000);
   return p;
 }
@@ -66,23 +84,57 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"growth", p.growth},
           {"inlet_length_d", p.inlet_length_d},
           {"outlet_length_d", p.outlet_length_d},
+          {"clip_window_d", p.clip ? nlohmann::json::array({p.clip_bottom_d, p.clip_top_d}) : nlohmann::json(nullptr)},
+          {"clip_shift_d", p.clip_shift_d},
+          {"clip_clearance_d", p.clip_clearance_d},
           {"self_intersection_limit", p.self_intersection_limit}};
 }
+
+namespace {
+
+// Points along the axis-aligned edge from corner a to corner b, about `edge` apart, b left out.
+// Computed from the corners in one fixed order, so the faces that share an edge get
+// bit-identical vertices and weld.
+std::vector<Eigen::Vector3d> box_edge(Eigen::Vector3d a, Eigen::Vector3d b, double edge) {
+  const bool flip = std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3);
+  if (flip) std::swap(a, b);
+  const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / edge)));
+  std::vector<Eigen::Vector3d> pts;
+  for (int k = 0; k <= n; ++k) pts.push_back(k == n ? b : Eigen::Vector3d(a + (b - a) * (static_cast<double>(k) / n)));
+  if (flip) std::reverse(pts.begin(), pts.end());
+  pts.pop_back();
+  return pts;
+}
+
+std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>& corners, double edge) {
+  std::vector<Eigen::Vector3d> loop;
+  for (int k = 0; k < 4; ++k) {
+    const auto side = box_edge(corners[k], corners[(k + 1) % 4], edge);
+    loop.insert(loop.end(), side.begin(), side.end());
+  }
+  return loop;
+}
+
+}  // namespace
 
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
   const double d = sauter_mean(bed.diameters), edge = p.edge_length_d * d;
   const double top = analysis::bed_height(bed);
-  const double z0 = -p.inlet_length_d * d, z1 = top + p.outlet_length_d * d;
-  TreatedBed tb = treat_contacts(bed, p, z0, z1);
+  DomainPlanes planes{-p.inlet_length_d * d, top + p.outlet_length_d * d, p.clip};
+  if (p.clip) planes.z0 = p.clip_bottom_d * d, planes.z1 = p.clip_top_d * d;
+  TreatedBed tb = treat_contacts(bed, p, planes);
+  const double z0 = tb.planes.z0, z1 = tb.planes.z1;
   const Container& c = *bed.container;
   const auto* ann = dynamic_cast<const Annulus*>(&c);
-  const double R = ann ? ann->outer_radius() : dynamic_cast<const Cylinder&>(c).radius();
+  const auto* cyl = dynamic_cast<const Cylinder*>(&c);
+  const auto* box = dynamic_cast<const Box*>(&c);
+  const double R = ann ? ann->outer_radius() : cyl ? cyl->radius() : 0.0;
   const double r_in = ann ? ann->inner_radius() : 0.0;
 
-  // The wall is faceted between vertices on it: its facets lie inside it by up to the sagitta,
-  // which must stay below half the narrowest wall gap or a facet would come close to a sphere.
-  const double wall_sag = R * (1.0 - std::cos(std::numbers::pi / ring_points(R, edge)));
+  // A curved wall is faceted between vertices on it: its facets lie inside it by up to the
+  // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a sphere.
+  const double wall_sag = box ? 0.0 : R * (1.0 - std::cos(std::numbers::pi / ring_points(R, edge)));
   if (wall_sag >= 0.5 * tb.min_wall_gap)
     throw InputError(fmt::format("surface.edge_length_d = {}: the wall facets lie up to {:.3g} d inside the wall, more "
                                  "than half the narrowest gap left at the wall ({:.3g} d); allowed: a shorter edge or a "
@@ -96,6 +148,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   std::vector<std::string> failure(n);
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::size_t i = 0; i < n; ++i) {
+    if (!tb.kept[i]) continue;
     try {
       spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles");
       chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
@@ -108,25 +161,55 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   for (const auto& f : failure)
     if (!f.empty()) throw InputError(f);
 
-  // Container: walls with holes where the bed meets them, inlet and outlet sharing their edges.
-  auto walls = [&](double radius, const std::vector<WallHole>& holes, bool outward, const std::string& patch) {
-    try {
-      return wall_mesh(radius, z0, z1, edge, holes, p.growth, outward, patch);
-    } catch (const CutConflict& e) {
-      throw InputError(fmt::format("the {}: {}", patch, e.what()));
-    }
-  };
-  const WallMesh outer = walls(R, tb.outer_holes, true, "wall");
+  // Container: walls with holes where the bed meets them, inlet and outlet sharing their edges
+  // (with holes where spheres cross clip planes); what the holes cut out closes the bed solid.
   FluidSurface out;
   TriangleMesh& f = out.fluid;
-  f.append(outer.outside);
-  f.append(ring_mesh(Frame::along({0.0, 0.0, z0}, Eigen::Vector3d::UnitZ()), r_in, R, edge, false, "inlet"));
-  f.append(ring_mesh(Frame::along({0.0, 0.0, z1}, Eigen::Vector3d::UnitZ()), r_in, R, edge, true, "outlet"));
-  out.bed.append(outer.inside);
-  if (ann) {
-    const WallMesh inner = walls(r_in, tb.inner_holes, false, "inner_wall");
-    f.append(inner.outside);
-    out.bed.append(inner.inside);
+  auto add = [&](const std::string& what, const std::function<WallMesh()>& mesh) {
+    try {
+      const WallMesh m = mesh();
+      f.append(m.outside);
+      out.bed.append(m.inside);
+    } catch (const CutConflict& e) {
+      throw InputError(fmt::format("the {}: {}", what, e.what()));
+    }
+  };
+  const Frame bottom = Frame::along({0.0, 0.0, z0}, Eigen::Vector3d::UnitZ()),
+              above = Frame::along({0.0, 0.0, z1}, Eigen::Vector3d::UnitZ());
+  if (box) {
+    const double hx = 0.5 * box->size_x(), hy = 0.5 * box->size_y();
+    auto corner = [&](double sx, double sy, double z) { return Eigen::Vector3d(sx * hx, sy * hy, z); };
+    // Sides in the order of TreatedBed::wall_holes, each normal out of the fluid (+w).
+    const std::array<std::pair<Eigen::Vector3d, Eigen::Vector3d>, 4> sides{{{{-hx, 0.0, 0.0}, -Eigen::Vector3d::UnitX()},
+                                                                           {{hx, 0.0, 0.0}, Eigen::Vector3d::UnitX()},
+                                                                           {{0.0, -hy, 0.0}, -Eigen::Vector3d::UnitY()},
+                                                                           {{0.0, hy, 0.0}, Eigen::Vector3d::UnitY()}}};
+    for (int k = 0; k < 4; ++k) {
+      const double sx = k == 0 ? -1.0 : k == 1 ? 1.0 : 0.0, sy = k == 2 ? -1.0 : k == 3 ? 1.0 : 0.0;
+      // The side's corners: along the side's own direction from one end to the other.
+      const double ax = sx != 0.0 ? sx : -1.0, ay = sy != 0.0 ? sy : -1.0, bx = sx != 0.0 ? sx : 1.0, by = sy != 0.0 ? sy : 1.0;
+      const auto loop = box_face_loop({corner(ax, ay, z0), corner(bx, by, z0), corner(bx, by, z1), corner(ax, ay, z1)}, edge);
+      add("wall", [&] {
+        return plane_mesh(Frame::along(sides[k].first, sides[k].second), {loop}, edge, tb.wall_holes[k], p.growth, true,
+                          "wall");
+      });
+    }
+    for (auto [frame, z, holes, patch] : {std::tuple{bottom, z0, &tb.inlet_holes, "inlet"}, std::tuple{above, z1, &tb.outlet_holes, "outlet"}}) {
+      const auto loop = box_face_loop({corner(-1, -1, z), corner(1, -1, z), corner(1, 1, z), corner(-1, 1, z)}, edge);
+      add(patch, [&] { return plane_mesh(frame, {loop}, edge, *holes, p.growth, z == z1, patch); });
+    }
+  } else {
+    add("wall", [&] { return wall_mesh(R, z0, z1, edge, tb.wall_holes[0], p.growth, true, "wall"); });
+    if (ann) add("inner_wall", [&] { return wall_mesh(r_in, z0, z1, edge, tb.wall_holes[1], p.growth, false, "inner_wall"); });
+    for (auto [frame, holes, patch, up] : {std::tuple{bottom, &tb.inlet_holes, "inlet", false}, std::tuple{above, &tb.outlet_holes, "outlet", true}}) {
+      if (!p.clip) {
+        f.append(ring_mesh(frame, r_in, R, edge, up, patch));
+        continue;
+      }
+      std::vector<std::vector<Eigen::Vector3d>> boundary{circle_loop(frame, R, ring_points(R, edge))};
+      if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, edge)));
+      add(patch, [&] { return plane_mesh(frame, boundary, edge, *holes, p.growth, up, patch); });
+    }
   }
   // The bed solid (normals out of it), and the same pieces turned inside out for the fluid.
   TriangleMesh solid;
@@ -138,14 +221,15 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   f.weld();
   out.bed.weld();
 
-  const double domain = std::numbers::pi * (R * R - r_in * r_in) * (z1 - z0);
+  const double domain = c.cross_section_area() * (z1 - z0);
+  const double section = p.clip ? z1 - z0 : top;  // the bed's own height, or the window's
   const MeshQuality q = mesh_quality(f);
   out.report = tb.report;
   out.report["parameters"] = to_json(p);
   out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
   out.report["fluid_volume_exact_m3"] = domain - tb.solid_volume;
   out.report["void_fraction_bed_section_change"] =
-      -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * top);
+      -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
   out.report["chordal_deviation_d"] = *std::max_element(chordal.begin(), chordal.end()) / d;
   out.report["wall_sagitta_d"] = wall_sag / d;
   out.report["triangles"] = f.triangles.size();

@@ -26,6 +26,12 @@ struct SurfaceParams {
   double growth = 1.5;                  // edge growth per ring away from those loops
   double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
   double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
+  // Height window of the bed (above the floor, d) whose planes are the inlet and outlet,
+  // instead of the empty sections: the spheres crossing them are cut there.
+  bool clip = false;
+  double clip_bottom_d = 0.0, clip_top_d = 0.0;
+  double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
+  double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
   long self_intersection_limit = 5'000'000;  // triangles above which the CGAL self-intersection test is skipped
 };
 const char* treatment_name(SurfaceParams::Treatment t);
@@ -39,7 +45,7 @@ struct FluidSurface {
 };
 
 // Treats the contacts of `bed` and builds the fluid domain's surface: patches `inlet`,
-// `outlet`, `wall` (and `inner_wall` for an annulus), `particles`. InputError, naming the
+// `outlet`, `wall` (the four sides of a box; and `inner_wall` for an annulus), `particles`. InputError, naming the
 // particles, when the treatment leaves spheres overlapping or touching a wall, or when the
 // wall facets would cut into the gaps left; the report holds the treatment's effect (contacts
 // treated, solid volume and area change, smallest gap) and the surface's accuracy (chordal

@@ -1,14 +1,14 @@
 #include "meshing/wall_mesh.hpp"
 
-#include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
-#include <numeric>
 
+#include "meshing/planar_cdt.hpp"
 #include "meshing/primitives.hpp"
 #include "meshing/spaced_points.hpp"
 
@@ -16,58 +16,12 @@ namespace bedforge::meshing {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
-using Fb = CGAL::Constrained_triangulation_face_base_2<Kernel>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
-
 double wrap_2pi(double a) {
   a = std::fmod(a, 2.0 * std::numbers::pi);
   return a < 0.0 ? a + 2.0 * std::numbers::pi : a;
 }
 
 double wrap_pi(double a) { return wrap_2pi(a + std::numbers::pi) - std::numbers::pi; }
-
-bool inside_polygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& p) {
-  bool in = false;
-  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++)
-    if ((poly[i].y() > p.y()) != (poly[j].y() > p.y()) &&
-        p.x() < (poly[j].x() - poly[i].x()) * (p.y() - poly[i].y()) / (poly[j].y() - poly[i].y()) + poly[i].x())
-      in = !in;
-  return in;
-}
-
-// The closed polygon moved outward by `offset` along its vertex normals, resampled at `spacing`.
-std::vector<Eigen::Vector2d> offset_polygon(const std::vector<Eigen::Vector2d>& poly, double offset, double spacing,
-                                            bool stagger) {
-  const std::size_t n = poly.size();
-  double area = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto &a = poly[i], &b = poly[(i + 1) % n];
-    area += a.x() * b.y() - b.x() * a.y();
-  }
-  const double sense = area > 0.0 ? 1.0 : -1.0;  // outward normal of edge (dx, dy) is sense * (dy, -dx)
-  std::vector<Eigen::Vector2d> moved;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d e0 = (poly[i] - poly[(i + n - 1) % n]).normalized(), e1 = (poly[(i + 1) % n] - poly[i]).normalized();
-    const Eigen::Vector2d normal = sense * Eigen::Vector2d(e0.y() + e1.y(), -e0.x() - e1.x()).normalized();
-    moved.push_back(poly[i] + offset * normal);
-  }
-  return resample_loop(moved, spacing, stagger);
-}
-
-// Drops the vertices no triangle uses.
-void compact(TriangleMesh& m) {
-  std::vector<int> to(m.points.size(), -1);
-  std::vector<Eigen::Vector3d> kept;
-  for (auto& t : m.triangles)
-    for (int& v : t) {
-      if (to[v] < 0) to[v] = static_cast<int>(kept.size()), kept.push_back(m.points[v]);
-      v = to[v];
-    }
-  m.points = std::move(kept);
-}
 
 }  // namespace
 
@@ -155,29 +109,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
       }
     }
   }
-  // Holes by their lowest z, so a point is tested against the few that can hold it.
-  std::vector<std::array<double, 4>> boxes;  // s_min, s_max, z_min, z_max
-  double tallest = 0.0;
-  for (const auto& poly : polygons) {
-    std::array<double, 4> box{poly[0].x(), poly[0].x(), poly[0].y(), poly[0].y()};
-    for (const auto& q : poly) box = {std::min(box[0], q.x()), std::max(box[1], q.x()), std::min(box[2], q.y()), std::max(box[3], q.y())};
-    boxes.push_back(box);
-    tallest = std::max(tallest, box[3] - box[2]);
-  }
-  std::vector<std::size_t> by_z(polygons.size());
-  std::iota(by_z.begin(), by_z.end(), 0);
-  std::sort(by_z.begin(), by_z.end(), [&](std::size_t a, std::size_t b) { return boxes[a][2] < boxes[b][2]; });
-  std::vector<double> z_low;
-  for (std::size_t h : by_z) z_low.push_back(boxes[h][2]);
-  auto in_hole = [&](const Eigen::Vector2d& q) {
-    const auto first = std::lower_bound(z_low.begin(), z_low.end(), q.y() - tallest) - z_low.begin();
-    for (auto k = first; k < static_cast<long>(z_low.size()) && z_low[k] <= q.y(); ++k) {
-      const std::size_t h = by_z[k];
-      if (q.x() >= boxes[h][0] && q.x() <= boxes[h][1] && q.y() <= boxes[h][3] && inside_polygon(polygons[h], q))
-        return true;
-    }
-    return false;
-  };
+  const PolygonIndex hole_index(polygons);
+  auto in_hole = [&](const Eigen::Vector2d& q) { return hole_index.contains(q); };
   auto try_add = [&](Eigen::Vector2d q, double spacing) {
     q.x() = R * wrap_2pi(q.x() / R);
     if (q.y() < z0 + 0.4 * spacing || q.y() > z1 - 0.4 * spacing) return;
@@ -197,24 +130,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
       try_add(Eigen::Vector2d(R * ((j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row_z(k)), step);
 
   // 4. Constrained Delaunay triangulation of the strip; faces inside a hole go to `inside`.
-  // Inserted row by row, back and forth, so each point is found from the previous one in a
-  // few steps (hole loops come in bed order, which jumps about).
-  std::vector<std::size_t> order(uv.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto row = [&](std::size_t i) { return static_cast<long>(std::floor((uv[i].y() - z0) / step)); };
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const long ra = row(a), rb = row(b);
-    if (ra != rb) return ra < rb;
-    return ra % 2 == 0 ? uv[a].x() < uv[b].x() : uv[a].x() > uv[b].x();
-  });
   Cdt cdt;
-  std::vector<Cdt::Vertex_handle> handle(uv.size());
-  Cdt::Face_handle hint;
-  for (std::size_t i : order) {
-    handle[i] = cdt.insert(Kernel::Point_2(uv[i].x(), uv[i].y()), hint);
-    handle[i]->info() = static_cast<int>(i);
-    hint = handle[i]->face();
-  }
+  const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, uv, step);
   for (const auto& sites : loop_sites)
     for (std::size_t k = 0; k < sites.size(); ++k)
       cdt.insert_constraint(handle[sites[k]], handle[sites[(k + 1) % sites.size()]]);
@@ -242,7 +159,94 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
       const Eigen::Vector3d radial(q.x(), q.y(), 0.0);
       return outward ? radial : Eigen::Vector3d(-radial);
     });
-    compact(*m);
+    drop_unused_points(*m);
+  }
+  return out;
+}
+
+WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch) {
+  auto local = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - f.origin).dot(f.u), (p - f.origin).dot(f.v)); };
+  std::vector<Eigen::Vector3d> points;  // 3D vertices, one per site
+  std::vector<Eigen::Vector2d> uv;      // their sites
+  SpacedPoints spaced(edge);
+  auto add_vertex = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& q, double spacing) {
+    points.push_back(p), uv.push_back(q);
+    spaced.add(Eigen::Vector3d(q.x(), q.y(), 0.0), spacing);
+  };
+  // 1. Fixed vertices: the boundary loops (with samples between their vertices, so nothing is
+  // placed too close to a boundary edge) and the hole loops.
+  std::vector<std::vector<Eigen::Vector2d>> outline, polygons;
+  std::vector<std::vector<int>> loops;  // constrained loops, as site indices
+  for (const auto& loop : boundary) {
+    outline.emplace_back(), loops.emplace_back();
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const Eigen::Vector2d a = local(loop[k]), b = local(loop[(k + 1) % loop.size()]);
+      const double spacing = std::min(edge, (b - a).norm());
+      outline.back().push_back(a);
+      loops.back().push_back(static_cast<int>(uv.size()));
+      add_vertex(loop[k], a, spacing);
+      for (double t : {0.25, 0.5, 0.75}) spaced.add(Eigen::Vector3d(a.x() + t * (b.x() - a.x()), a.y() + t * (b.y() - a.y()), 0.0), spacing);
+    }
+  }
+  auto in_region = [&](const Eigen::Vector2d& q) {
+    if (!inside_polygon(outline[0], q)) return false;
+    for (std::size_t k = 1; k < outline.size(); ++k)
+      if (inside_polygon(outline[k], q)) return false;
+    return true;
+  };
+  for (const auto& hole : holes) {
+    polygons.emplace_back(), loops.emplace_back();
+    for (const auto& p : hole.loop) {
+      const Eigen::Vector2d q = local(p);
+      if (!in_region(q)) throw CutConflict(fmt::format("a hole (particle {}) reaches the edge of the {}", hole.particle, patch));
+      polygons.back().push_back(q);
+      loops.back().push_back(static_cast<int>(uv.size()));
+      add_vertex(p, q, std::min(hole.spacing, edge));
+    }
+  }
+  const PolygonIndex hole_index(polygons);
+  auto try_add = [&](const Eigen::Vector2d& q, double spacing) {
+    const Eigen::Vector3d s(q.x(), q.y(), 0.0);
+    if (!in_region(q) || hole_index.contains(q) || !spaced.fits(s, spacing)) return;
+    add_vertex(f.to_world(s), q, spacing);
+  };
+  // 2. Rings graded away from the holes.
+  std::vector<double> spacing;
+  for (const auto& hole : holes) spacing.push_back(hole.spacing);
+  graded_rings(spacing, edge, growth, [&](std::size_t h, int ring, double offset, double next) {
+    for (const auto& q : offset_polygon(polygons[h], offset, next, ring % 2 == 1)) try_add(q, next);
+  });
+  // 3. The staggered lattice over the outer loop's bounding box.
+  Eigen::Vector2d lo = outline[0][0], hi = lo;
+  for (const auto& q : outline[0]) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  const double row = std::sqrt(3.0) / 2.0 * edge;
+  for (int k = 0; lo.y() + k * row <= hi.y(); ++k)
+    for (int j = 0; lo.x() + (j + 0.5 * (k % 2)) * edge <= hi.x(); ++j)
+      try_add(Eigen::Vector2d(lo.x() + (j + 0.5 * (k % 2)) * edge, lo.y() + k * row), edge);
+
+  // 4. Constrained Delaunay triangulation; faces inside a hole go to `inside`.
+  Cdt cdt;
+  const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, uv, edge);
+  for (const auto& loop : loops)
+    for (std::size_t k = 0; k < loop.size(); ++k) cdt.insert_constraint(handle[loop[k]], handle[loop[(k + 1) % loop.size()]]);
+  WallMesh out;
+  out.outside.points = out.inside.points = points;
+  for (auto fh : cdt.finite_face_handles()) {
+    std::array<int, 3> t;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      t[k] = fh->vertex(k)->info();
+      centroid += uv[t[k]] / 3.0;
+    }
+    if (!in_region(centroid)) continue;
+    (hole_index.contains(centroid) ? out.inside : out.outside).triangles.push_back(t);
+  }
+  for (TriangleMesh* m : {&out.outside, &out.inside}) {
+    m->patch.assign(m->triangles.size(), 0);
+    m->patches = {patch};
+    orient_by(*m, [&](const Eigen::Vector3d&) { return along_w ? f.w : Eigen::Vector3d(-f.w); });
+    drop_unused_points(*m);
   }
   return out;
 }

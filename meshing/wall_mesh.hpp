@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "meshing/primitives.hpp"
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -31,5 +32,17 @@ struct WallMesh {
 // strip's ends or no generator is clear of the holes.
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
                    bool outward, const std::string& patch);
+
+// Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
+// the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the
+// plane shared with the faces next to this one, and constraints; hole loops are shared with the
+// parts that meet the face. Vertices as in wall_mesh: the loops, rings graded away from the
+// holes, a staggered lattice of spacing about `edge`, none closer than 0.8 x the mean spacing
+// to another or to a boundary edge; then a constrained Delaunay triangulation (no vertex is
+// added). Normals +w if `along_w`. CutConflict when a hole vertex lies outside the face. A
+// hole may come as close to the boundary as its own loop's chords allow (a sphere 0.005 d off
+// the wall): the triangles in that gap are as narrow as the gap.
+WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch);
 
 }  // namespace bedforge::meshing

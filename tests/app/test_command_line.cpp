@@ -287,5 +287,20 @@ TEST(CommandLine, SurfaceStageOnAPackedBed) {
   const Result bad = bedforge("surface " + dir.string() + " --contacts glue");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.output.find("contacts.treatment"), std::string::npos) << bad.output;
+  // A clip window replaces the empty sections: the domain runs between its planes, each within
+  // clip_shift_d (0.25 d) of where it was asked.
+  const Result clip = bedforge("--quiet surface " + dir.string() + " --clip-window-d 1 3 --edge-length-d 0.15");
+  ASSERT_EQ(clip.status, 0) << clip.output;
+  std::ifstream clipped(dir / "report.json");
+  const auto s = nlohmann::json::parse(clipped)["stages"]["surface"];
+  EXPECT_EQ(s["check"]["closed"], true);
+  // The domain's planes (m) stand in the ratio of the window's used heights (d).
+  EXPECT_NEAR(s["domain_m"]["outlet_z"].get<double>() / s["domain_m"]["inlet_z"].get<double>(),
+              s["clip"]["outlet"]["used_d"].get<double>() / s["clip"]["inlet"]["used_d"].get<double>(), 1e-9);
+  EXPECT_NEAR(s["clip"]["inlet"]["used_d"].get<double>(), 1.0, 0.25);
+  EXPECT_NEAR(s["clip"]["outlet"]["used_d"].get<double>(), 3.0, 0.25);
+  const Result reversed = bedforge("surface " + dir.string() + " --clip-window-d 3 1");
+  EXPECT_EQ(reversed.status, 2);
+  EXPECT_NE(reversed.output.find("surface.clip_window_d"), std::string::npos) << reversed.output;
 }
 #endif

@@ -86,9 +86,7 @@ using Treatment = SurfaceParams::Treatment;
 // The surface of `b` under treatment `t` must be closed, free of self-intersections, and
 // enclose the exact fluid volume within the discretisation: the chordal deviation over the
 // particle area plus the wall sagitta over the wall area bound the deficit.
-FluidSurface valid_surface(const Bed& b, Treatment t, const std::string& label) {
-  SurfaceParams p;
-  p.treatment = p.wall_treatment = t;
+FluidSurface valid_surface(const Bed& b, const SurfaceParams& p, const std::string& label) {
   const FluidSurface fs = build_fluid_surface(b, p);
   const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
   EXPECT_TRUE(k.manifold && k.closed) << label << ": " << k.defects.size() << " defective edges";
@@ -109,6 +107,12 @@ FluidSurface valid_surface(const Bed& b, Treatment t, const std::string& label) 
   return fs;
 }
 
+FluidSurface valid_surface(const Bed& b, Treatment t, const std::string& label) {
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = t;
+  return valid_surface(b, p, label);
+}
+
 Bed column(std::shared_ptr<Container> c, std::vector<Eigen::Vector3d> centres) {
   Bed b;
   b.container = std::move(c);
@@ -127,8 +131,9 @@ TEST(FluidSurface, EveryTreatmentHandlesTouchingNearlyTouchingAndWallTangentSphe
   const Bed b = column(std::make_shared<Cylinder>(1.5), {{0, 0, 0.6}, {0, 0, 1.6}, {0.0, 0.0, 2.600001}, {0, 1.0, 1.6}});
   for (const auto& [t, name] : kAll) {
     const FluidSurface fs = valid_surface(b, t, name);
-    if (t != Treatment::enlarge)
+    if (t != Treatment::enlarge) {
       EXPECT_GE(fs.report["contacts_treated"]["particle_wall"].get<long>(), 1) << name;
+    }
     EXPECT_GT(fs.report["smallest_gap_d"]["particle_particle"].get<double>(), 0.0) << name;
   }
 }
@@ -194,4 +199,125 @@ TEST(FluidSurface, TheSameBedGivesTheSameSurface) {
   const FluidSurface first = build_fluid_surface(b, p), second = build_fluid_surface(b, p);
   EXPECT_EQ(first.fluid.points, second.fluid.points);
   EXPECT_EQ(first.fluid.triangles, second.fluid.triangles);
+}
+
+namespace {
+
+// Layers of spheres touching each other and the walls of a box of 2 x 2 d: four per layer at
+// (+-0.5, +-0.5), the layers touching too.
+Bed box_stack(int layers) {
+  std::vector<Eigen::Vector3d> c;
+  for (int k = 0; k < layers; ++k)
+    for (double x : {-0.5, 0.5})
+      for (double y : {-0.5, 0.5}) c.emplace_back(x, y, 0.5 + k);
+  return column(std::make_shared<Box>(2.0, 2.0, false, false), c);
+}
+
+// Two spheres per layer touching each other and the wall of a tube of a = 2, each layer turned
+// by 90 degrees and 0.75 d above the last (gaps of 0.03 d between layers).
+Bed twisted_column(int layers) {
+  std::vector<Eigen::Vector3d> c;
+  for (int k = 0; k < layers; ++k)
+    for (double s : {-0.5, 0.5}) c.emplace_back(k % 2 ? 0.0 : s, k % 2 ? s : 0.0, 0.5 + 0.75 * k);
+  return column(std::make_shared<Cylinder>(1.0), c);
+}
+
+// Exact volume of the spheres (radius r) between the planes z0 and z1.
+double spheres_between(const Bed& b, double r, double z0, double z1) {
+  double v = 0.0;
+  for (const auto& c : b.centres) {
+    const double lo = std::max(z0, c.z() - r) - c.z(), hi = std::min(z1, c.z() + r) - c.z();
+    if (hi > lo) v += std::numbers::pi * (r * r * (hi - lo) - (hi * hi * hi - lo * lo * lo) / 3.0);
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST(FluidSurface, BoxWallsTakeEveryTreatment) {
+  // Every sphere touches two walls and its neighbours: the box's flat sides take bridges, caps
+  // and unions like the cylinder's wall, and the sides, inlet and outlet share their edges.
+  const Bed b = box_stack(2);
+  for (const auto& [t, name] : kAll) {
+    const FluidSurface fs = valid_surface(b, t, "box, " + name);
+    EXPECT_EQ(fs.report["contacts_treated"]["particle_wall"].get<long>(), 16) << name;
+  }
+  // Shrink: the exact volume is the box less the shrunk spheres.
+  const FluidSurface fs = build_fluid_surface(b, {});
+  EXPECT_NEAR(fs.report["fluid_volume_exact_m3"].get<double>(),
+              4.0 * (2.0 + 2.0) - 8 * 4.0 / 3.0 * std::numbers::pi * std::pow(0.495, 3), 1e-12);
+}
+
+TEST(FluidSurface, APeriodicBoxIsRefusedNamingTheField) {
+  Bed b = box_stack(1);
+  b.container = std::make_shared<Box>(2.0, 2.0, true, false);
+  try {
+    build_fluid_surface(b, {});
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("periodic_x"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FluidSurface, AClipWindowCutsTheSpheresAtItsPlanes) {
+  const Bed b = twisted_column(8);
+  SurfaceParams p;
+  p.clip = true;
+  p.clip_bottom_d = 1.3;
+  p.clip_top_d = 4.1;
+  const FluidSurface fs = valid_surface(b, p, "clip, shrink");
+  const double z0 = fs.report["domain_m"]["inlet_z"].get<double>(), z1 = fs.report["domain_m"]["outlet_z"].get<double>();
+  // Each plane moved by at most clip_shift_d, to a height clear of every sphere's top and bottom.
+  EXPECT_LE(std::abs(z0 - 1.3), p.clip_shift_d + 1e-12);
+  EXPECT_LE(std::abs(z1 - 4.1), p.clip_shift_d + 1e-12);
+  for (const auto& c : b.centres)
+    for (double e : {c.z() - 0.495, c.z() + 0.495})
+      for (double z : {z0, z1}) EXPECT_GE(std::abs(z - e), p.clip_clearance_d) << "plane " << z << ", sphere end " << e;
+  // The exact fluid volume is the tube between the planes less the shrunk spheres' slices.
+  EXPECT_NEAR(fs.report["fluid_volume_exact_m3"].get<double>(),
+              std::numbers::pi * (z1 - z0) - spheres_between(b, 0.495, z0, z1), 1e-12);
+  // The spheres crossing a plane make holes in the inlet and outlet: less area than the disk.
+  double inlet = 0.0;
+  for (std::size_t t = 0; t < fs.fluid.triangles.size(); ++t)
+    if (fs.fluid.patches[fs.fluid.patch[t]] == "inlet") {
+      const auto& tri = fs.fluid.triangles[t];
+      inlet += 0.5 * (fs.fluid.points[tri[1]] - fs.fluid.points[tri[0]]).cross(fs.fluid.points[tri[2]] - fs.fluid.points[tri[0]]).norm();
+    }
+  double cut = 0.0;
+  for (const auto& c : b.centres)
+    if (std::abs(c.z() - z0) < 0.495) cut += std::numbers::pi * (0.495 * 0.495 - std::pow(c.z() - z0, 2));
+  EXPECT_GT(cut, 0.0);
+  EXPECT_NEAR(inlet, std::numbers::pi - cut, 0.01 * std::numbers::pi);
+}
+
+TEST(FluidSurface, AClipPlaneMovesOffBridgedContacts) {
+  // Asked through the contacts at z = 2.0: with bridges (0.2 d wide) the plane moves clear of
+  // them by clip_clearance_d. In the tube they are horizontal, so reach 0.1 d above and below,
+  // and the bridges to the wall also keep 0.6 edge (0.06 d) from the wall's ends; in the box
+  // they are vertical, and the cap each cuts off its sphere reaches 0.5 - sqrt(0.24) d.
+  for (auto [b, reach] : {std::pair{twisted_column(6), 0.16}, std::pair{box_stack(4), 0.5 - std::sqrt(0.24)}}) {
+    SurfaceParams p;
+    p.treatment = p.wall_treatment = Treatment::bridge;
+    p.clip = true;
+    p.clip_bottom_d = 0.9;
+    p.clip_top_d = 2.0;
+    const FluidSurface fs = valid_surface(b, p, "clip, bridge, " + b.container->kind());
+    const double z1 = fs.report["domain_m"]["outlet_z"].get<double>();
+    EXPECT_GE(std::abs(z1 - 2.0), reach + p.clip_clearance_d - 1e-9) << b.container->kind();
+    EXPECT_LE(std::abs(z1 - 2.0), reach + 1.01 * p.clip_clearance_d) << b.container->kind() << ": the nearest clear height";
+    EXPECT_GT(fs.report["contacts_treated"]["particle_particle"].get<long>(), 0);
+  }
+  // A tight window around a layer's contacts with no room to move: a clear error.
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::bridge;
+  p.clip = true;
+  p.clip_bottom_d = 0.9;
+  p.clip_top_d = 2.0;
+  p.clip_shift_d = 0.01;
+  try {
+    build_fluid_surface(box_stack(4), p);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("clip_window_d"), std::string::npos) << e.what();
+  }
 }

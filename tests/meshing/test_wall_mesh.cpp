@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "meshing/primitives.hpp"
 #include "meshing/surface_checks.hpp"
@@ -79,4 +80,44 @@ TEST(WallMesh, HolesAreCutExactlyAndFilledByInside) {
 
 TEST(WallMesh, HoleReachingAnEndIsRefused) {
   EXPECT_THROW(wall_mesh(1.0, 0.0, 1.5, 0.1, {radial_hole(1.0, 1.0, 0.05, 0.1, 0.025)}, 1.3, true, "wall"), CutConflict);
+}
+
+namespace {
+
+double area(const TriangleMesh& m, const Eigen::Vector3d& normal) {
+  double a = 0.0;
+  for (const auto& t : m.triangles) a += 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).dot(normal);
+  return a;
+}
+
+}  // namespace
+
+TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
+  // A 2 x 1 face in the plane x = 0.5 with two circular holes, one 0.002 from the edge: the
+  // outside and inside cover the face, the inside is exactly the holes' polygons, every triangle
+  // faces +w.
+  const Frame f = Frame::along({0.5, 0.0, 0.0}, Eigen::Vector3d::UnitX());
+  std::vector<Eigen::Vector3d> boundary;
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  std::vector<WallHole> holes;
+  double hole_area = 0.0;
+  for (auto [y, z, rho] : {std::tuple{-0.4, 0.5, 0.3}, std::tuple{0.5, 0.198, 0.196}}) {
+    const int n = ring_points(rho, 0.03);
+    holes.push_back({circle_loop(Frame::along({0.5, y, z}, Eigen::Vector3d::UnitX()), rho, n), 2 * kPi * rho / n, 0});
+    hole_area += 0.5 * n * rho * rho * std::sin(2 * kPi / n);
+  }
+  const WallMesh m = plane_mesh(f, {boundary}, 0.1, holes, 1.5, true, "wall");
+  EXPECT_NEAR(area(m.outside, f.w) + area(m.inside, f.w), 2.0, 1e-12);
+  EXPECT_NEAR(area(m.inside, f.w), hole_area, 1e-12);
+  for (const TriangleMesh* part : {&m.outside, &m.inside})
+    for (const auto& t : part->triangles) {
+      EXPECT_GT((part->points[t[1]] - part->points[t[0]]).cross(part->points[t[2]] - part->points[t[0]]).dot(f.w), 0.0);
+      for (int v : t) EXPECT_EQ(part->points[v].x(), 0.5) << "generated vertices lie exactly in the plane";
+    }
+  // A hole beyond the edge is refused.
+  holes[1].loop = circle_loop(Frame::along({0.5, 0.95, 0.5}, Eigen::Vector3d::UnitX()), 0.1, 21);
+  EXPECT_THROW(plane_mesh(f, {boundary}, 0.1, holes, 1.5, true, "wall"), CutConflict);
 }
