@@ -208,7 +208,7 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
       meshing::write_vtp(out, built->fluid, "bedforge " + version + " fluid-domain surface, lengths in m");
     });
   }
-  const std::string line = fmt::format(
+  std::string line = fmt::format(
       "surface ({}, {} contacts treated): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, "
       "min angle {:.1f} deg, smallest gap {:.3g} d",
       j["parameters"]["treatment"].get<std::string>(),
@@ -218,6 +218,9 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
       j["fluid_volume_relative_error"].get<double>(), j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
       std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()));
+  if (j.contains("clip"))
+    line += fmt::format(", clipped at {:.3f}-{:.3f} d", j["clip"]["inlet"]["used_d"].get<double>(),
+                        j["clip"]["outlet"]["used_d"].get<double>());
   finish_stage(j, meter, line, console);
   report.set_stage("surface", j);
   return built;
