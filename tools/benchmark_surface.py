@@ -4,6 +4,7 @@ writes docs/surface_benchmark.md and .json.
 
     /usr/bin/python3 tools/benchmark_surface.py                 # N = 500, 2000, 10000
     /usr/bin/python3 tools/benchmark_surface.py --counts 500 2000
+    /usr/bin/python3 tools/benchmark_surface.py --counts 10000 --keep   # adds N = 1e4 to the rows there
 
 Beds: `bedforge pack --aspect-ratio 5 --count N --seed 1` (soft sphere, accelerated). Each
 treatment is a real `bedforge surface DIR --contacts T` on a copy of the bed, timed from outside
@@ -35,8 +36,12 @@ def timed(cmd):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--counts", type=int, nargs="+", default=[500, 2000, 10000])
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the rows of docs/surface_benchmark.json for the counts not run now")
     args = ap.parse_args()
     rows = []
+    if args.keep and os.path.exists(os.path.join(DOCS, "surface_benchmark.json")):
+        rows = [r for r in json.load(open(os.path.join(DOCS, "surface_benchmark.json"))) if r["n"] not in args.counts]
     with tempfile.TemporaryDirectory() as tmp:
         for n in args.counts:
             bed = os.path.join(tmp, f"bed{n}")
