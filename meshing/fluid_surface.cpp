@@ -211,13 +211,20 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       add(patch, [&] { return plane_mesh(frame, boundary, edge, *holes, p.growth, up, patch); });
     }
   }
-  // The bed solid (normals out of it), and the same pieces turned inside out for the fluid.
-  TriangleMesh solid;
-  for (const auto& m : spheres) solid.append(m);
-  for (const auto& m : tb.parts) solid.append(m);
-  out.bed.append(solid);
-  for (auto& t : solid.triangles) std::swap(t[1], t[2]);
-  f.append(solid);
+  // The bed solid (normals out of it), and the same pieces turned inside out for the fluid;
+  // each piece is released once appended (at N = 1e4 the pieces are gigabytes).
+  std::size_t points = 0, triangles = 0;
+  for (const auto* pieces : {&spheres, &tb.parts})
+    for (const auto& m : *pieces) points += m.points.size(), triangles += m.triangles.size();
+  f.reserve(points, triangles);
+  out.bed.reserve(points, triangles);
+  for (auto* pieces : {&spheres, &tb.parts})
+    for (auto& m : *pieces) {
+      out.bed.append(m);
+      for (auto& t : m.triangles) std::swap(t[1], t[2]);
+      f.append(m);
+      m = TriangleMesh();
+    }
   f.weld();
   out.bed.weld();
 

@@ -30,9 +30,10 @@ void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {
     for (std::size_t k = 0; k < m.triangles.size(); ++k)
       if (m.patch[k] == static_cast<int>(p)) mine.push_back(k);
     for (std::size_t first = 0; first < mine.size(); first += kChunk * kBatch) {
-      std::vector<std::string> chunks(kBatch);
+      std::vector<fmt::memory_buffer> chunks(kBatch);  // fmt writes into its own buffer directly
 #pragma omp parallel for schedule(dynamic)
       for (std::size_t c = 0; c < kBatch; ++c) {
+        chunks[c].reserve(kChunk * 280);  // about 260 characters a facet
         auto it = std::back_inserter(chunks[c]);
         const std::size_t lo = first + c * kChunk, hi = std::min(mine.size(), lo + kChunk);
         for (std::size_t i = lo; i < hi; ++i) {
@@ -44,7 +45,7 @@ void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {
           fmt::format_to(it, "    endloop\n  endfacet\n");
         }
       }
-      for (const auto& c : chunks) out << c;
+      for (const auto& c : chunks) out.write(c.data(), static_cast<std::streamsize>(c.size()));
     }
     out << "endsolid " << m.patches[p] << "\n";
   }

@@ -10,7 +10,7 @@
 
 #include <algorithm>
 #include <tuple>
-#include <unordered_map>
+#include <cstdint>
 
 namespace bedforge::meshing {
 
@@ -28,25 +28,25 @@ nlohmann::json SurfaceCheck::to_json() const {
 
 SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) {
   SurfaceCheck out;
-  std::vector<Kernel::Point_3> points;
-  points.reserve(m.points.size());
-  for (const auto& p : m.points) points.emplace_back(p.x(), p.y(), p.z());
-  std::vector<std::vector<std::size_t>> polygons;
-  polygons.reserve(m.triangles.size());
-  for (const auto& t : m.triangles) polygons.push_back({std::size_t(t[0]), std::size_t(t[1]), std::size_t(t[2])});
-  // Step 0: every edge used once in each direction.
-  std::unordered_map<long, std::pair<int, int>> uses;  // edge -> (triangles, sum of directions)
-  for (std::size_t t = 0; t < m.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const long a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
-      auto& u = uses[std::min(a, b) << 32 | std::max(a, b)];
-      ++u.first, u.second += a < b ? 1 : -1;
-    }
-  for (const auto& [key, u] : uses)
-    if (u.first != 2 || u.second != 0) {
-      const Eigen::Vector3d at = 0.5 * (m.points[key >> 32] + m.points[key & 0xffffffffL]);
-      out.defects.push_back({at, u.first});
-    }
+  // Step 0: every edge used once in each direction. Directed edges a -> b, sorted (a hash map
+  // of 27 M edges at N = 1e4 took gigabytes and a malloc per edge).
+  std::vector<std::uint64_t> half;
+  half.reserve(3 * m.triangles.size());
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) half.push_back(std::uint64_t(t[k]) << 32 | std::uint32_t(t[(k + 1) % 3]));
+  std::sort(half.begin(), half.end());
+  auto uses = [&](std::uint64_t key) {
+    const auto r = std::equal_range(half.begin(), half.end(), key);
+    return static_cast<int>(r.second - r.first);
+  };
+  for (std::size_t i = 0, j = 0; i < half.size(); i = j) {
+    while (j < half.size() && half[j] == half[i]) ++j;
+    const std::uint64_t a = half[i] >> 32, b = half[i] & 0xffffffffULL;
+    const int forward = static_cast<int>(j - i), back = uses(b << 32 | a);
+    // Each undirected edge once: from its smaller end, or from its only direction.
+    if ((forward != 1 || back != 1) && (a < b || back == 0))
+      out.defects.push_back({0.5 * (m.points[a] + m.points[b]), forward + back});
+  }
   std::sort(out.defects.begin(), out.defects.end(), [](const auto& a, const auto& b) {
     return std::tie(a.at.x(), a.at.y(), a.at.z()) < std::tie(b.at.x(), b.at.y(), b.at.z());
   });

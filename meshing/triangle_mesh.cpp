@@ -22,11 +22,19 @@ int TriangleMesh::patch_index(const std::string& name) {
 void TriangleMesh::append(const TriangleMesh& other) {
   const int offset = static_cast<int>(points.size());
   points.insert(points.end(), other.points.begin(), other.points.end());
+  std::vector<int> to;  // other's patch indices -> ours
+  for (const auto& name : other.patches) to.push_back(patch_index(name));
   for (std::size_t t = 0; t < other.triangles.size(); ++t) {
     const auto& tri = other.triangles[t];
     triangles.push_back({tri[0] + offset, tri[1] + offset, tri[2] + offset});
-    patch.push_back(patch_index(other.patches[other.patch[t]]));
+    patch.push_back(to[other.patch[t]]);
   }
+}
+
+void TriangleMesh::reserve(std::size_t more_points, std::size_t more_triangles) {
+  points.reserve(points.size() + more_points);
+  triangles.reserve(triangles.size() + more_triangles);
+  patch.reserve(patch.size() + more_triangles);
 }
 
 void TriangleMesh::weld() {
@@ -44,6 +52,7 @@ void TriangleMesh::weld() {
   index.reserve(points.size());
   std::vector<int> to(points.size());
   std::vector<Eigen::Vector3d> kept;
+  kept.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     Bits key;
     for (int k = 0; k < 3; ++k) key.b[k] = std::bit_cast<std::uint64_t>(points[i][k] == 0.0 ? 0.0 : points[i][k]);

@@ -21,6 +21,8 @@ struct TriangleMesh {
   int patch_index(const std::string& name);  // adds the name when new
   // Appends `other`, renumbering its vertices and patches.
   void append(const TriangleMesh& other);
+  // Room for that many more, so appending pieces does not reallocate (and briefly double) the mesh.
+  void reserve(std::size_t more_points, std::size_t more_triangles);
   // Merges vertices with bit-identical coordinates: parts meshed on their own with shared seam
   // vertices become one connected mesh.
   void weld();

@@ -28,7 +28,16 @@ double wrap_pi(double a) { return wrap_2pi(a + std::numbers::pi) - std::numbers:
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
                    bool outward, const std::string& patch) {
   const int n = ring_points(R, edge);
-  const double step = 2.0 * std::numbers::pi * R / n, period = 2.0 * std::numbers::pi * R, margin = 3.0 * step;
+  // Sites lie on a dyadic grid in s whose step divides the period, so a site's copy one period
+  // on is its exact translate: the exact predicates then see the two ends of the strip alike
+  // (with rounded copies, cocircular hole loops were triangulated differently at each end).
+  const double quantum = std::ldexp(1.0, std::ilogb(2.0 * std::numbers::pi * R) - 36);
+  auto on_grid = [quantum](Eigen::Vector2d q) {
+    q.x() = std::round(q.x() / quantum) * quantum;
+    return q;
+  };
+  const double step = 2.0 * std::numbers::pi * R / n, period = on_grid({2.0 * std::numbers::pi * R, 0.0}).x(),
+               margin = 3.0 * step;
   const int nz = 2 * std::max(1, static_cast<int>(std::ceil((z1 - z0) / (std::sqrt(3.0) * step))));
   auto row_z = [&](int k) { return k == nz ? z1 : z0 + (z1 - z0) * k / nz; };
   auto row_frame = [&](int k) { return Frame::along(Eigen::Vector3d(0.0, 0.0, row_z(k)), Eigen::Vector3d::UnitZ()); };
@@ -47,7 +56,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     uv.push_back(q), vertex.push_back(v), copy.push_back(shifted);
   };
   // A vertex, its site, and its copy one period away when it lies within the margin of an end.
-  auto add_vertex = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& q, double spacing, bool copies) {
+  auto add_vertex = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& at, double spacing, bool copies) {
+    const Eigen::Vector2d q = on_grid(at);
     points.push_back(p);
     const int v = static_cast<int>(points.size()) - 1;
     add_site(q, v, 0);
@@ -56,8 +66,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     if (copies && q.x() > period - margin) add_site(q - Eigen::Vector2d(period, 0.0), v, -1);
   };
   // The strip's ends (s = 0) along the lattice generator farthest from every hole's centre:
-  // faces there are matched with their copies one period on, which is exact only where the
-  // two triangulations agree, so keep holes away from it where the wall has room.
+  // faces there are matched with their copies one period on, so keep holes away from it where
+  // the wall has room.
   std::vector<double> centres;
   for (const auto& hole : holes) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -87,7 +97,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     const double centre = wrap_2pi(std::atan2(mean.y(), mean.x()) - seam);
     std::vector<Eigen::Vector2d> poly;
     for (const auto& p : hole.loop) {
-      const Eigen::Vector2d q(R * (centre + wrap_pi(std::atan2(p.y(), p.x()) - seam - centre)), p.z());
+      const Eigen::Vector2d q = on_grid({R * (centre + wrap_pi(std::atan2(p.y(), p.x()) - seam - centre)), p.z()});
       if (q.y() <= z0 + 0.5 * step || q.y() >= z1 - 0.5 * step)
         throw CutConflict("a hole in the wall reaches the inlet or outlet plane");
       poly.push_back(q);

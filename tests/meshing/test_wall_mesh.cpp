@@ -78,6 +78,22 @@ TEST(WallMesh, HolesAreCutExactlyAndFilledByInside) {
   EXPECT_GT(mesh_quality(w.outside).min_angle_deg, 20.0);
 }
 
+TEST(WallMesh, HolesAtEveryAngleStillCloseAcrossTheSeam) {
+  // A tall wall with holes on a helix, so every generator (the seam too) passes through some:
+  // the faces at the two ends of the unrolled strip must match.
+  const double R = 1.0, edge = 0.1, height = 60.0;
+  std::vector<WallHole> holes;
+  for (int k = 0; k < 400; ++k) holes.push_back(radial_hole(R, 2.399963 * k, 0.5 + 0.147 * k, 0.08 + 0.03 * (k % 4), 0.025));
+  const WallMesh w = wall_mesh(R, 0.0, height, edge, holes, 1.3, true, "wall");
+  TriangleMesh m = container(R, 0.0, height, edge, w);
+  m.append(w.inside);
+  m.weld();
+  const SurfaceCheck k = check_surface(m, 0);
+  for (const auto& d : k.defects) ADD_FAILURE() << d.at.transpose() << " used by " << d.triangles;
+  EXPECT_TRUE(k.manifold && k.closed);
+  EXPECT_NEAR(k.volume, kPi * R * R * height, 0.005 * kPi * R * R * height);
+}
+
 TEST(WallMesh, HoleReachingAnEndIsRefused) {
   EXPECT_THROW(wall_mesh(1.0, 0.0, 1.5, 0.1, {radial_hole(1.0, 1.0, 0.05, 0.1, 0.025)}, 1.3, true, "wall"), CutConflict);
 }
