@@ -99,9 +99,9 @@ using Extents = std::unordered_map<long long, std::pair<double, double>>;
 class Treater {
  public:
   // `survey`: the extents of the contacts treated without clip planes, to leave out those
-  // beyond the planes (null without clipping).
-  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey)
-      : bed_(bed), p_(p), planes_(planes), survey_(survey), walls_(walls_of(*bed.container)) {
+  // beyond the planes (null without clipping). `measure`: record this run's extents.
+  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey, bool measure)
+      : bed_(bed), p_(p), planes_(planes), survey_(survey), measure_(measure), walls_(walls_of(*bed.container)) {
     d_ = sauter_mean(bed.diameters);
     edge_c_ = p.contact_edge_length_d * d_;
     scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
@@ -211,11 +211,13 @@ class Treater {
   };
   Marks mark(std::size_t i, std::size_t j) const {
     Marks m{out_.cuts[i].size(), out_.cuts[j].size(), out_.parts.size(), {}};
-    for (const auto& h : out_.wall_holes) m.holes.push_back(h.size());
+    if (measure_)
+      for (const auto& h : out_.wall_holes) m.holes.push_back(h.size());
     return m;
   }
   // The z extent of what the contact (i, j) added since `m` (the cut caps included), widened by `pad`.
   void record(long long k, const Marks& m, std::size_t i, std::size_t j, double pad) {
+    if (!measure_) return;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     auto take = [&](const Eigen::Vector3d& q) { lo = std::min(lo, q.z()), hi = std::max(hi, q.z()); };
     for (auto [s, from] : {std::pair{i, m.cuts_i}, std::pair{j, m.cuts_j}}) {
@@ -523,6 +525,7 @@ class Treater {
   const SurfaceParams& p_;
   DomainPlanes planes_;
   const Extents* survey_;
+  bool measure_;
   std::vector<Wall> walls_;
   Extents extents_;
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
@@ -571,11 +574,11 @@ ClipHeight clip_height(double asked, double shift, double wanted, const std::vec
 
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes) {
   if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
-  if (!planes.clip) return Treater(bed, p, planes, nullptr).run();
+  if (!planes.clip) return Treater(bed, p, planes, nullptr, false).run();
   // Survey the whole bed's contacts, place the clip planes clear of them and of every sphere's
   // top and bottom, then treat the window.
   const double inf = std::numeric_limits<double>::infinity();
-  Treater survey(bed, p, {-inf, inf, false}, nullptr);
+  Treater survey(bed, p, {-inf, inf, false}, nullptr, true);
   const TreatedBed whole = survey.run();
   const double d = sauter_mean(bed.diameters);
   std::vector<std::pair<double, double>> obstacles;
@@ -601,7 +604,7 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   }
   if (!(planes.z1 > planes.z0))
     throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
-  TreatedBed out = Treater(bed, p, planes, &survey.extents()).run();
+  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false).run();
   out.report["clip"] = clip_report;
   return out;
 }

@@ -84,7 +84,10 @@ def write(rows):
                      f"{r['volume_error']:.2e} | {r['chordal_d']:.1e} | {r['min_angle_deg']:.1f} | "
                      f"{r['smallest_gap_d']:.3g} |")
     lines += ["", "(no SI): above `surface.self_intersection_limit` triangles the CGAL self-intersection test is "
-              "skipped and the report says so; closedness and manifoldness are always checked."]
+              "skipped and the report says so; closedness and manifoldness are always checked, so the wall "
+              "time at N = 1e4 leaves out a test the smaller N include: compare the build column for scaling.",
+              "", "Rows added with `--keep` come from another run; this machine's speed has varied by up to "
+              "1.5x between sessions, so a ratio across runs is indicative only."]
     os.makedirs(DOCS, exist_ok=True)
     open(os.path.join(DOCS, "surface_benchmark.md"), "w").write("\n".join(lines) + "\n")
     json.dump(rows, open(os.path.join(DOCS, "surface_benchmark.json"), "w"), indent=1)
