@@ -227,7 +227,7 @@ class Treater {
         const SphereCut& cut = out_.cuts[s][k2];
         for (const auto& q : cut.loop) take(q);
         take(c + r * cut.axis);
-        for (const Eigen::Vector3d pole : {Eigen::Vector3d(c + r * Eigen::Vector3d::UnitZ()), Eigen::Vector3d(c - r * Eigen::Vector3d::UnitZ())})
+        for (const Eigen::Vector3d& pole : {Eigen::Vector3d(c + r * Eigen::Vector3d::UnitZ()), Eigen::Vector3d(c - r * Eigen::Vector3d::UnitZ())})
           if (cut.removed(pole)) take(pole);
       }
     }
@@ -422,15 +422,8 @@ class Treater {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i];
     auto& holes = out_.wall_holes[w.index];
-    if (w.plane) {  // a circle: cut exactly
-      const double h = w.reach(c), rho = std::sqrt(r * r - h * h);
-      plane_cut(i, a, h, rho, ring_points(rho, edge_c_), "union with the " + w.name);
-      const SphereCut& cut = out_.cuts[i].back();
-      holes.push_back({cut.loop, cut.spacing, static_cast<int>(i)});
-      wedge(kPi - std::acos(std::clamp(((cut.loop[0] - c) / r).dot(-w.n), -1.0, 1.0)));
-      ++unions_;
-      return;
-    }
+    ++unions_;
+    if (w.plane) return cross_plane(i, a, w.reach(c), "union with the " + w.name, holes, std::nullopt);
     const Eigen::Vector3d e1 = Eigen::Vector3d::UnitZ(), e2 = a.cross(e1);
     // Polar angle from a of the curve in the direction phi, by bisection.
     auto point = [&](double beta, double phi) {
@@ -461,15 +454,29 @@ class Treater {
     cut.spacing = perimeter / n;
     cut.axis = a;
     cut.removed = [w](const Eigen::Vector3d& q) { return w.beyond(q); };
-    holes.push_back({cut.loop, cut.spacing, static_cast<int>(i)});
-    const Eigen::Vector3d q = cut.loop[0];
-    wedge(kPi - std::acos(std::clamp(((q - c) / r).dot(-w.towards(q)), -1.0, 1.0)));
     add_cut(i, std::move(cut), "union with the " + w.name, beta_max);
+    open_hole(i, holes, -w.towards(out_.cuts[i].back().loop[0]));
     const double rho = std::hypot(c.x(), c.y());
     const double inside = analysis::sphere_cylinder_volume(r, rho, c.z(), w.R, c.z() - r, c.z() + r);
     volume_ -= w.inner ? inside : 4.0 / 3.0 * kPi * r * r * r - inside;
     area_ -= removed_area;
-    ++unions_;
+  }
+
+  // Sphere i's last cut is where it crosses a wall or clip plane: the loop is a hole there, and
+  // the fluid's wedge between the sphere and that surface (normal `into_fluid` at the loop) is measured.
+  void open_hole(std::size_t i, std::vector<WallHole>& holes, const Eigen::Vector3d& into_fluid) {
+    const SphereCut& cut = out_.cuts[i].back();
+    holes.push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+    wedge(kPi - std::acos(std::clamp(((cut.loop[0] - bed_.centres[i]) / out_.radius[i]).dot(into_fluid), -1.0, 1.0)));
+  }
+
+  // Sphere i crossing a plane at distance h along a (unit, into the part removed): cut on the
+  // exact circle (about `at` when given, so its loop lies exactly in the plane), a hole in the plane.
+  void cross_plane(std::size_t i, const Eigen::Vector3d& a, double h, const std::string& name,
+                   std::vector<WallHole>& holes, std::optional<Eigen::Vector3d> at) {
+    const double r = out_.radius[i], rho = std::sqrt(std::max(0.0, r * r - h * h));
+    plane_cut(i, a, h, rho, ring_points(rho, edge_c_), name, at);
+    open_hole(i, holes, -a);
   }
 
   // Spheres must stay clear of the inlet and outlet planes, or are cut by them when they clip.
@@ -491,17 +498,13 @@ class Treater {
   // that patch. The untreated reference loses the same cap of the untreated sphere.
   void clip(std::size_t i, bool outlet) {
     const Eigen::Vector3d& c = bed_.centres[i];
-    const double r = out_.radius[i], z = outlet ? planes_.z1 : planes_.z0, h = outlet ? z - c.z() : c.z() - z;
+    const double z = outlet ? planes_.z1 : planes_.z0, h = outlet ? z - c.z() : c.z() - z;
     const Eigen::Vector3d a = outlet ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
-    const double rho = std::sqrt(std::max(0.0, r * r - h * h));
-    plane_cut(i, a, h, rho, ring_points(rho, edge_c_), outlet ? "outlet clip plane" : "inlet clip plane",
-              Eigen::Vector3d(c.x(), c.y(), z));
-    const SphereCut& cut = out_.cuts[i].back();
-    (outlet ? out_.outlet_holes : out_.inlet_holes).push_back({cut.loop, cut.spacing, static_cast<int>(i)});
+    cross_plane(i, a, h, outlet ? "outlet clip plane" : "inlet clip plane", outlet ? out_.outlet_holes : out_.inlet_holes,
+                Eigen::Vector3d(c.x(), c.y(), z));
     const double r0 = 0.5 * bed_.diameters[i], H0 = std::clamp(r0 - h, 0.0, 2.0 * r0);
     volume0_ -= cap_volume(r0, H0);
     area0_ -= cap_area(r0, H0);
-    wedge(kPi - std::acos(std::clamp(((cut.loop[0] - c) / r).dot(-a), -1.0, 1.0)));
   }
 
   // The cuts on one sphere must not overlap: the angle between their axes must exceed the sum

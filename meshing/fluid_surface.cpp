@@ -174,42 +174,41 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       throw InputError(fmt::format("the {}: {}", what, e.what()));
     }
   };
-  const Frame bottom = Frame::along({0.0, 0.0, z0}, Eigen::Vector3d::UnitZ()),
-              above = Frame::along({0.0, 0.0, z1}, Eigen::Vector3d::UnitZ());
+  const double hx = box ? 0.5 * box->size_x() : 0.0, hy = box ? 0.5 * box->size_y() : 0.0;
+  auto corner = [&](const Eigen::Vector2d& s, double z) { return Eigen::Vector3d(s.x() * hx, s.y() * hy, z); };
   if (box) {
-    const double hx = 0.5 * box->size_x(), hy = 0.5 * box->size_y();
-    auto corner = [&](double sx, double sy, double z) { return Eigen::Vector3d(sx * hx, sy * hy, z); };
-    // Sides in the order of TreatedBed::wall_holes, each normal out of the fluid (+w).
-    const std::array<std::pair<Eigen::Vector3d, Eigen::Vector3d>, 4> sides{{{{-hx, 0.0, 0.0}, -Eigen::Vector3d::UnitX()},
-                                                                           {{hx, 0.0, 0.0}, Eigen::Vector3d::UnitX()},
-                                                                           {{0.0, -hy, 0.0}, -Eigen::Vector3d::UnitY()},
-                                                                           {{0.0, hy, 0.0}, Eigen::Vector3d::UnitY()}}};
-    for (int k = 0; k < 4; ++k) {
-      const double sx = k == 0 ? -1.0 : k == 1 ? 1.0 : 0.0, sy = k == 2 ? -1.0 : k == 3 ? 1.0 : 0.0;
-      // The side's corners: along the side's own direction from one end to the other.
-      const double ax = sx != 0.0 ? sx : -1.0, ay = sy != 0.0 ? sy : -1.0, bx = sx != 0.0 ? sx : 1.0, by = sy != 0.0 ? sy : 1.0;
-      const auto loop = box_face_loop({corner(ax, ay, z0), corner(bx, by, z0), corner(bx, by, z1), corner(ax, ay, z1)}, edge);
-      add("wall", [&] {
-        return plane_mesh(Frame::along(sides[k].first, sides[k].second), {loop}, edge, tb.wall_holes[k], p.growth, true,
-                          "wall");
-      });
-    }
-    for (auto [frame, z, holes, patch] : {std::tuple{bottom, z0, &tb.inlet_holes, "inlet"}, std::tuple{above, z1, &tb.outlet_holes, "outlet"}}) {
-      const auto loop = box_face_loop({corner(-1, -1, z), corner(1, -1, z), corner(1, 1, z), corner(-1, 1, z)}, edge);
-      add(patch, [&] { return plane_mesh(frame, {loop}, edge, *holes, p.growth, z == z1, patch); });
+    // Sides in the order of TreatedBed::wall_holes: normal out of the fluid (+w of the face's
+    // frame) and the signs (x, y) of its two ends.
+    const std::array<std::tuple<Eigen::Vector3d, Eigen::Vector2d, Eigen::Vector2d>, 4> sides{
+        {{-Eigen::Vector3d::UnitX(), {-1, -1}, {-1, 1}},
+         {Eigen::Vector3d::UnitX(), {1, -1}, {1, 1}},
+         {-Eigen::Vector3d::UnitY(), {-1, -1}, {1, -1}},
+         {Eigen::Vector3d::UnitY(), {-1, 1}, {1, 1}}}};
+    for (std::size_t k = 0; k < sides.size(); ++k) {
+      const auto& [normal, a, b] = sides[k];
+      const auto loop = box_face_loop({corner(a, z0), corner(b, z0), corner(b, z1), corner(a, z1)}, edge);
+      const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
+      add("wall", [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall"); });
     }
   } else {
     add("wall", [&] { return wall_mesh(R, z0, z1, edge, tb.wall_holes[0], p.growth, true, "wall"); });
     if (ann) add("inner_wall", [&] { return wall_mesh(r_in, z0, z1, edge, tb.wall_holes[1], p.growth, false, "inner_wall"); });
-    for (auto [frame, holes, patch, up] : {std::tuple{bottom, &tb.inlet_holes, "inlet", false}, std::tuple{above, &tb.outlet_holes, "outlet", true}}) {
-      if (!p.clip) {
-        f.append(ring_mesh(frame, r_in, R, edge, up, patch));
-        continue;
-      }
-      std::vector<std::vector<Eigen::Vector3d>> boundary{circle_loop(frame, R, ring_points(R, edge))};
-      if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, edge)));
-      add(patch, [&] { return plane_mesh(frame, boundary, edge, *holes, p.growth, up, patch); });
+  }
+  // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
+  using Loops = std::vector<std::vector<Eigen::Vector3d>>;
+  auto end_boundary = [&](const Frame& frame, double z) {
+    if (box) return Loops{box_face_loop({corner({-1, -1}, z), corner({1, -1}, z), corner({1, 1}, z), corner({-1, 1}, z)}, edge)};
+    Loops boundary{circle_loop(frame, R, ring_points(R, edge))};
+    if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, edge)));
+    return boundary;
+  };
+  for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
+    const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
+    if (!box && !p.clip) {  // nothing cuts it: the structured ring
+      f.append(ring_mesh(frame, r_in, R, edge, up, patch));
+      continue;
     }
+    add(patch, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
   }
   // The bed solid (normals out of it), and the same pieces turned inside out for the fluid;
   // each piece is released once appended (at N = 1e4 the pieces are gigabytes).

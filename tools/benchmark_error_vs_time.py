@@ -175,6 +175,12 @@ def plots(R):
         fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_mesh_case.png"), dpi=110), plt.close(fig)
 
 
+def table(title, intro, columns, rows, image):
+    """A stage's section of the report: heading, what was run, its table and its plot."""
+    return ([f"## {title}", "", intro, "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)] +
+            ["| " + " | ".join(r) + " |" for r in rows] + ["", image, ""])
+
+
 def write_report(R):
     L = ["# Error against run time, stage by stage", "",
          "Made by `/usr/bin/python3 tools/benchmark_error_vs_time.py` on the 2-core machine of the CI; "
@@ -183,35 +189,36 @@ def write_report(R):
          "iterative stage; `tools/plot_bed.py DIR` draws it).", ""]
     if "packer" in R:
         P = R["packer"]
-        L += ["## Packer: overlap tolerance and mode", "",
-              f"a = 5, N = 500, {P['seeds']} seeds per setting. Error = distance of the seed-mean central void "
-              f"fraction and radial profile from those of the tightest setting (accelerated, 1e-5 d). Seed-to-seed "
-              f"standard error of that mean: {P['noise_eps']:.4f} (void fraction), {P['noise_profile']:.4f} "
-              "(profile): errors below these are noise.", "",
-              "| mode | overlap tolerance (d) | time per bed (s) | iterations | central eps | error eps | "
-              "error profile (rms) |", "|---|---|---|---|---|---|---|"]
-        for p in sorted(P["points"], key=lambda p: (p["mode"], -p["tolerance_d"])):
-            L.append(f"| {p['mode']} | {p['tolerance_d']:g} | {p['time_s']:.2f} | {p['iterations']:.0f} | "
-                     f"{p['eps_central']:.4f} | {p['eps_error']:.4f} | {p['profile_rms_error']:.4f} |")
-        L += ["", "![packer](pareto_packer.png)", ""]
+        L += table("Packer: overlap tolerance and mode",
+                   f"a = 5, N = 500, {P['seeds']} seeds per setting. Error = distance of the seed-mean central void "
+                   f"fraction and radial profile from those of the tightest setting (accelerated, 1e-5 d). Seed-to-seed "
+                   f"standard error of that mean: {P['noise_eps']:.4f} (void fraction), {P['noise_profile']:.4f} "
+                   "(profile): errors below these are noise.",
+                   ["mode", "overlap tolerance (d)", "time per bed (s)", "iterations", "central eps", "error eps",
+                    "error profile (rms)"],
+                   [[p["mode"], f"{p['tolerance_d']:g}", f"{p['time_s']:.2f}", f"{p['iterations']:.0f}",
+                     f"{p['eps_central']:.4f}", f"{p['eps_error']:.4f}", f"{p['profile_rms_error']:.4f}"]
+                    for p in sorted(P["points"], key=lambda p: (p["mode"], -p["tolerance_d"]))],
+                   "![packer](pareto_packer.png)")
     if "surface" in R:
-        L += ["## Surface: edge length", "", "One bed (a = 5, N = 500, seed 1, d = 3 mm), `shrink` (the default), "
-              "contact edge a third of the edge length.", "",
-              "| edge (d) | triangles | time (s) | peak MB | volume error | chordal deviation (d) | min angle (deg) |",
-              "|---|---|---|---|---|---|---|"]
-        for p in R["surface"]["points"]:
-            L.append(f"| {p['edge_d']:g} | {p['triangles']} | {p['time_s']:.1f} | {p['peak_memory_mb']:.0f} | "
-                     f"{p['volume_error']:.2e} | {p['chordal_d']:.2e} | {p['min_angle_deg']:.1f} |")
-        L += ["", "![surface](pareto_surface.png)", ""]
+        L += table("Surface: edge length",
+                   "One bed (a = 5, N = 500, seed 1, d = 3 mm), `shrink` (the default), contact edge a third of the "
+                   "edge length.",
+                   ["edge (d)", "triangles", "time (s)", "peak MB", "volume error", "chordal deviation (d)",
+                    "min angle (deg)"],
+                   [[f"{p['edge_d']:g}", str(p["triangles"]), f"{p['time_s']:.1f}", f"{p['peak_memory_mb']:.0f}",
+                     f"{p['volume_error']:.2e}", f"{p['chordal_d']:.2e}", f"{p['min_angle_deg']:.1f}"]
+                    for p in R["surface"]["points"]],
+                   "![surface](pareto_surface.png)")
     if "mesh" in R:
-        L += ["## Mesh and CFD: mesh size", "", "From [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, "
-              "N = 500, bridges, Re_p = 1, simpleFoam on 2 processes); the mesh size follows the surface edge.", "",
-              "| surface edge (d) | cells | surface + mesh (s) | with the solve (s) | dp/L / finest | dp/L / E&S |",
-              "|---|---|---|---|---|---|"]
-        for p in R["mesh"]["points"]:
-            L.append(f"| {p['edge_d']:g} | {p['cells']} | {p['mesh_time_s']:.0f} | {p['time_s']:.0f} | "
-                     f"{p['ratio_finest']:.3f} | {p['ratio_es']:.3f} |")
-        L += ["", "![mesh and CFD](pareto_mesh_case.png)", ""]
+        L += table("Mesh and CFD: mesh size",
+                   "From [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, N = 500, bridges, Re_p = 1, "
+                   "simpleFoam on 2 processes); the mesh size follows the surface edge.",
+                   ["surface edge (d)", "cells", "surface + mesh (s)", "with the solve (s)", "dp/L / finest",
+                    "dp/L / E&S"],
+                   [[f"{p['edge_d']:g}", str(p["cells"]), f"{p['mesh_time_s']:.0f}", f"{p['time_s']:.0f}",
+                     f"{p['ratio_finest']:.3f}", f"{p['ratio_es']:.3f}"] for p in R["mesh"]["points"]],
+                   "![mesh and CFD](pareto_mesh_case.png)")
     L += ["Why the defaults are what they are, read from these curves: [defaults.md](defaults.md).", ""]
     open(os.path.join(DOCS, "error_vs_time.md"), "w").write("\n".join(L))
 
