@@ -9,8 +9,8 @@
 namespace bedforge {
 
 // Verlet list built on a cell grid: for each sphere, every sphere whose surface is closer than
-// `skin`. The list is rebuilt only when some sphere has moved more than skin/2 since the last
-// build, so between rebuilds it still holds every touching pair. Work and memory are O(N).
+// `skin`. The list is rebuilt only when the two largest displacements since the last build sum
+// to more than the skin, so between rebuilds it still holds every touching pair. Work and memory are O(N).
 // Each sphere lists all its neighbours (both directions), so forces are gathered per sphere in
 // parallel without atomics and in a fixed order: the result does not depend on thread count.
 class NeighbourList {
@@ -36,6 +36,7 @@ class NeighbourList {
   std::vector<long> cell_;
   std::vector<std::size_t> start_, fill_;
   std::vector<int> sorted_;
+  std::vector<Eigen::Vector4d> in_cells_;  // centre and radius, in cell order
   std::vector<int> scratch_;    // n rows of capacity_ neighbours
   std::size_t capacity_ = 32;
 };

@@ -27,6 +27,7 @@ class AcceleratedDescent {
   // `done`; no sphere moves more than `max_step` in one iteration.
   // Smallest C_k the stability limit allowed (C_k = 2 x the momentum step).
   double smallest_stiffness_step() const { return 2.0 * smallest_; }
+  long neighbour_list_builds() const { return nl_.builds(); }
 
   Relaxed relax(double kappa, bool gravity, double max_step, const std::function<bool(const Relaxed&)>& done) {
     const std::size_t n = s_.size();
@@ -60,13 +61,15 @@ class AcceleratedDescent {
         std::swap(s_.x, x);
         nl_.update(s_.x, s_.r, c_);
         evaluate_contacts(s_, nl_, c_, at_x.contacts);
-        mass_centre.add(deterministic_sum(n, [&](std::size_t i) { return s_.w[i] * s_.x[i].z(); }) / total_weight);
+        const double height = deterministic_sum(n, [&](std::size_t i) { return s_.w[i] * s_.x[i].z(); }) / total_weight;
+        mass_centre.add(height);
         at_x.settled = mass_centre.settled();
         at_x.residual_rms = gravity ? force_residual(s_, at_x.contacts, kappa).first : 0.0;
         std::swap(s_.x, x);
         log_.record({{"max_pair_overlap_d", at_x.contacts.max_pair_overlap / p_.d_min},
                      {"max_wall_overlap_d", at_x.contacts.max_wall_overlap / p_.d_min},
                      {"stiffness_ratio", kappa},
+                     {"mass_centre", height},
                      {"force_residual_rms", at_x.residual_rms}});
         log_.show(fmt::format("accelerated, {} stage, iteration {}, max overlap {:.2e} d, residual {:.2e}", log_.stage(),
                               log_.iterations(), at_x.contacts.max_pair_overlap / p_.d_min, at_x.residual_rms));
@@ -181,7 +184,9 @@ nlohmann::json run_accelerated(Spheres& s, const Container& container, const Sof
                                          p.given.overlap_tolerance_d, r.contacts.max_pair_overlap / p.d_min,
                                          r.contacts.max_wall_overlap / p.d_min));
   }
-  return {{"stiffness_ratio", kappa}, {"smallest_C_k", descent.smallest_stiffness_step()}};
+  return {{"stiffness_ratio", kappa},
+          {"smallest_C_k", descent.smallest_stiffness_step()},
+          {"neighbour_list_builds", descent.neighbour_list_builds()}};
 }
 
 }  // namespace bedforge::packer

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 
 using namespace bedforge;
@@ -42,15 +43,20 @@ TEST(NeighbourList, MatchesBruteForceForAMixtureInACylinder) {
   EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.1));
 }
 
-TEST(NeighbourList, RebuildsOnlyAfterHalfASkin) {
+TEST(NeighbourList, RebuildsOnlyWhenTwoDisplacementsExceedTheSkin) {
+  // Two spheres 0.1 apart, skin 0.2: one may close the whole skin alone, but the two together
+  // only as much.
   Cylinder c(2.0);
-  std::vector<Eigen::Vector3d> x = {{0, 0, 0.5}, {0, 0, 1.6}};
-  std::vector<double> r = {0.5, 0.5};
+  std::vector<Eigen::Vector3d> x = {{0, 0, 0.5}, {0, 0, 1.6}, {1, 0, 0.5}};
+  std::vector<double> r = {0.5, 0.5, 0.4};
   NeighbourList nl(0.2);
   EXPECT_TRUE(nl.update(x, r, c));
-  x[1].z() -= 0.09;
+  x[1].z() -= 0.19;
   EXPECT_FALSE(nl.update(x, r, c));
-  x[1].z() -= 0.02;
+  const auto held = listed(nl, x.size()), touching = brute_force(x, r, 0.0);
+  EXPECT_EQ(touching.size(), 2u);
+  EXPECT_TRUE(std::includes(held.begin(), held.end(), touching.begin(), touching.end())) << "a touching pair is not listed";
+  x[0].z() += 0.02;
   EXPECT_TRUE(nl.update(x, r, c));
   EXPECT_EQ(nl.builds(), 2);
 }
@@ -67,20 +73,33 @@ TEST(NeighbourList, SurvivesSpheresThrownFarApart) {
 }
 
 TEST(NeighbourList, FindsPairsAcrossPeriodicSides) {
-  // Periodic along x with only 2 and 3 cells across (the cases where a wrapped cell repeats),
-  // walls along y; positions given outside the central cell must be wrapped too.
-  for (double lx : {3.0, 3.7, 5.0}) {
-    Box box(lx, 4.0, true, false);
-    Rng rng(3);
-    std::vector<Eigen::Vector3d> x;
-    std::vector<double> r;
-    for (int i = 0; i < 300; ++i) {
-      const auto p = box.sample_centre(rng, 0.5);
-      x.emplace_back(p.x() + lx * (i % 3 - 1), p.y(), 20.0 * rng.uniform());
-      r.push_back(i % 4 == 0 ? 0.5 : 0.35);
+  // Periodic along x, or along both x and y, with 1 to about 10 cells across (a wrapped row
+  // must not visit a cell twice); positions given outside the central cell must be wrapped too.
+  for (bool periodic_y : {false, true})
+    for (double lx : {1.1, 3.0, 3.7, 5.0}) {
+      Box box(lx, 4.0, true, periodic_y);
+      Rng rng(3);
+      std::vector<Eigen::Vector3d> x;
+      std::vector<double> r;
+      for (int i = 0; i < 300; ++i) {
+        const auto p = box.sample_centre(rng, 0.5);
+        x.emplace_back(p.x() + lx * (i % 3 - 1), p.y() + (periodic_y ? 4.0 * (i % 2) : 0.0), 20.0 * rng.uniform());
+        r.push_back(i % 4 == 0 ? 0.5 : 0.35);
+      }
+      NeighbourList nl(0.2);
+      nl.build(x, r, box);
+      EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.2, box.periodicity()))
+          << "Lx = " << lx << (periodic_y ? ", periodic y" : "");
     }
-    NeighbourList nl(0.2);
-    nl.build(x, r, box);
-    EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.2, box.periodicity())) << "Lx = " << lx;
-  }
+}
+
+TEST(NeighbourList, FindsSpheresPushedThroughTheWall) {
+  // Soft walls let a sphere's centre leave the cross-section; it is kept in the grid's edge
+  // cells, which must still be searched as far as it reaches.
+  Cylinder c(3.0);
+  std::vector<Eigen::Vector3d> x = {{2.9, 0, 1}, {3.6, 0.3, 1}, {4.4, 0.1, 1.2}, {-3.5, -0.2, 0.8}, {-2.6, 0, 1}, {0, 3.3, 1}};
+  std::vector<double> r(x.size(), 0.5);
+  NeighbourList nl(0.1);
+  nl.build(x, r, c);
+  EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.1));
 }
