@@ -320,9 +320,11 @@ std::string pack_key(const Scene& scene) {
   if (scene.algorithm == "import") inputs["file_key"] = stage_key(read_file(scene.import.file));
   return scene_stage_key(scene, inputs, {"container", "particles", "packing"});
 }
+#ifdef BEDFORGE_HAVE_CGAL
 std::string downstream_key(const Scene& scene, const std::string& upstream_key, std::initializer_list<const char*> sections) {
   return scene_stage_key(scene, {{"upstream", upstream_key}}, sections);
 }
+#endif
 
 // The report entry of stage `name` an earlier run left in DIR, when it was made with the same
 // key and the files it wrote (`files`) are still there; null otherwise.
