@@ -37,11 +37,12 @@ from references import de_klerk  # noqa: E402
 
 SCENES = os.path.join(ROOT, "scenes", "examples")
 SECTIONS = ["fig3", "annulus", "segregation", "speed"]
+WORK = tempfile.TemporaryDirectory(prefix="bedforge_mc_")  # every run's output; removed at exit
 
 
 def run(case):
     """bedforge run SCENE with options; returns the case with the report and output folder."""
-    out = tempfile.mkdtemp(prefix="bedforge_mc_")
+    out = tempfile.mkdtemp(prefix="run_", dir=WORK.name)
     cmd = [BEDFORGE, "--quiet", "run", os.path.join(SCENES, case["scene"]), "-o", out,
            "--seed", str(case["seed"])] + case.get("args", [])
     t0 = time.time()
@@ -140,7 +141,7 @@ def box_scene():
     text = open(os.path.join(SCENES, "abreu1999_segregation.toml")).read()
     head, rest = text.split("[container]", 1)
     rest = rest.split("[particles]", 1)[1]
-    path = os.path.join(tempfile.mkdtemp(prefix="bedforge_mc_scene_"), "segregation_box.toml")
+    path = os.path.join(WORK.name, "segregation_box.toml")
     open(path, "w").write(head + '[container]\ntype = "box"\nsize_x_d = 8.862\nsize_y_d = 8.862\n'
                           'periodic_x = true\nperiodic_y = true\n\n[particles]' + rest)
     return path

@@ -1,11 +1,11 @@
 #include "core/atomic_file.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 
 #include "core/error.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 namespace fs = std::filesystem;
@@ -13,7 +13,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_test_atomic_" + std::to_string(::getpid()));
+  const fs::path d = test_support::process_temp_dir() / "atomic_file";
   fs::create_directories(d);
   return d;
 }

@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 namespace fs = std::filesystem;
@@ -14,7 +15,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir() {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_test_bed_io_" + std::to_string(::getpid()));
+  const fs::path d = test_support::process_temp_dir() / "bed_io";
   fs::create_directories(d);
   return d;
 }

@@ -1,13 +1,13 @@
 #include "core/dem_import.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "core/error.hpp"
 #include "support/input_error.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 using input_error_test::error_of;
@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path write(const std::string& name, const std::string& text) {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_test_dem_import_" + std::to_string(::getpid()));
+  const fs::path d = test_support::process_temp_dir() / "dem_import";
   fs::create_directories(d);
   std::ofstream(d / name) << text;
   return d / name;

@@ -1,19 +1,18 @@
 #include "core/report.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "core/error.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 namespace fs = std::filesystem;
 
 TEST(Report, StagesAccumulateInTheDirectory) {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_test_report_" + std::to_string(::getpid()));
-  fs::remove_all(d);
+  const fs::path d = test_support::fresh_dir("report");
   Report first = Report::load_or_new(d);
   first.set_provenance("1.2.3", {{"particles", {{"count", 3}}}}, 7);
   first.set_stage("pack", {{"summary", "pack: fine"}, {"time_s", 1.0}});
@@ -29,8 +28,7 @@ TEST(Report, StagesAccumulateInTheDirectory) {
 }
 
 TEST(Report, CorruptReportIsNamed) {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_test_report_bad_" + std::to_string(::getpid()));
-  fs::create_directories(d);
+  const fs::path d = test_support::fresh_dir("corrupt_report", true);
   std::ofstream(d / "report.json") << "{ not json";
   try {
     Report::load_or_new(d);

@@ -11,14 +11,21 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 #include "core/dem_import.hpp"
 #include "core/error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
-  static const std::filesystem::path file =
-      std::filesystem::temp_directory_path() / ("bedforge_fuzz_bed_" + std::to_string(::getpid()));
+  static const struct Scratch {  // one file per fuzzing process, removed when it ends
+    std::filesystem::path path = std::filesystem::temp_directory_path() / ("bedforge_fuzz_bed_" + std::to_string(::getpid()));
+    ~Scratch() {
+      std::error_code ignored;
+      std::filesystem::remove(path, ignored);
+    }
+  } scratch;
+  const std::filesystem::path& file = scratch.path;
   std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
   const bedforge::BedFileFormat format = data[0] % 3 == 0   ? bedforge::BedFileFormat::xyzd
                                          : data[0] % 3 == 1 ? bedforge::BedFileFormat::lammps_dump

@@ -3,7 +3,6 @@
 #include "meshing/volume_mesh.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,6 +10,7 @@
 
 #include "meshing/fluid_surface.hpp"
 #include "meshing/surface_checks.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 using namespace bedforge::meshing;
@@ -36,10 +36,7 @@ FluidSurface coarse_surface(const Bed& b) {
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("bedforge_volume_" + std::to_string(::getpid())) / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+  return test_support::fresh_dir(name, true);
 }
 
 std::vector<int> patch_counts(const TriangleMesh& s, const PolyMesh& m) {

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "support/temp_dir.hpp"
+
 namespace cli_test {
 
 struct Result {
@@ -32,12 +34,8 @@ inline Result shell(const std::string& command) {
 
 inline Result bedforge(const std::string& args) { return shell(std::string(BEDFORGE_BINARY) + " " + args); }
 
-// An empty path under the temporary directory, unique to this test process.
-inline std::filesystem::path fresh_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("bedforge_cli_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(d);
-  return d;
-}
+// An empty path under the test process's temporary directory.
+inline std::filesystem::path fresh_dir(const std::string& name) { return test_support::fresh_dir(name); }
 
 inline std::string read(const std::filesystem::path& p) {
   std::ifstream in(p);
