@@ -6,7 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <functional>
+#include <numeric>
 #include <numbers>
 #include <tuple>
 #include <unordered_map>
@@ -40,6 +41,65 @@ std::vector<Eigen::Vector3d> offset_loop(const SphereCut& cut, const Eigen::Vect
   std::vector<Eigen::Vector3d> out = resample_loop(moved, spacing, stagger);
   for (auto& p : out) p = c + r * (p - c).normalized();
   return out;
+}
+
+// Where four or more hull points are coplanar (cocircular, on a sphere) the hull may split the
+// flat facet along either diagonal, and CGAL's choice follows the memory addresses of its
+// faces, which differ between threads and runs. Each flat facet is therefore triangulated
+// again as a fan from its lowest-numbered vertex, so the mesh depends on the points alone.
+// `faces`: hull triangles (indices into `p`, consistently oriented), changed in place.
+void canonical_flat_facets(std::vector<std::array<int, 3>>& faces, const std::vector<Kernel::Point_3>& p) {
+  const int nf = static_cast<int>(faces.size());
+  auto directed = [](int a, int b) { return static_cast<long>(a) << 32 | static_cast<long>(b); };
+  std::vector<std::pair<long, int>> edges;  // directed edge -> its face, sorted
+  for (int f = 0; f < nf; ++f)
+    for (int e = 0; e < 3; ++e) edges.emplace_back(directed(faces[f][e], faces[f][(e + 1) % 3]), f);
+  std::sort(edges.begin(), edges.end());
+  auto face_across = [&](int a, int b) {  // the face holding edge b -> a
+    const auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(directed(b, a), -1));
+    return it != edges.end() && it->first == directed(b, a) ? it->second : -1;
+  };
+  // Flat facets: faces joined across edges where the neighbour's far vertex is coplanar.
+  std::vector<int> group(nf);
+  std::iota(group.begin(), group.end(), 0);
+  std::function<int(int)> root = [&](int f) { return group[f] == f ? f : group[f] = root(group[f]); };
+  bool flat = false;
+  for (int f = 0; f < nf; ++f)
+    for (int e = 0; e < 3; ++e) {
+      const int a = faces[f][e], b = faces[f][(e + 1) % 3], g = face_across(a, b);
+      if (g < 0 || root(g) == root(f)) continue;
+      const int far = faces[g][0] + faces[g][1] + faces[g][2] - a - b;
+      if (CGAL::orientation(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[far]) != CGAL::COPLANAR) continue;
+      group[root(g)] = root(f);
+      flat = true;
+    }
+  if (!flat) return;
+  // Each facet's boundary (its directed edges whose reverse lies outside it), walked from the
+  // lowest vertex, becomes a fan.
+  std::vector<int> order(nf);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int f, int g) { return root(f) < root(g); });
+  std::vector<std::array<int, 3>> out;
+  std::vector<std::pair<int, int>> boundary;  // a -> b, sorted by a
+  for (std::size_t first = 0, last; first < order.size(); first = last) {
+    const int r = root(order[first]);
+    for (last = first; last < order.size() && root(order[last]) == r; ++last) {}
+    if (last - first == 1) {
+      out.push_back(faces[order[first]]);
+      continue;
+    }
+    boundary.clear();
+    for (std::size_t k = first; k < last; ++k)
+      for (int e = 0; e < 3; ++e) {
+        const int a = faces[order[k]][e], b = faces[order[k]][(e + 1) % 3], g = face_across(a, b);
+        if (g < 0 || root(g) != r) boundary.emplace_back(a, b);
+      }
+    std::sort(boundary.begin(), boundary.end());
+    auto next = [&](int v) { return std::lower_bound(boundary.begin(), boundary.end(), std::make_pair(v, -1))->second; };
+    const int v0 = boundary.front().first;
+    for (int v = next(v0); next(v) != v0; v = next(v)) out.push_back({v0, v, next(v)});
+  }
+  faces = std::move(out);
 }
 
 long edge_key(int a, int b) { return static_cast<long>(std::min(a, b)) << 32 | static_cast<long>(std::max(a, b)); }
@@ -108,24 +168,35 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   // whose circumradius exceeds 0.7 x its vertices' spacing), its circumcentre on the sphere
   // is added and the hull taken again (Delaunay refinement, at most 3 rounds).
   TriangleMesh m;
+  std::vector<Kernel::Point_3> kp;
+  std::vector<int> by_position;  // point indices in lexicographic order of (x, y, z)
+  auto lexicographic_less = [&](int a, const Eigen::Vector3d& q) {
+    const Eigen::Vector3d& p = pts.points[a];
+    return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
+  };
   for (int round = 0;; ++round) {
-    std::vector<Kernel::Point_3> kp;
-    std::map<std::tuple<double, double, double>, int> index;
-    for (std::size_t v = 0; v < pts.points.size(); ++v) {
-      const auto& p = pts.points[v];
-      kp.emplace_back(p.x(), p.y(), p.z());
-      index.emplace(std::make_tuple(p.x(), p.y(), p.z()), static_cast<int>(v));
-    }
+    kp.clear();
+    for (const auto& p : pts.points) kp.emplace_back(p.x(), p.y(), p.z());
     Hull hull;
     CGAL::convex_hull_3(kp.begin(), kp.end(), hull);
-    m.triangles.clear();
+    // The hull's vertices are input points, found again by their exact coordinates.
+    by_position.resize(pts.points.size());
+    std::iota(by_position.begin(), by_position.end(), 0);
+    std::sort(by_position.begin(), by_position.end(), [&](int a, int b) { return lexicographic_less(a, pts.points[b]); });
+    std::vector<std::array<int, 3>> faces;
     for (auto f : hull.faces()) {
       std::array<int, 3> t;
       int k = 0;
       for (auto v : hull.vertices_around_face(hull.halfedge(f))) {
         const auto& p = hull.point(v);
-        t[k++] = index.at(std::make_tuple(p.x(), p.y(), p.z()));
+        t[k++] = *std::lower_bound(by_position.begin(), by_position.end(), Eigen::Vector3d(p.x(), p.y(), p.z()),
+                                   lexicographic_less);
       }
+      faces.push_back(t);
+    }
+    canonical_flat_facets(faces, kp);
+    m.triangles.clear();
+    for (auto t : faces) {
       if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
       std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
       m.triangles.push_back(t);

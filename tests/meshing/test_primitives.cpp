@@ -136,3 +136,20 @@ TEST(Primitives, RingMeshesShareTheirLoopsWithCircleLoop) {
   for (const auto& t : m.triangles) area += 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).z();
   EXPECT_NEAR(area, kPi * (4.0 - 0.49), 0.01 * kPi * 4.0);  // +z normals, area of the polygonal ring
 }
+
+TEST(Primitives, SphereMeshDependsOnItsInputAlone) {
+  // Rings parallel to a cut loop, with angles symmetric about the loop's frame, put four points
+  // on one plane again and again; the hull may split such a flat facet along either diagonal,
+  // as the memory addresses of its faces fall. The same sphere meshed in two threads at once
+  // (each with its own heap) must give the same triangles every time.
+  const Eigen::Vector3d c(0.0, 0.0, 0.5);
+  const double r = 0.5;
+  const std::vector<SphereCut> cuts{plane(c, r, Eigen::Vector3d::UnitZ(), 0.45, 0.0125),
+                                    plane(c, r, Eigen::Vector3d::UnitX(), 0.47, 0.0125),
+                                    plane(c, r, -Eigen::Vector3d::UnitY(), 0.48, 0.0125)};
+  const TriangleMesh first = sphere_mesh(c, r, cuts, 0.05, 1.3, true, "particles");
+  std::vector<TriangleMesh> again(16);
+#pragma omp parallel for num_threads(2) schedule(static, 1)
+  for (std::size_t k = 0; k < again.size(); ++k) again[k] = sphere_mesh(c, r, cuts, 0.05, 1.3, true, "particles");
+  for (const auto& m : again) EXPECT_EQ(m.triangles, first.triangles);
+}
