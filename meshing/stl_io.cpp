@@ -55,19 +55,29 @@ void write_stl_binary(std::ostream& out, const TriangleMesh& m, int patch, const
   std::string head(80, ' ');
   std::memcpy(head.data(), header.data(), std::min<std::size_t>(80, header.size()));
   out << head;
-  std::uint32_t count = 0;
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) count += patch < 0 || m.patch[k] == patch;
+  std::vector<std::size_t> mine;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    if (patch < 0 || m.patch[k] == patch) mine.push_back(k);
+  const auto count = static_cast<std::uint32_t>(mine.size());
   out.write(reinterpret_cast<const char*>(&count), 4);  // little-endian on every Debian target we build for
-  auto put = [&](const Eigen::Vector3d& v) {
-    const float f[3] = {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())};
-    out.write(reinterpret_cast<const char*>(f), sizeof f);
-  };
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-    if (patch >= 0 && m.patch[k] != patch) continue;
-    const auto& t = m.triangles[k];
-    put(unit_normal(m, t));
-    for (int v : t) put(m.points[v]);
-    out.write("\0\0", 2);  // attribute byte count
+  // Records of 50 bytes (normal, three corners as float32, attribute count 0), filled in
+  // parallel a batch at a time and written in one call.
+  constexpr std::size_t kRecord = 50, kBatch = 1 << 20;
+  std::vector<char> buffer;
+  for (std::size_t first = 0; first < mine.size(); first += kBatch) {
+    const std::size_t last = std::min(mine.size(), first + kBatch);
+    buffer.assign((last - first) * kRecord, 0);
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = first; i < last; ++i) {
+      const auto& t = m.triangles[mine[i]];
+      const Eigen::Vector3d n = unit_normal(m, t);
+      const Eigen::Vector3d* corners[3] = {&m.points[t[0]], &m.points[t[1]], &m.points[t[2]]};
+      float record[12] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
+      for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 3; ++k) record[3 + 3 * c + k] = static_cast<float>((*corners[c])[k]);
+      std::memcpy(buffer.data() + (i - first) * kRecord, record, sizeof record);
+    }
+    out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
   }
 }
 

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <numbers>
 #include <sstream>
 
@@ -168,7 +171,7 @@ TEST(FluidSurface, ABridgeThroughAThirdSphereIsRefusedNamingIt) {
   }
 }
 
-TEST(StlIo, NamedSolidsAndBinarySizes) {
+TEST(StlIo, NamedSolidsAndBinaryRecords) {
   Bed b;
   b.container = std::make_shared<Cylinder>(1.0);
   b.centres = {{0, 0, 0.5}};
@@ -186,7 +189,25 @@ TEST(StlIo, NamedSolidsAndBinarySizes) {
   EXPECT_EQ(facets, fs.fluid.triangles.size());
   // Binary: 80-byte header, count, 50 bytes per triangle.
   write_stl_binary(binary, fs.fluid, -1, "x");
-  EXPECT_EQ(binary.str().size(), 84 + 50 * fs.fluid.triangles.size());
+  const std::string bytes = binary.str();
+  ASSERT_EQ(bytes.size(), 84 + 50 * fs.fluid.triangles.size());
+  std::uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 80, 4);
+  EXPECT_EQ(count, fs.fluid.triangles.size());
+  // Each record holds its triangle's corners, in order, as float32.
+  for (std::size_t k = 0; k < fs.fluid.triangles.size(); k += 97) {
+    float record[12];
+    std::memcpy(record, bytes.data() + 84 + 50 * k, sizeof record);
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 3; ++i)
+        ASSERT_EQ(record[3 + 3 * c + i], static_cast<float>(fs.fluid.points[fs.fluid.triangles[k][c]][i])) << "triangle " << k;
+  }
+  // One patch alone: its triangles only.
+  const int particles =
+      static_cast<int>(std::find(fs.fluid.patches.begin(), fs.fluid.patches.end(), "particles") - fs.fluid.patches.begin());
+  std::ostringstream one;
+  write_stl_binary(one, fs.fluid, particles, "x");
+  EXPECT_EQ(one.str().size(), 84 + 50 * static_cast<std::size_t>(std::count(fs.fluid.patch.begin(), fs.fluid.patch.end(), particles)));
 }
 
 TEST(FluidSurface, TheSameBedGivesTheSameSurface) {
