@@ -117,6 +117,7 @@ class Treater {
     cut_angle_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
+      if (p.treatment == SurfaceParams::Treatment::enlarge) join_to_concave_wall(i);
       const double z = bed.centres[i].z();
       out_.kept[i] = !planes.clip || (z + out_.radius[i] > planes.z0 && z - out_.radius[i] < planes.z1);
       if (!out_.kept[i]) continue;
@@ -158,7 +159,8 @@ class Treater {
         {"contacts_treated",
          {{"particle_particle", treated_pp_},
           {"particle_wall", treated_pw_},
-          {"by_kind", {{"bridge", bridges_}, {"cap", caps_}, {"union", unions_}}}}},
+          {"by_kind", {{"bridge", bridges_}, {"cap", caps_}, {"union", unions_}}},
+          {"grown_to_meet_the_wall", grown_to_wall_}}},
         {"solid_volume_change_relative", volume_ / volume0_ - 1.0},
         {"solid_volume_change_m3", volume_ - volume0_},
         {"particle_area_change_relative", area_ / area0_ - 1.0},
@@ -172,6 +174,21 @@ class Treater {
 
  private:
   using T = SurfaceParams::Treatment;
+
+  // The faceted wall of a cylinder lies inside it by up to its sagitta, so an enlarged sphere
+  // nearer to it than twice that would meet the facets. Such a sphere is taken as touching the
+  // wall: grown further, to cross it by what the enlargement gives a sphere that touched it
+  // (its radius x (factor - 1)), it is joined to the wall like the others.
+  void join_to_concave_wall(std::size_t i) {
+    const double r0 = 0.5 * bed_.diameters[i];
+    for (const Wall& w : walls_) {
+      if (w.plane || w.inner) continue;
+      const double gap = w.gap(bed_.centres[i], out_.radius[i]);
+      if (gap < 0.0 || gap > 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) continue;
+      out_.radius[i] += gap + (p_.enlarge_factor - 1.0) * r0;
+      ++grown_to_wall_;
+    }
+  }
 
   // Gap below which a contact is treated (pairs and walls share the tolerance of their treatment).
   double treat_below(T t) const {
@@ -534,6 +551,7 @@ class Treater {
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
   TreatedBed out_;
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
+  long grown_to_wall_ = 0;  // enlarged spheres grown further to meet a cylinder wall
   double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
   double min_wedge_ = std::numeric_limits<double>::infinity();
   std::string gap_error_;

@@ -134,7 +134,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
 
   // A curved wall is faceted between vertices on it: its facets lie inside it by up to the
   // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a sphere.
-  const double wall_sag = box ? 0.0 : R * (1.0 - std::cos(std::numbers::pi / ring_points(R, edge)));
+  const double wall_sag = box ? 0.0 : ring_sagitta(R, edge);
   if (wall_sag >= 0.5 * tb.min_wall_gap)
     throw InputError(fmt::format("surface.edge_length_d = {}: the wall facets lie up to {:.3g} d inside the wall, more "
                                  "than half the narrowest gap left at the wall ({:.3g} d); allowed: a shorter edge or a "

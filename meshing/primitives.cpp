@@ -126,6 +126,8 @@ int ring_points(double R, double edge) {
   return std::max(8, static_cast<int>(std::ceil(2.0 * std::numbers::pi * R / edge)));
 }
 
+double ring_sagitta(double R, double edge) { return R * (1.0 - std::cos(std::numbers::pi / ring_points(R, edge))); }
+
 std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n) {
   std::vector<Eigen::Vector3d> loop;
   for (int j = 0; j < n; ++j) loop.push_back(f.to_world(on_circle(rho, j, n, false, 0.0)));
