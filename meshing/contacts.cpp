@@ -153,7 +153,7 @@ class Treater {
     for (std::size_t i = 0; i < n; ++i) check_cuts(i);
     if (!(min_gap_ > 0.0)) throw InputError(gap_error_);
     out_.solid_volume = volume_;
-    out_.min_wall_gap = min_wall_gap_;
+    out_.min_concave_wall_gap = min_concave_wall_gap_;
     auto angle = [](double a) { return std::isfinite(a) ? nlohmann::json(a * 180.0 / kPi) : nlohmann::json(nullptr); };
     out_.report = {
         {"contacts_treated",
@@ -200,9 +200,11 @@ class Treater {
     }
   }
 
-  void gap_left(double gap, bool wall, const std::string& what) {
+  // `wall`: the wall of the gap, null for a pair's.
+  void gap_left(double gap, const Wall* wall, const std::string& what) {
     double& m = wall ? min_wall_gap_ : min_pair_gap_;
     m = std::min(m, gap);
+    if (wall && !wall->plane && !wall->inner) min_concave_wall_gap_ = std::min(min_concave_wall_gap_, gap);
     if (gap < min_gap_) {
       min_gap_ = gap;
       gap_error_ = fmt::format("{} still touch{} or overlap{} by {:.3g} d after the '{}' treatment; allowed: a "
@@ -295,7 +297,7 @@ class Treater {
     if ((treated && beyond_planes(key(i, j), who)) || !out_.kept[i] || !out_.kept[j]) return;
     if (!treated) {
       if (p_.treatment == T::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
-      return gap_left(gap, false, who);
+      return gap_left(gap, nullptr, who);
     }
     const Eigen::Vector3d a = (cj - ci) / dist;
     ++treated_pp_;
@@ -310,7 +312,7 @@ class Treater {
         area_ += kPi * rho * rho;
       }
       ++caps_;
-      return gap_left(g, false, who);
+      return gap_left(g, nullptr, who);
     }
     const double rb = 0.5 * p_.bridge_diameter_d * d_;
     const double rho_union = gap < 0.0 ? std::sqrt(std::max(0.0, ri * ri - std::pow((dist * dist + ri * ri - rj * rj) / (2.0 * dist), 2))) : 0.0;
@@ -364,7 +366,7 @@ class Treater {
     out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
     wedge(0.5 * kPi + std::asin(rb / std::max(ri, rj)));
     ++bridges_;
-    gap_left(L, false, who);
+    gap_left(L, nullptr, who);
   }
 
   void wall(std::size_t i, const Wall& w, const NeighbourList& nl) {
@@ -376,7 +378,7 @@ class Treater {
     if ((treated && beyond_planes(key(i, bed_.size() + w.index), who)) || !out_.kept[i]) return;
     if (!treated) {
       if (t == T::shrink && w.gap(c, r / scale_) <= kContact * d_) ++treated_pw_;
-      return gap_left(gap, true, who);
+      return gap_left(gap, &w, who);
     }
     ++treated_pw_;
     const Eigen::Vector3d a = w.towards(c);
@@ -392,7 +394,7 @@ class Treater {
       double left = g;  // the disk's rim bends towards a concave wall
       for (const auto& q : out_.cuts[i].back().loop) left = std::min(left, w.reach(q));
       ++caps_;
-      return gap_left(left, true, who);
+      return gap_left(left, &w, who);
     }
     const double rb = 0.5 * p_.bridge_diameter_d * d_;
     if (t == T::enlarge || (gap < 0.0 && std::sqrt(-gap * (2.0 * r + gap)) >= 0.5 * rb)) return wall_union(i, w, a);
@@ -431,7 +433,7 @@ class Treater {
     area_ += lateral;
     wedge(0.5 * kPi + std::asin(rb / r));
     ++bridges_;
-    gap_left(shortest, true, who);
+    gap_left(shortest, &w, who);
   }
 
   // Sphere i crossing wall w: its mesh stops on the curve where they meet, and the wall gets a hole there.
@@ -553,6 +555,7 @@ class Treater {
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
   long grown_to_wall_ = 0;  // enlarged spheres grown further to meet a cylinder wall
   double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
+  double min_concave_wall_gap_ = min_pair_gap_;
   double min_wedge_ = std::numeric_limits<double>::infinity();
   std::string gap_error_;
   long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0;

@@ -31,7 +31,9 @@ struct TreatedBed {
   std::vector<WallHole> inlet_holes, outlet_holes;
   DomainPlanes planes;                            // as used: clip planes move off near-tangent spheres and contacts
   double solid_volume = 0.0;                      // exact volume of the treated solid (m^3)
-  double min_wall_gap = 0.0;                      // narrowest gap left between a sphere and a wall (m)
+  // Narrowest gap left between a sphere and a cylinder wall around the fluid (m): that wall's
+  // facets lie inside it, towards the spheres (an annulus's inner wall's lie away from them).
+  double min_concave_wall_gap = 0.0;
   nlohmann::json report;                          // contacts treated, volume and area change, gaps, angles
 };
 

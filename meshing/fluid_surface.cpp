@@ -135,11 +135,11 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   // A curved wall is faceted between vertices on it: its facets lie inside it by up to the
   // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a sphere.
   const double wall_sag = box ? 0.0 : ring_sagitta(R, edge);
-  if (wall_sag >= 0.5 * tb.min_wall_gap)
+  if (wall_sag >= 0.5 * tb.min_concave_wall_gap)
     throw InputError(fmt::format("surface.edge_length_d = {}: the wall facets lie up to {:.3g} d inside the wall, more "
                                  "than half the narrowest gap left at the wall ({:.3g} d); allowed: a shorter edge or a "
                                  "treatment that leaves a wider gap",
-                                 p.edge_length_d, wall_sag / d, tb.min_wall_gap / d));
+                                 p.edge_length_d, wall_sag / d, tb.min_concave_wall_gap / d));
 
   // Spheres, each on its own (in parallel), stopping at their cuts.
   const std::size_t n = bed.size();

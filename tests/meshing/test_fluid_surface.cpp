@@ -153,6 +153,12 @@ TEST(FluidSurface, EnlargeJoinsASphereLeftWithinTheWallFacetsReach) {
   // Far enough (0.01 d after enlarging), it is left alone.
   const FluidSurface apart = valid_surface(column(std::make_shared<Cylinder>(1.5), {{0.985, 0, 0.6}}), Treatment::enlarge, "apart");
   EXPECT_EQ(apart.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 0);
+  // An annulus's inner wall is faceted inside its cylinder, away from the spheres: a sphere
+  // as near to it is left as it is.
+  const FluidSurface inner =
+      valid_surface(column(std::make_shared<Annulus>(3.0, 1.0), {{1.5055, 0, 0.6}}), Treatment::enlarge, "inner wall");
+  EXPECT_EQ(inner.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 0);
+  EXPECT_NEAR(inner.report["smallest_gap_d"]["particle_wall"].get<double>(), 0.0005, 1e-9);
 }
 
 TEST(FluidSurface, ThreeMutuallyTouchingSpheresInAnAnnulus) {
