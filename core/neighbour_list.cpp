@@ -10,9 +10,9 @@ bool NeighbourList::update(const std::vector<Eigen::Vector3d>& x, const std::vec
   bool stale = built_at_.size() != x.size();
   if (!stale) {
     // A pair's gap has shrunk by at most the sum of the two spheres' displacements, so the list
-    // holds every touching pair while the two largest displacements sum to less than the skin.
-    // (Twice the largest would do too, but one fast sphere, a rattler falling in its cage,
-    // would then trigger rebuilds of the whole list twice as often.)
+    // holds every touching pair while the two largest displacements sum to less than the skin
+    // (the usual rule, twice the largest, rebuilds sooner; on packed beds the two rebuild about as
+    // often, since whole regions move together).
     auto keep_two_largest = [](double m, double& first, double& second) {
       if (m > first) {
         second = first;

@@ -50,6 +50,8 @@ struct Wall {
   }
   double gap(const Eigen::Vector3d& c, double r) const { return reach(c) - r; }
   bool beyond(const Eigen::Vector3d& p) const { return reach(p) < 0.0; }
+  // A cylinder around the fluid: its facets lie inside it, towards the spheres.
+  bool concave() const { return !plane && !inner; }
   // Unit direction from p to the nearest point of the wall.
   Eigen::Vector3d towards(const Eigen::Vector3d& p) const {
     if (plane) return n;
@@ -182,7 +184,7 @@ class Treater {
   void join_to_concave_wall(std::size_t i) {
     const double r0 = 0.5 * bed_.diameters[i];
     for (const Wall& w : walls_) {
-      if (w.plane || w.inner) continue;
+      if (!w.concave()) continue;
       const double gap = w.gap(bed_.centres[i], out_.radius[i]);
       if (gap < 0.0 || gap > 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) continue;
       out_.radius[i] += gap + (p_.enlarge_factor - 1.0) * r0;
@@ -204,7 +206,7 @@ class Treater {
   void gap_left(double gap, const Wall* wall, const std::string& what) {
     double& m = wall ? min_wall_gap_ : min_pair_gap_;
     m = std::min(m, gap);
-    if (wall && !wall->plane && !wall->inner) min_concave_wall_gap_ = std::min(min_concave_wall_gap_, gap);
+    if (wall && wall->concave()) min_concave_wall_gap_ = std::min(min_concave_wall_gap_, gap);
     if (gap < min_gap_) {
       min_gap_ = gap;
       gap_error_ = fmt::format("{} still touch{} or overlap{} by {:.3g} d after the '{}' treatment; allowed: a "

@@ -20,15 +20,21 @@ Eigen::Vector3d unit_normal(const TriangleMesh& m, const std::array<int, 3>& t) 
   return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
 }
 
+// Indices of the triangles of `patch` (all of them when negative), in order.
+std::vector<std::size_t> triangles_of(const TriangleMesh& m, int patch) {
+  std::vector<std::size_t> mine;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    if (patch < 0 || m.patch[k] == patch) mine.push_back(k);
+  return mine;
+}
+
 }  // namespace
 
 void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {
   constexpr std::size_t kChunk = 1 << 14, kBatch = 16;  // formatting is the slow part: chunks in parallel
   for (std::size_t p = 0; p < m.patches.size(); ++p) {
     out << "solid " << m.patches[p] << "\n";
-    std::vector<std::size_t> mine;
-    for (std::size_t k = 0; k < m.triangles.size(); ++k)
-      if (m.patch[k] == static_cast<int>(p)) mine.push_back(k);
+    const std::vector<std::size_t> mine = triangles_of(m, static_cast<int>(p));
     for (std::size_t first = 0; first < mine.size(); first += kChunk * kBatch) {
       std::vector<fmt::memory_buffer> chunks(kBatch);  // fmt writes into its own buffer directly
 #pragma omp parallel for schedule(dynamic)
@@ -55,9 +61,7 @@ void write_stl_binary(std::ostream& out, const TriangleMesh& m, int patch, const
   std::string head(80, ' ');
   std::memcpy(head.data(), header.data(), std::min<std::size_t>(80, header.size()));
   out << head;
-  std::vector<std::size_t> mine;
-  for (std::size_t k = 0; k < m.triangles.size(); ++k)
-    if (patch < 0 || m.patch[k] == patch) mine.push_back(k);
+  const std::vector<std::size_t> mine = triangles_of(m, patch);
   const auto count = static_cast<std::uint32_t>(mine.size());
   out.write(reinterpret_cast<const char*>(&count), 4);  // little-endian on every Debian target we build for
   // Records of 50 bytes (normal, three corners as float32, attribute count 0), filled in
