@@ -69,8 +69,7 @@ BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, dou
   double fluid = 0.0;
   for (int k = 0; k < mesh.cells; ++k)
     if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
-  const double area = std::numbers::pi * (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius);
-  s.void_fraction = fluid / (area * (s.z_high - s.z_low));
+  s.void_fraction = fluid / (g.cross_section_area * (s.z_high - s.z_low));
   return s;
 }
 
@@ -274,19 +273,19 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
       // Background cells, refined `snappy_level` times at every surface; the fluid is the side
       // holding the centre of the largest tetrahedron (inside the fluid and away from its
       // surface, also when a clip window leaves no empty section).
-      const double cell = p.snappy_cell_d * g.d_ref, pad = cell, r = g.outer_radius + pad;
+      const double cell = p.snappy_cell_d * g.d_ref, pad = cell;
+      const Eigen::Vector4d b = g.lateral_bounds + Eigen::Vector4d(-pad, -pad, pad, pad);
       const double z0 = g.inlet_z - pad, z1 = g.outlet_z + pad;
-      const int nxy = std::max(1, static_cast<int>(std::ceil(2 * r / cell))),
-                nz = std::max(1, static_cast<int>(std::ceil((z1 - z0) / cell)));
+      auto cells = [&](double length) { return std::max(1, static_cast<int>(std::ceil(length / cell))); };
       write_text(tmp / "constant/triSurface/fluid.stl", fluid_stl);
       write_text(tmp / "system/blockMeshDict",
                  dict("dictionary", "system", "blockMeshDict", note,
-                      fmt::format("convertToMeters 1;\n\nvertices\n(\n    ({0} {0} {2}) ({1} {0} {2}) ({1} {1} {2}) ({0} {1} {2})\n"
-                                  "    ({0} {0} {3}) ({1} {0} {3}) ({1} {1} {3}) ({0} {1} {3})\n);\n\n"
-                                  "blocks\n(\n    hex (0 1 2 3 4 5 6 7) ({4} {4} {5}) simpleGrading (1 1 1)\n);\n\n"
+                      fmt::format("convertToMeters 1;\n\nvertices\n(\n    ({0} {1} {4}) ({2} {1} {4}) ({2} {3} {4}) ({0} {3} {4})\n"
+                                  "    ({0} {1} {5}) ({2} {1} {5}) ({2} {3} {5}) ({0} {3} {5})\n);\n\n"
+                                  "blocks\n(\n    hex (0 1 2 3 4 5 6 7) ({6} {7} {8}) simpleGrading (1 1 1)\n);\n\n"
                                   "boundary\n(\n    background\n    {{\n        type patch;\n        faces\n        (\n"
                                   "            (0 3 2 1) (4 5 6 7) (0 1 5 4) (1 2 6 5) (2 3 7 6) (3 0 4 7)\n        );\n    }}\n);\n",
-                                  -r, r, z0, z1, nxy, nz)));
+                                  b[0], b[1], b[2], b[3], z0, z1, cells(b[2] - b[0]), cells(b[3] - b[1]), cells(z1 - z0))));
       write_text(tmp / "system/surfaceFeatureExtractDict",
                  dict("dictionary", "system", "surfaceFeatureExtractDict", note,
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
@@ -340,7 +339,7 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
           {"cells", mesh.cells},
           {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
           {"aspect_ratio", g.aspect_ratio},
-          {"inlet_area_m2", std::numbers::pi * (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius)},
+          {"inlet_area_m2", g.cross_section_area},
           {"d_ref_m", g.d_ref}};
 }
 

@@ -1,4 +1,6 @@
 #pragma once
+#include <Eigen/Core>
+
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -37,8 +39,12 @@ nlohmann::json to_json(const CaseParams& p);
 // What the case needs to know about the bed and its domain (m).
 struct CaseGeometry {
   double d_ref = 0.0;          // reference (Sauter) diameter
-  double aspect_ratio = 0.0;   // D/d, for the correlation
-  double outer_radius = 0.0, inner_radius = 0.0;  // inner_radius > 0 for an annulus
+  // D_h/d for the correlation, D_h = 4 A / P the hydraulic diameter: D for a cylinder. Eisfeld &
+  // Schnitzlein fitted cylinders; their wall term A_w (Mehta & Hawley's wall area per bed
+  // volume, 4 / D) is exact for any cross-section with D_h, B_w is carried over unproven.
+  double aspect_ratio = 0.0;
+  double cross_section_area = 0.0;
+  Eigen::Vector4d lateral_bounds = Eigen::Vector4d::Zero();  // xmin, ymin, xmax, ymax of the cross-section
   double inlet_z = 0.0, outlet_z = 0.0, bed_top = 0.0;
 };
 

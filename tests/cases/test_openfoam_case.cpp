@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -172,6 +173,33 @@ TEST(OpenFoamCase, ACaseWithoutAMeshAndAMeshWithoutAClosedSurfaceAreRefused) {
   EXPECT_EQ(open.status, 2) << open.output;
   EXPECT_NE(open.output.find("not closed"), std::string::npos) << open.output;
   EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+}
+
+// A walled box: checkMesh passes, and the correlation sees the box through its cross-section
+// (3 d x 4 d: area 12 d^2, hydraulic diameter 4 A / P = 24/7 d).
+TEST(OpenFoamCase, AWalledBoxGivesACaseCheckMeshPasses) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const fs::path dir = fresh_dir("box");
+  const double d = 0.002;
+  fs::create_directories(dir);
+  std::ofstream(dir / "box.toml") << "[container]\ntype = \"box\"\nsize_x_d = 3\nsize_y_d = 4\n";
+  ASSERT_EQ(bedforge("--quiet pack --scene " + (dir / "box.toml").string() + " --count 12 --diameter-m " + std::to_string(d) + " -o " +
+                     dir.string())
+                .status,
+            0);
+  ASSERT_EQ(bedforge("--quiet surface " + dir.string() + " --edge-length-d 0.1").status, 0);
+  ASSERT_EQ(bedforge("--quiet mesh " + dir.string()).status, 0);
+  const Result r = bedforge("--quiet case " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Result c = check_mesh(dir / "case");
+  EXPECT_NE(c.output.find("Mesh OK."), std::string::npos) << c.output;
+  const auto cs = nlohmann::json::parse(read(dir / "report.json"))["stages"]["case"];
+  EXPECT_NEAR(cs["inlet_area_m2"].get<double>(), 12.0 * d * d, 1e-12);
+  EXPECT_NEAR(cs["aspect_ratio"].get<double>(), 24.0 / 7.0, 1e-9);
+  // The bed section's void fraction is a fraction of the box's cross-section.
+  const double eps = cs["section"]["void_fraction_mesh"].get<double>();
+  EXPECT_GT(eps, 0.3);
+  EXPECT_LT(eps, 1.0);
 }
 
 TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
