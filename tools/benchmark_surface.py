@@ -5,6 +5,7 @@ writes docs/surface_benchmark.md and .json.
     /usr/bin/python3 tools/benchmark_surface.py                 # N = 500, 2000, 10000
     /usr/bin/python3 tools/benchmark_surface.py --counts 500 2000
     /usr/bin/python3 tools/benchmark_surface.py --counts 10000 --keep   # adds N = 1e4 to the rows there
+    /usr/bin/python3 tools/benchmark_surface.py --treatments enlarge --keep   # redoes the enlarge rows
 
 Beds: `bedforge pack --aspect-ratio 5 --count N --seed 1` (soft sphere, accelerated). Each
 treatment is a real `bedforge surface DIR --contacts T` on a copy of the bed, timed from outside
@@ -36,18 +37,20 @@ def timed(cmd):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--counts", type=int, nargs="+", default=[500, 2000, 10000])
+    ap.add_argument("--treatments", nargs="+", choices=TREATMENTS, default=TREATMENTS)
     ap.add_argument("--keep", action="store_true",
-                    help="keep the rows of docs/surface_benchmark.json for the counts not run now")
+                    help="keep the rows of docs/surface_benchmark.json for the counts and treatments not run now")
     args = ap.parse_args()
     rows = []
     if args.keep and os.path.exists(os.path.join(DOCS, "surface_benchmark.json")):
-        rows = [r for r in json.load(open(os.path.join(DOCS, "surface_benchmark.json"))) if r["n"] not in args.counts]
+        rows = [r for r in json.load(open(os.path.join(DOCS, "surface_benchmark.json")))
+                if r["n"] not in args.counts or r["treatment"] not in args.treatments]
     with tempfile.TemporaryDirectory() as tmp:
         for n in args.counts:
             bed = os.path.join(tmp, f"bed{n}")
             subprocess.run([BEDFORGE, "--quiet", "pack", "--aspect-ratio", "5", "--count", str(n), "--seed", "1", "-o", bed],
                            check=True)
-            for t in TREATMENTS:
+            for t in args.treatments:
                 work = os.path.join(tmp, f"{t}{n}")
                 shutil.copytree(bed, work)
                 wall, mb = timed([BEDFORGE, "--quiet", "surface", work, "--contacts", t])
@@ -62,7 +65,13 @@ def main():
                                                    s["smallest_gap_d"]["particle_wall"])})
                 print(rows[-1], flush=True)
                 shutil.rmtree(work)
+                rows.sort(key=lambda r: (r["n"], TREATMENTS.index(r["treatment"])))
                 write(rows)
+
+
+def allocator():
+    """The shared libraries of the benchmarked program, as ldd lists them."""
+    return subprocess.run(["ldd", BEDFORGE], capture_output=True, text=True).stdout
 
 
 def write(rows):
@@ -73,7 +82,11 @@ def write(rows):
              "Made by `/usr/bin/python3 tools/benchmark_surface.py` (a = 5, soft-sphere beds, seed 1, "
              "default `[contacts]` and `[surface]` settings, 2 cores). Wall time and peak memory of the whole "
              "`bedforge surface DIR` command, including writing the STL files; *ratio* = time per sphere "
-             "over that at the smallest N (1 = linear scaling).", "",
+             "over that at the smallest N (1 = linear scaling). The allocator matters here: bedforge is linked "
+             "with tcmalloc when `libgoogle-perftools-dev` is installed (these rows: "
+             f"{'tcmalloc' if 'tcmalloc' in allocator() else 'glibc malloc'}); with glibc's malloc the N = 1e4 cap "
+             "surface took 261 s and 162 s against 175 s and 124 s with tcmalloc, in two back-to-back pairs of runs "
+             "(2026-11-22).", "",
              "| N | treatment | contacts treated | triangles | wall s | build s | checks s | peak MB | ratio | "
              "volume error | chordal d | min angle | smallest gap d |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
