@@ -117,9 +117,9 @@ class Treater {
     out_.wall_holes.resize(walls_.size());
     out_.planes = planes;
     cut_angle_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
+    if (p.treatment == SurfaceParams::Treatment::enlarge) grow_to_join();
     for (std::size_t i = 0; i < n; ++i) {
-      out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
-      if (p.treatment == SurfaceParams::Treatment::enlarge) join_to_concave_wall(i);
       const double z = bed.centres[i].z();
       out_.kept[i] = !planes.clip || (z + out_.radius[i] > planes.z0 && z - out_.radius[i] < planes.z1);
       if (!out_.kept[i]) continue;
@@ -133,9 +133,11 @@ class Treater {
   TreatedBed run() {
     const std::size_t n = bed_.size();
     const double tolerance = treat_below(p_.treatment);
-    // Skin: the treatment's tolerance, and what a shrink opens (so every contact of the bed is seen).
+    // Skin: the treatment's tolerance, what a shrink opens and an enlarge closes, and the join
+    // gap: every contact of the bed is seen, and every gap the smallest-gap report must cover.
     const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
-    NeighbourList nl(std::max(tolerance, 0.0) + std::max(0.0, 1.0 - scale_) * d_max + 1e-3 * d_);
+    const double join = p_.treatment == T::enlarge ? p_.enlarge_join_gap_d * d_ : 0.0;
+    NeighbourList nl(std::max(tolerance, 0.0) + std::abs(1.0 - scale_) * d_max + join + 1e-3 * d_);
     nl.build(bed_.centres, out_.radius, *bed_.container);
     const double wall_pad = 0.6 * p_.edge_length_d * d_;  // the wall mesh keeps its holes this clear of its ends
     for (std::size_t i = 0; i < n; ++i) {
@@ -162,7 +164,8 @@ class Treater {
          {{"particle_particle", treated_pp_},
           {"particle_wall", treated_pw_},
           {"by_kind", {{"bridge", bridges_}, {"cap", caps_}, {"union", unions_}}},
-          {"grown_to_meet_the_wall", grown_to_wall_}}},
+          {"grown_to_meet_the_wall", grown_to_wall_},
+          {"grown_to_meet_a_sphere", grown_to_sphere_}}},
         {"solid_volume_change_relative", volume_ / volume0_ - 1.0},
         {"solid_volume_change_m3", volume_ - volume0_},
         {"particle_area_change_relative", area_ / area0_ - 1.0},
@@ -177,20 +180,52 @@ class Treater {
  private:
   using T = SurfaceParams::Treatment;
 
-  // The faceted wall of a cylinder lies inside it by up to its sagitta, so an enlarged sphere
-  // nearer to it than twice that would meet the facets. Such a sphere is taken as touching the
-  // wall: grown further, to cross it by what the enlargement gives a sphere that touched it
-  // (its radius x (factor - 1)), it is joined to the wall like the others.
-  void join_to_concave_wall(std::size_t i) {
-    const double r0 = 0.5 * bed_.diameters[i];
-    for (const Wall& w : walls_) {
-      if (!w.concave()) continue;
-      const double gap = w.gap(bed_.centres[i], out_.radius[i]);
-      if (gap < 0.0 || gap > 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) continue;
-      out_.radius[i] += gap + (p_.enlarge_factor - 1.0) * r0;
-      ++grown_to_wall_;
+  // Enlarging leaves the pairs that were just out of its reach a sliver of a gap (1e-6 d at
+  // N = 1e4), which no volume mesh resolves. So a sphere left nearer than
+  // `enlarge_join_gap_d` to another sphere or to a wall is grown further, to overlap it by what
+  // the enlargement gives spheres that touched (their radii x (factor - 1)), and joined like
+  // the others. A curved wall's facets lie inside it by up to their sagitta: there the reach
+  // is at least twice that. Growing can bring a sphere near a third one, so this repeats until
+  // no such gap is left.
+  void grow_to_join() {
+    const std::size_t n = bed_.size();
+    const double f = p_.enlarge_factor - 1.0, join = p_.enlarge_join_gap_d * d_;
+    auto r0 = [&](std::size_t i) { return 0.5 * bed_.diameters[i]; };
+    for (int round = 0;; ++round) {
+      std::vector<double> grow(n, 0.0);
+      std::string last;
+      for (std::size_t i = 0; i < n; ++i)
+        for (const Wall& w : walls_) {
+          const double gap = w.gap(bed_.centres[i], out_.radius[i]);
+          const double reach = w.concave() ? std::max(join, 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) : join;
+          if (gap < 0.0 || gap >= reach) continue;
+          grow[i] = std::max(grow[i], gap + f * r0(i));
+          ++grown_to_wall_;
+          last = fmt::format("sphere {} and the {}", i, w.name);
+        }
+      NeighbourList nl(join);
+      nl.build(bed_.centres, out_.radius, *bed_.container);
+      for (std::size_t i = 0; i < n; ++i)
+        for (int j : nl.of(i)) {
+          if (static_cast<std::size_t>(j) <= i) continue;
+          const double gap = (bed_.centres[j] - bed_.centres[i]).norm() - out_.radius[i] - out_.radius[j];
+          if (gap < 0.0 || gap >= join) continue;
+          const double g = 0.5 * (gap + f * (r0(i) + r0(j)));
+          grow[i] = std::max(grow[i], g);
+          grow[j] = std::max(grow[j], g);
+          ++grown_to_sphere_;
+          last = fmt::format("spheres {} and {}", i, j);
+        }
+      if (last.empty()) return;
+      if (round == kJoinRounds)
+        throw InputError(fmt::format("contacts.enlarge_join_gap_d = {}: after {} rounds of growing spheres to join "
+                                     "their near neighbours, {} are still nearer than that; allowed: a smaller "
+                                     "enlarge_join_gap_d or another treatment",
+                                     p_.enlarge_join_gap_d, kJoinRounds, last));
+      for (std::size_t i = 0; i < n; ++i) out_.radius[i] += grow[i];
     }
   }
+  static constexpr int kJoinRounds = 20;
 
   // Gap below which a contact is treated (pairs and walls share the tolerance of their treatment).
   double treat_below(T t) const {
@@ -555,7 +590,7 @@ class Treater {
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
   TreatedBed out_;
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
-  long grown_to_wall_ = 0;  // enlarged spheres grown further to meet a cylinder wall
+  long grown_to_wall_ = 0, grown_to_sphere_ = 0;  // enlarged spheres grown further to join a wall, pairs grown to join
   double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
   double min_concave_wall_gap_ = min_pair_gap_;
   double min_wedge_ = std::numeric_limits<double>::infinity();

@@ -43,6 +43,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
                                  wall, treatment_name(p.treatment)));
   p.shrink_factor = c.number("shrink_factor", p.shrink_factor, Range{0.5, 1.0, false, true});
   p.enlarge_factor = c.number("enlarge_factor", p.enlarge_factor, Range{1.0, 1.2, true, false});
+  p.enlarge_join_gap_d = c.number("enlarge_join_gap_d", p.enlarge_join_gap_d, Range::closed(0.0, 0.1));
   p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, true, true});
   p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
   p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
@@ -76,6 +77,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"wall_treatment", treatment_name(p.wall_treatment)},
           {"shrink_factor", p.shrink_factor},
           {"enlarge_factor", p.enlarge_factor},
+          {"enlarge_join_gap_d", p.enlarge_join_gap_d},
           {"bridge_diameter_d", p.bridge_diameter_d},
           {"bridge_gap_d", p.bridge_gap_d},
           {"cap_gap_d", p.cap_gap_d},

@@ -144,21 +144,60 @@ TEST(FluidSurface, EveryTreatmentHandlesTouchingNearlyTouchingAndWallTangentSphe
 
 TEST(FluidSurface, EnlargeJoinsASphereLeftWithinTheWallFacetsReach) {
   // Tube a = 3, edge 0.1 d: the wall's facets lie up to 8.2e-4 d inside it. A sphere 0.0055 d
-  // from the wall keeps 0.0005 d after enlarging by 1.01, inside twice that reach: it is grown
-  // to meet the wall and joined to it, instead of the stage failing on the narrow gap.
+  // from the wall keeps 0.0005 d after enlarging by 1.01: it is grown to meet the wall and
+  // joined to it, instead of the stage failing on the narrow gap; also with the join gap off,
+  // because the facets reach into that gap.
   const Bed b = column(std::make_shared<Cylinder>(1.5), {{0.9945, 0, 0.6}});
-  const FluidSurface fs = valid_surface(b, Treatment::enlarge, "enlarge");
-  EXPECT_EQ(fs.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 1);
-  EXPECT_EQ(fs.report["contacts_treated"]["particle_wall"].get<long>(), 1);
-  // Far enough (0.01 d after enlarging), it is left alone.
-  const FluidSurface apart = valid_surface(column(std::make_shared<Cylinder>(1.5), {{0.985, 0, 0.6}}), Treatment::enlarge, "apart");
+  SurfaceParams off;
+  off.treatment = off.wall_treatment = Treatment::enlarge;
+  off.enlarge_join_gap_d = 0.0;
+  for (const FluidSurface& fs : {valid_surface(b, Treatment::enlarge, "enlarge"), valid_surface(b, off, "join off")}) {
+    EXPECT_EQ(fs.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 1);
+    EXPECT_EQ(fs.report["contacts_treated"]["particle_wall"].get<long>(), 1);
+  }
+  // Far enough (0.015 d after enlarging, beyond the join gap of 0.01 d), it is left alone.
+  const FluidSurface apart = valid_surface(column(std::make_shared<Cylinder>(1.5), {{0.98, 0, 0.6}}), Treatment::enlarge, "apart");
   EXPECT_EQ(apart.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 0);
-  // An annulus's inner wall is faceted inside its cylinder, away from the spheres: a sphere
-  // as near to it is left as it is.
-  const FluidSurface inner =
-      valid_surface(column(std::make_shared<Annulus>(3.0, 1.0), {{1.5055, 0, 0.6}}), Treatment::enlarge, "inner wall");
-  EXPECT_EQ(inner.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 0);
-  EXPECT_NEAR(inner.report["smallest_gap_d"]["particle_wall"].get<double>(), 0.0005, 1e-9);
+  EXPECT_NEAR(apart.report["smallest_gap_d"]["particle_wall"].get<double>(), 0.015, 1e-9);
+  // An annulus's inner wall is faceted inside its cylinder, away from the spheres: only the
+  // join gap brings a sphere 0.0005 d from it to meet it.
+  const Bed inner = column(std::make_shared<Annulus>(3.0, 1.0), {{1.5055, 0, 0.6}});
+  EXPECT_EQ(valid_surface(inner, Treatment::enlarge, "inner wall")
+                .report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(),
+            1);
+  const FluidSurface left = valid_surface(inner, off, "inner wall, join off");
+  EXPECT_EQ(left.report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(), 0);
+  EXPECT_NEAR(left.report["smallest_gap_d"]["particle_wall"].get<double>(), 0.0005, 1e-9);
+}
+
+TEST(FluidSurface, EnlargeGrowsSpheresLeftNearerThanTheJoinGapUntilNoneIs) {
+  // Three spheres in a row in a tube a = 4, gaps 0.015 d and 0.0225 d. Enlarging by 1.01
+  // leaves 0.005 d and 0.0125 d: the first pair is nearer than the join gap (0.01 d), so both
+  // grow by (0.005 + 0.01) / 2 to overlap by 0.01 d, as touching spheres do. That brings the
+  // middle one within 0.005 d of the third: a second round joins them the same way.
+  const double x1 = 0.5075, x2 = x1 + 1.0225, shift = -0.5;  // all well clear of the wall
+  const Bed b = column(std::make_shared<Cylinder>(2.0),
+                       {{shift - x1, 0, 0.6}, {shift + x1, 0, 0.6}, {shift + x2, 0, 0.6}});
+  const FluidSurface fs = valid_surface(b, Treatment::enlarge, "row");
+  EXPECT_EQ(fs.report["contacts_treated"]["grown_to_meet_a_sphere"].get<long>(), 2);
+  EXPECT_EQ(fs.report["contacts_treated"]["by_kind"]["union"].get<long>(), 2);
+  // Radii 0.5125, 0.52, 0.5125 (overlaps 0.0175 d and 0.01 d): three balls less two lenses,
+  // each a cap on either side of the radical plane.
+  auto cap = [](double r, double h) { return std::numbers::pi * h * h * (3.0 * r - h) / 3.0; };
+  auto ball = [](double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; };
+  auto lens = [&](double ra, double rb, double dist) {
+    const double ha = (dist * dist + ra * ra - rb * rb) / (2.0 * dist), hb = dist - ha;  // centre to radical plane
+    return cap(ra, ra - ha) + cap(rb, rb - hb);
+  };
+  const double solid = 2.0 * ball(0.5125) + ball(0.52) - lens(0.5125, 0.52, 2.0 * x1) - lens(0.52, 0.5125, x2 - x1);
+  EXPECT_NEAR(fs.report["solid_volume_change_relative"].get<double>(), solid / (3.0 * ball(0.5)) - 1.0, 1e-9);
+  // With the join gap off, the first pair keeps its sliver.
+  SurfaceParams off;
+  off.treatment = off.wall_treatment = Treatment::enlarge;
+  off.enlarge_join_gap_d = 0.0;
+  const FluidSurface sliver = valid_surface(b, off, "join off");
+  EXPECT_EQ(sliver.report["contacts_treated"]["grown_to_meet_a_sphere"].get<long>(), 0);
+  EXPECT_NEAR(sliver.report["smallest_gap_d"]["particle_particle"].get<double>(), 0.005, 1e-9);
 }
 
 TEST(FluidSurface, ThreeMutuallyTouchingSpheresInAnAnnulus) {
