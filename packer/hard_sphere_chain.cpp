@@ -123,9 +123,12 @@ void HardSphereChain::adapt_displacement(double acceptance, double target, doubl
   delta_ = std::clamp(delta_ * (acceptance > target ? 1.05 : 0.95), lo, hi);
 }
 
-void HardSphereChain::lift(double height) {
+void HardSphereChain::lift(double height, double dilation) {
+  double top = 0.0;
+  for (const auto& q : x_) top = std::max(top, q.z());
+  const double stretch = top > 0.0 ? dilation * height / top : 0.0;
   for (std::size_t i = 0; i < x_.size(); ++i) {
-    x_[i].z() += height;
+    x_[i].z() += height + stretch * x_[i].z();
     const long cell = cell_index(x_[i]);
     if (cell != cell_of_[i]) {
       remove(static_cast<int>(i));

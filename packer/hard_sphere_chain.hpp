@@ -40,8 +40,9 @@ class HardSphereChain {
   double displacement() const { return delta_; }
   void set_displacement(double delta) { delta_ = delta; }
 
-  // Raises every sphere by `height` (a shake lifts the bed off the floor; see monte_carlo.hpp).
-  void lift(double height);
+  // Raises every sphere by `height` and stretches the bed upwards by `dilation` x `height` in
+  // proportion to each centre's height (a shake; see monte_carlo.hpp). Never creates an overlap.
+  void lift(double height, double dilation);
   void set_lid(double lid) { lid_ = lid; }
 
   const std::vector<Eigen::Vector3d>& positions() const { return x_; }

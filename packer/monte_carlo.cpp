@@ -43,6 +43,7 @@ MonteCarloParams read_monte_carlo_params(SceneSection& s) {
   p.mixing_cycles = s.integer("mixing_cycles", p.mixing_cycles, 0, 1'000'000'000);
   p.shakes = s.integer("shakes", p.shakes, 0, 1'000'000);
   p.shake_amplitude_d = s.number("shake_amplitude_d", p.shake_amplitude_d, Range::non_negative());
+  p.shake_dilation = s.number("shake_dilation", p.shake_dilation, Range::closed(0.0, 100.0));
   p.settle_block_cycles = s.integer("settle_block_cycles", p.settle_block_cycles, 1, 1'000'000);
   p.settle_tolerance_d = s.number("settle_tolerance_d", p.settle_tolerance_d, positive);
   p.max_settle_cycles = s.integer("max_settle_cycles", p.max_settle_cycles, 1, 1'000'000'000);
@@ -61,6 +62,7 @@ nlohmann::json to_json(const MonteCarloParams& p) {
           {"mixing_cycles", p.mixing_cycles},
           {"shakes", p.shakes},
           {"shake_amplitude_d", p.shake_amplitude_d},
+          {"shake_dilation", p.shake_dilation},
           {"settle_block_cycles", p.settle_block_cycles},
           {"settle_tolerance_d", p.settle_tolerance_d},
           {"max_settle_cycles", p.max_settle_cycles},
@@ -177,7 +179,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   long unsettled = 0;
   timed("shaking", [&] {
     for (long k = 0; k < params.shakes; ++k) {
-      chain.lift(amplitude);
+      chain.lift(amplitude, params.shake_dilation);
       double before = chain.mass_centre();
       long used = 0;
       bool settled = false;

@@ -16,8 +16,10 @@ namespace bedforge::packer {
 // smallest particle diameters (suffix _d) unless said otherwise. The schedule (docs/monte_carlo.md):
 //  (a) random placement below a lid, then `mixing_cycles` without gravity;
 //  (b) `shakes` shakes under gravity: the whole bed is lifted by `shake_amplitude_d` (the floor
-//      drops away, as in Rosato et al. 1987, which Castier et al. 1998 follow) and settles until
-//      its mass centre falls by less than `settle_tolerance_d` over `settle_block_cycles`;
+//      drops away, as in Rosato et al. 1987, which Castier et al. 1998 follow), optionally also
+//      stretched so its top rises by `shake_dilation` x the amplitude more (every gap opens in
+//      proportion to its height, as in a bed's flight phase), and settles until its mass centre
+//      falls by less than `settle_tolerance_d` over `settle_block_cycles`;
 //  (c) `settling_cycles` more cycles with gravity. A cycle is one trial move per particle.
 struct MonteCarloParams {
   double temperature = 0.01;                       // kT / (m*_ref g d_ref): barometric height in d
@@ -29,6 +31,7 @@ struct MonteCarloParams {
   long mixing_cycles = 10'000;
   long shakes = 10;                                // the paper: 10 for equal spheres, 100 for mixtures
   double shake_amplitude_d = 1.5;
+  double shake_dilation = 0.0;                     // 0: a rigid lift
   long settle_block_cycles = 100;
   double settle_tolerance_d = 1e-3;
   long max_settle_cycles = 20'000;                 // per shake; reported when reached

@@ -128,3 +128,25 @@ TEST(HardSphereChain, SameSeedSameChain) {
   EXPECT_EQ(run(4), run(4));
   EXPECT_NE(run(4), run(5));
 }
+
+TEST(HardSphereChain, AShakeLiftsAndStretchesTheBedWithoutOverlap) {
+  // A column of touching spheres and a tilted touching pair: lift by h = 1.5 with dilation 2,
+  // so the top centre (z = 4.5) rises by h + 2 h and every centre by h (1 + 2 z / 4.5).
+  Cylinder cyl(1.5);
+  HardSphereChain chain(cyl, 1.0, 20.0, kInf, 1);
+  const std::vector<Eigen::Vector3d> before = {{0, 0, 0.5}, {0, 0, 1.5}, {0, 0, 2.5}, {1, 0, 2.5}, {0.5, 0.5, 3.25}, {0, 0, 4.5}};
+  for (const auto& p : before) ASSERT_TRUE(chain.add(p, 0.5, 1.0)) << p.transpose();
+  const std::vector<double> r(before.size(), 0.5);
+  chain.lift(1.5, 2.0);
+  const std::vector<Eigen::Vector3d> after = chain.positions();
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    EXPECT_NEAR(after[i].z(), before[i].z() + 1.5 * (1.0 + 2.0 * before[i].z() / 4.5), 1e-12) << i;
+    EXPECT_EQ(after[i].head<2>(), before[i].head<2>()) << i;
+  }
+  // Vertical gaps open, horizontal ones stay (the pair side by side at z = 2.5 still touches,
+  // as does the sphere at the wall): nothing overlaps.
+  EXPECT_NEAR(worst_overlap(after, r, cyl), 0.0, 1e-12);
+  // A rigid lift moves everything by h alone.
+  chain.lift(1.0, 0.0);
+  EXPECT_NEAR(chain.positions()[0].z(), after[0].z() + 1.0, 1e-12);
+}
