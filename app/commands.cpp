@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <numbers>
 #include <optional>
 
 #include "analysis/bed_analysis.hpp"
@@ -237,17 +236,7 @@ void add_case(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CasePa
   const Container& c = *bed.container;
   g.cross_section_area = c.cross_section_area();
   g.lateral_bounds = c.lateral_bounds();
-  double perimeter = 0.0;  // wetted by the walls
-  if (const auto* ann = dynamic_cast<const Annulus*>(&c)) {
-    perimeter = 2.0 * std::numbers::pi * (ann->outer_radius() + ann->inner_radius());
-  } else if (const auto* cyl = dynamic_cast<const Cylinder*>(&c)) {
-    perimeter = 2.0 * std::numbers::pi * cyl->radius();
-  } else if (const auto* box = dynamic_cast<const Box*>(&c)) {
-    perimeter = 2.0 * (box->size_x() + box->size_y());
-  } else {
-    throw InputError(fmt::format("container.type = \"{}\": cases are made for cylinders, annuli and boxes", c.kind()));
-  }
-  g.aspect_ratio = 4.0 * g.cross_section_area / perimeter / g.d_ref;  // hydraulic diameter over d
+  g.aspect_ratio = 4.0 * g.cross_section_area / c.wall_perimeter() / g.d_ref;  // hydraulic diameter over d
   g.inlet_z = std::numeric_limits<double>::infinity();
   g.outlet_z = -g.inlet_z;
   for (const auto& x : mesh.points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());

@@ -10,6 +10,7 @@
 namespace bedforge {
 
 double Cylinder::cross_section_area() const { return std::numbers::pi * radius_ * radius_; }
+double Cylinder::wall_perimeter() const { return 2.0 * std::numbers::pi * radius_; }
 
 int Cylinder::wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const {
   const double rho = std::sqrt(c.x() * c.x() + c.y() * c.y());  // hypot's overflow care costs 10 % of a packing
@@ -34,6 +35,7 @@ std::unique_ptr<Container> Cylinder::scaled(double factor) const { return std::m
 nlohmann::json Cylinder::to_json() const { return {{"type", "cylinder"}, {"diameter", 2.0 * radius_}}; }
 
 double Annulus::cross_section_area() const { return std::numbers::pi * (outer_ * outer_ - inner_ * inner_); }
+double Annulus::wall_perimeter() const { return 2.0 * std::numbers::pi * (outer_ + inner_); }
 
 int Annulus::wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const {
   const double rho = std::sqrt(c.x() * c.x() + c.y() * c.y());

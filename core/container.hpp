@@ -50,6 +50,9 @@ class Container {
   virtual std::string kind() const = 0;
   // Cross-section area (length^2).
   virtual double cross_section_area() const = 0;
+  // Length of wall around the cross-section (periodic sides have none): with the area, the
+  // hydraulic diameter 4 A / P.
+  virtual double wall_perimeter() const = 0;
   // Walls overlapped by the sphere (centre c, radius r): writes up to kMaxWallContacts, returns
   // count. Periodic sides have no walls.
   virtual int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const = 0;
@@ -76,6 +79,7 @@ class Cylinder final : public Container {
 
   std::string kind() const override { return "cylinder"; }
   double cross_section_area() const override;
+  double wall_perimeter() const override;
   int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const override;
   Eigen::Vector2d sample_centre(Rng& rng, double r) const override;
   double max_radius() const override { return radius_; }
@@ -97,6 +101,7 @@ class Annulus final : public Container {
 
   std::string kind() const override { return "annulus"; }
   double cross_section_area() const override;
+  double wall_perimeter() const override;
   int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const override;
   Eigen::Vector2d sample_centre(Rng& rng, double r) const override;
   double max_radius() const override { return 0.5 * (outer_ - inner_); }
@@ -119,6 +124,7 @@ class Box final : public Container {
 
   std::string kind() const override { return "box"; }
   double cross_section_area() const override { return lx_ * ly_; }
+  double wall_perimeter() const override { return (px_ ? 0.0 : 2.0 * ly_) + (py_ ? 0.0 : 2.0 * lx_); }
   int wall_contacts(const Eigen::Vector3d& c, double r, WallContact* out) const override;
   Eigen::Vector2d sample_centre(Rng& rng, double r) const override;
   Periodicity periodicity() const override { return {px_ ? lx_ : 0.0, py_ ? ly_ : 0.0}; }

@@ -191,14 +191,16 @@ class Treater {
     const std::size_t n = bed_.size();
     const double f = p_.enlarge_factor - 1.0, join = p_.enlarge_join_gap_d * d_;
     auto r0 = [&](std::size_t i) { return 0.5 * bed_.diameters[i]; };
+    std::vector<double> reach;  // per wall
+    for (const Wall& w : walls_)
+      reach.push_back(w.concave() ? std::max(join, 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) : join);
     for (int round = 0;; ++round) {
       std::vector<double> grow(n, 0.0);
       std::string last;
       for (std::size_t i = 0; i < n; ++i)
         for (const Wall& w : walls_) {
           const double gap = w.gap(bed_.centres[i], out_.radius[i]);
-          const double reach = w.concave() ? std::max(join, 2.0 * ring_sagitta(w.R, p_.edge_length_d * d_)) : join;
-          if (gap < 0.0 || gap >= reach) continue;
+          if (gap < 0.0 || gap >= reach[w.index]) continue;
           grow[i] = std::max(grow[i], gap + f * r0(i));
           ++grown_to_wall_;
           last = fmt::format("sphere {} and the {}", i, w.name);

@@ -105,6 +105,17 @@ TEST(Box, WallsOnlyOnNonPeriodicSides) {
   EXPECT_EQ(p.lx, 0.0);
   EXPECT_NEAR(p.separation({0, 1.4, 0}, {0, -1.4, 0}).y(), -0.2, 1e-12);
   EXPECT_NEAR(p.wrapped({0, 1.6, 0}).y(), -1.4, 1e-12);
+  // Wall only along the two x walls (each 3 long); all four sides when walled.
+  EXPECT_DOUBLE_EQ(b.wall_perimeter(), 6.0);
+  EXPECT_DOUBLE_EQ(corner.wall_perimeter(), 14.0);
+}
+
+TEST(Containers, HydraulicDiameterOfCircularShapesIsTheirWidth) {
+  // 4 A / P: the diameter of a cylinder, the gap's width twice over for an annulus.
+  const Cylinder c(1.5);
+  EXPECT_NEAR(4.0 * c.cross_section_area() / c.wall_perimeter(), 3.0, 1e-12);
+  const Annulus a(5.0, 2.0);
+  EXPECT_NEAR(4.0 * a.cross_section_area() / a.wall_perimeter(), 6.0, 1e-12);
 }
 
 TEST(Containers, ReadWithClearErrors) {
