@@ -218,9 +218,12 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
       j["fluid_volume_relative_error"].get<double>(), j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
       std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()));
-  if (j.contains("clip"))
+  if (j.contains("clip")) {
     line += fmt::format(", clipped at {:.3f}-{:.3f} d", j["clip"]["inlet"]["used_d"].get<double>(),
                         j["clip"]["outlet"]["used_d"].get<double>());
+    const long opened = j["clip"]["inlet"]["contacts_opened"].get<long>() + j["clip"]["outlet"]["contacts_opened"].get<long>();
+    if (opened > 0) line += fmt::format(" ({} contacts opened there)", opened);
+  }
   finish_stage(j, meter, line, console);
   report.set_stage("surface", j);
   return built;

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <optional>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "analysis/intersection_volumes.hpp"
 #include "analysis/quadrature.hpp"
@@ -98,12 +99,22 @@ std::vector<Wall> walls_of(const Container& c) {
 // What a treated contact occupies in z (m): a clip plane must keep clear of it.
 using Extents = std::unordered_map<long long, std::pair<double, double>>;
 
+// Contacts a clip plane cuts through, opened instead of treated (see treat_contacts): their
+// spheres shrink by contacts.shrink_factor and the contacts are left as gaps.
+struct Opening {
+  std::vector<char> spheres;              // per sphere
+  std::unordered_set<long long> contacts;  // keys as Treater::key
+};
+
 class Treater {
  public:
   // `survey`: the extents of the contacts treated without clip planes, to leave out those
   // beyond the planes (null without clipping). `measure`: record this run's extents.
-  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey, bool measure)
-      : bed_(bed), p_(p), planes_(planes), survey_(survey), measure_(measure), walls_(walls_of(*bed.container)) {
+  // `opening`: contacts to open at the clip planes (null: none).
+  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey, bool measure,
+          const Opening* opening = nullptr)
+      : bed_(bed), p_(p), planes_(planes), survey_(survey), measure_(measure), opening_(opening),
+        walls_(walls_of(*bed.container)) {
     d_ = sauter_mean(bed.diameters);
     edge_c_ = p.contact_edge_length_d * d_;
     scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
@@ -117,7 +128,8 @@ class Treater {
     out_.wall_holes.resize(walls_.size());
     out_.planes = planes;
     cut_angle_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out_.radius[i] = scale_ * 0.5 * bed.diameters[i];
+    for (std::size_t i = 0; i < n; ++i)
+      out_.radius[i] = (opening && opening->spheres[i] ? p.shrink_factor : scale_) * 0.5 * bed.diameters[i];
     if (p.treatment == SurfaceParams::Treatment::enlarge) grow_to_join();
     for (std::size_t i = 0; i < n; ++i) {
       const double z = bed.centres[i].z();
@@ -137,7 +149,8 @@ class Treater {
     // gap: every contact of the bed is seen, and every gap the smallest-gap report must cover.
     const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
     const double join = p_.treatment == T::enlarge ? p_.enlarge_join_gap_d * d_ : 0.0;
-    NeighbourList nl(std::max(tolerance, 0.0) + std::abs(1.0 - scale_) * d_max + join + 1e-3 * d_);
+    const double resized = std::max(std::abs(1.0 - scale_), opening_ ? 1.0 - p_.shrink_factor : 0.0);
+    NeighbourList nl(std::max(tolerance, 0.0) + resized * d_max + join + 1e-3 * d_);
     nl.build(bed_.centres, out_.radius, *bed_.container);
     const double wall_pad = 0.6 * p_.edge_length_d * d_;  // the wall mesh keeps its holes this clear of its ends
     for (std::size_t i = 0; i < n; ++i) {
@@ -172,6 +185,8 @@ class Treater {
         {"smallest_gap_d", {{"particle_particle", min_pair_gap_ / d_}, {"particle_wall", min_wall_gap_ / d_}}},
         {"smallest_fluid_wedge_angle_deg", angle(min_wedge_)},
         {"solid_volume_exact_m3", volume_}};
+    if (opening_)
+      out_.report["opened_at_clip_planes"] = {{"particle_particle", opened_pp_}, {"particle_wall", opened_pw_}};
     return std::move(out_);
   }
 
@@ -260,7 +275,15 @@ class Treater {
     cut_angle_[i].push_back(angle);
   }
 
+  // A contact's key: spheres i < j, or sphere i and wall w as j = n + w.
   long long key(std::size_t i, std::size_t j) const { return static_cast<long long>(i) * (bed_.size() + 8) + j; }
+
+ public:
+  static std::pair<std::size_t, std::size_t> unkey(long long k, std::size_t n) {
+    return {static_cast<std::size_t>(k) / (n + 8), static_cast<std::size_t>(k) % (n + 8)};
+  }
+
+ private:
 
   // How much geometry there is before a contact is treated, so its extent can be taken after.
   struct Marks {
@@ -309,6 +332,23 @@ class Treater {
     return false;
   }
 
+  // Contact k (`wall`: its wall, null for a pair) when it is opened at a clip plane: its gap is
+  // left as it is (nothing to do when a sphere of it is left out); returns false for any other
+  // contact. InputError when shrinking did not open it (an overlap deeper than the shrink).
+  bool open(long long k, const std::string& who, double gap, bool kept, const Wall* wall) {
+    if (!opening_ || !opening_->contacts.count(k)) return false;
+    if (!kept) return true;
+    if (!(gap > 0.0))
+      throw InputError(fmt::format("{} meet at a clip plane, so they are shrunk by contacts.shrink_factor = {} "
+                                   "instead of treated, but still overlap by {:.3g} d; allowed: a smaller "
+                                   "shrink_factor, or a clip window whose planes find room between the contacts "
+                                   "(surface.clip_shift_d)",
+                                   who, p_.shrink_factor, -gap / d_));
+    ++(wall ? opened_pw_ : opened_pp_);
+    gap_left(gap, wall, who);
+    return true;
+  }
+
   // A planar cut of sphere i at distance h along axis a (unit), its loop of n vertices on the
   // circle of radius rho (given, so a bridge's loop is exactly its tube's) about `at` (default
   // c + h a); returns the loop's frame.
@@ -332,6 +372,7 @@ class Treater {
     const Eigen::Vector3d &ci = bed_.centres[i], &cj = bed_.centres[j];
     const double ri = out_.radius[i], rj = out_.radius[j], dist = (cj - ci).norm(), gap = dist - ri - rj;
     const std::string who = fmt::format("spheres {} and {}", i, j);
+    if (open(key(i, j), who, gap, out_.kept[i] && out_.kept[j], nullptr)) return;
     const bool treated = gap < treat_below(p_.treatment);
     if ((treated && beyond_planes(key(i, j), who)) || !out_.kept[i] || !out_.kept[j]) return;
     if (!treated) {
@@ -412,6 +453,7 @@ class Treater {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i], gap = w.gap(c, r);
     const std::string who = fmt::format("sphere {} and the {}", i, w.name);
+    if (open(key(i, bed_.size() + w.index), who, gap, out_.kept[i], &w)) return;
     const T t = p_.wall_treatment;
     const bool treated = gap < treat_below(t);
     if ((treated && beyond_planes(key(i, bed_.size() + w.index), who)) || !out_.kept[i]) return;
@@ -587,6 +629,7 @@ class Treater {
   DomainPlanes planes_;
   const Extents* survey_;
   bool measure_;
+  const Opening* opening_;
   std::vector<Wall> walls_;
   Extents extents_;
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
@@ -597,7 +640,7 @@ class Treater {
   double min_concave_wall_gap_ = min_pair_gap_;
   double min_wedge_ = std::numeric_limits<double>::infinity();
   std::string gap_error_;
-  long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0;
+  long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0, opened_pp_ = 0, opened_pw_ = 0;
   std::vector<std::vector<double>> cut_angle_;  // per sphere and cut, see add_cut
 };
 
@@ -640,34 +683,64 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   if (!planes.clip) return Treater(bed, p, planes, nullptr, false).run();
   // Survey the whole bed's contacts, place the clip planes clear of them and of every sphere's
   // top and bottom, then treat the window.
+  const std::size_t n = bed.size();
   const double inf = std::numeric_limits<double>::infinity();
   Treater survey(bed, p, {-inf, inf, false}, nullptr, true);
   const TreatedBed whole = survey.run();
-  const double d = sauter_mean(bed.diameters);
-  std::vector<std::pair<double, double>> obstacles;
-  for (std::size_t i = 0; i < bed.size(); ++i) {
+  const double d = sauter_mean(bed.diameters), d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
+  const double clearance = p.clip_clearance_d * d;
+  std::vector<std::pair<double, double>> sphere_ends, everything;
+  for (std::size_t i = 0; i < n; ++i) {
     const double z = bed.centres[i].z(), r = whole.radius[i];
-    obstacles.push_back({z - r, z - r}), obstacles.push_back({z + r, z + r});
+    for (double e : {z - r, z + r}) sphere_ends.push_back({e, e});
   }
-  for (const auto& [k, range] : survey.extents()) obstacles.push_back(range);
+  everything = sphere_ends;
+  for (const auto& [k, range] : survey.extents()) everything.push_back(range);
+  // A packed bed has bridges or caps at every height, so a plane often finds no height clear of
+  // them. Such a plane then keeps clear of the spheres' tops and bottoms only (at either radius)
+  // and the contacts near it are opened: both spheres shrink by contacts.shrink_factor, as in
+  // the shrink treatment, and the contact is left as a gap. Not with enlarge, whose grown
+  // neighbours a shrunk sphere would still overlap.
+  const bool can_open = p.treatment != SurfaceParams::Treatment::enlarge &&
+                        p.wall_treatment != SurfaceParams::Treatment::enlarge;
+  auto with_shrunk = sphere_ends;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double z = bed.centres[i].z(), r = 0.5 * p.shrink_factor * bed.diameters[i];
+    for (double e : {z - r, z + r}) with_shrunk.push_back({e, e});
+  }
+  const double moved = (1.0 - p.shrink_factor) * d_max;  // how far a contact's geometry moves when opened
+  Opening opening;
+  opening.spheres.assign(n, 0);
   const DomainPlanes asked = planes;
   nlohmann::json clip_report;
   for (auto [z, name] : {std::pair<double*, const char*>{&planes.z0, "inlet"}, {&planes.z1, "outlet"}}) {
-    const ClipHeight h = clip_height(*z, p.clip_shift_d * d, p.clip_clearance_d * d, obstacles);
-    if (!(h.clearance >= p.clip_clearance_d * d))
+    ClipHeight h = clip_height(*z, p.clip_shift_d * d, clearance, everything);
+    const bool opens = !(h.clearance >= clearance) && can_open;
+    if (opens) h = clip_height(*z, p.clip_shift_d * d, clearance, with_shrunk);
+    if (!(h.clearance >= clearance))
       throw InputError(fmt::format(
           "surface.clip_window_d: the {} clip plane at {:.4g} d finds no height within surface.clip_shift_d = {} d "
-          "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom and every treated "
-          "contact (at best {:.3g} d, at {:.4g} d); allowed: a larger clip_shift_d, a smaller clip_clearance_d, or "
-          "a treatment that leaves no contact geometry (shrink, none)",
-          name, *z / d, p.clip_shift_d, p.clip_clearance_d, h.clearance / d, h.z / d));
+          "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom{} (at best {:.3g} d, at "
+          "{:.4g} d); allowed: a larger clip_shift_d or a smaller clip_clearance_d",
+          name, *z / d, p.clip_shift_d, p.clip_clearance_d, can_open ? "" : " and every enlarged contact",
+          h.clearance / d, h.z / d));
     *z = h.z;
+    long opened = 0;
+    if (opens)
+      for (const auto& [k, range] : survey.extents()) {
+        if (!(range.first < h.z + clearance + moved && range.second > h.z - clearance - moved)) continue;
+        opening.contacts.insert(k);
+        const auto [i, j] = Treater::unkey(k, n);
+        opening.spheres[i] = 1;
+        if (j < n) opening.spheres[j] = 1;
+        ++opened;
+      }
     clip_report[name] = {{"asked_d", (name[0] == 'i' ? asked.z0 : asked.z1) / d}, {"used_d", h.z / d},
-                         {"clearance_d", h.clearance / d}};
+                         {"clearance_d", h.clearance / d}, {"contacts_opened", opened}};
   }
   if (!(planes.z1 > planes.z0))
     throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
-  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false).run();
+  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false, opening.contacts.empty() ? nullptr : &opening).run();
   out.report["clip"] = clip_report;
   return out;
 }

@@ -387,17 +387,44 @@ TEST(FluidSurface, AClipPlaneMovesOffBridgedContacts) {
     EXPECT_LE(std::abs(z1 - 2.0), reach + 1.01 * p.clip_clearance_d) << b.container->kind() << ": the nearest clear height";
     EXPECT_GT(fs.report["contacts_treated"]["particle_particle"].get<long>(), 0);
   }
-  // A tight window around a layer's contacts with no room to move: a clear error.
+}
+
+TEST(FluidSurface, AClipPlaneWithNoRoomOpensTheContactsItCuts) {
+  // The outlet asked at 2.004 d, next to the four vertical contacts at z = 2.0, with room to
+  // move 0.01 d only: those contacts reach 0.0101 d above and below (the cap each cuts off its
+  // sphere, 0.5 - sqrt(0.24) d for a bridge, more for a cap), which with 0.005 d clearance
+  // needs 2.0151 d. So the plane keeps clear of the spheres' ends alone, at either radius (2.0,
+  // and 2.0 +- 0.005 shrunk), nearest at 2.005 + 1.001 x 0.005 d, and opens those four
+  // contacts: their eight spheres shrink by shrink_factor, leaving gaps of (1 - shrink_factor) d.
+  for (Treatment t : {Treatment::bridge, Treatment::cap}) {
+    SurfaceParams p;
+    p.treatment = p.wall_treatment = t;
+    p.clip = true;
+    p.clip_bottom_d = 0.9;
+    p.clip_top_d = 2.004;
+    p.clip_shift_d = 0.01;
+    const std::string name = treatment_name(t);
+    const FluidSurface fs = valid_surface(box_stack(4), p, "opened at the clip plane, " + name);
+    EXPECT_NEAR(fs.report["domain_m"]["outlet_z"].get<double>(), 2.005 + 1.001 * p.clip_clearance_d, 1e-12) << name;
+    EXPECT_EQ(fs.report["clip"]["outlet"]["contacts_opened"].get<long>(), 4) << name;
+    EXPECT_EQ(fs.report["clip"]["inlet"]["contacts_opened"].get<long>(), 0) << name << ": the inlet found room";
+    EXPECT_EQ(fs.report["opened_at_clip_planes"]["particle_particle"].get<long>(), 4) << name;
+    EXPECT_EQ(fs.report["opened_at_clip_planes"]["particle_wall"].get<long>(), 0) << name;
+    EXPECT_NEAR(fs.report["smallest_gap_d"]["particle_particle"].get<double>(), 1.0 - p.shrink_factor, 1e-9) << name;
+  }
+  // Enlarge cannot open a contact (its grown neighbours would still overlap a shrunk sphere):
+  // with no room between its unions, a clear error.
   SurfaceParams p;
-  p.treatment = p.wall_treatment = Treatment::bridge;
+  p.treatment = p.wall_treatment = Treatment::enlarge;
   p.clip = true;
   p.clip_bottom_d = 0.9;
   p.clip_top_d = 2.0;
-  p.clip_shift_d = 0.01;
+  p.clip_shift_d = 0.005;
   try {
     build_fluid_surface(box_stack(4), p);
     FAIL() << "accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("clip_window_d"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("enlarged contact"), std::string::npos) << e.what();
   }
 }
