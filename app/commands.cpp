@@ -25,6 +25,7 @@
 #include "meshing/fluid_surface.hpp"
 #include "meshing/stl_io.hpp"
 #include "meshing/vtp_io.hpp"
+#include "meshing/defect_locations.hpp"
 #include "meshing/surface_checks.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
@@ -173,9 +174,11 @@ void add_analysis(const Bed& bed, const analysis::AnalysisParams& params, Report
 
 #ifdef BEDFORGE_HAVE_CGAL
 // Surface stage: treated contacts, the fluid-domain surface checked by CGAL, STL files.
-// Returns the surface for the mesh stage; writes the STL files when `write_files`.
+// Returns the surface for the mesh stage; writes the STL files when `write_files`. A surface
+// failing the angle gate writes its bad triangles to DIR/bad_triangles.vtp and throws.
 std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const meshing::SurfaceParams& p,
-                                                         const std::string& version, bool write_files, Report& report,
+                                                         const std::string& version, bool write_files,
+                                                         const std::filesystem::path& dir, Report& report,
                                                          Outputs& files, const Console& console) {
   const StageMeter meter;
   auto built = std::make_shared<meshing::FluidSurface>(meshing::build_fluid_surface(bed, p));
@@ -195,6 +198,31 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
                                          check.to_json().dump(), check.defects.size(), where));
   }
   j["fluid_volume_relative_error"] = (check.volume - exact) / exact;
+  if (j["min_angle_deg"].get<double>() < p.min_angle_deg) {
+    // Say where the needles and slivers are: the nearest particle to each, and all of them in a
+    // file for ParaView.
+    meshing::TriangleMesh bad;
+    bad.patches = fs.fluid.patches;
+    std::vector<Eigen::Vector3d> centroids;
+    for (std::size_t t = 0; t < fs.fluid.triangles.size(); ++t) {
+      if (meshing::min_angle_deg(fs.fluid, t) >= p.min_angle_deg) continue;
+      const int first = static_cast<int>(bad.points.size());
+      for (int v : fs.fluid.triangles[t]) bad.points.push_back(fs.fluid.points[v]);
+      bad.triangles.push_back({first, first + 1, first + 2});
+      bad.patch.push_back(fs.fluid.patch[t]);
+      centroids.push_back((bad.points[first] + bad.points[first + 1] + bad.points[first + 2]) / 3.0);
+    }
+    const meshing::DefectLocations where = meshing::locate_defects(bed, centroids, "triangles");
+    const std::filesystem::path path = dir / "bad_triangles.vtp";
+    write_file_atomically(path, [&](std::ostream& out) {
+      meshing::write_vtp(out, bad, "bedforge " + version + " surface triangles below surface.min_angle_deg, lengths in m");
+    });
+    throw ConvergenceError(fmt::format(
+        "surface: {} triangles have an angle below surface.min_angle_deg = {} deg (smallest {:.2f} deg), most near {}; "
+        "written to {}. Refine where contacts meet (surface.contact_edge_length_d), widen the gaps ([contacts]), "
+        "move the clip window, or lower surface.min_angle_deg",
+        bad.triangles.size(), p.min_angle_deg, j["min_angle_deg"].get<double>(), where.summary, path.string()));
+  }
   if (write_files) {
     files.add_writer("fluid.stl", [built](std::ostream& out) { meshing::write_stl_ascii_by_patch(out, built->fluid); });
     for (std::size_t k = 0; k < fs.fluid.patches.size(); ++k)
@@ -410,7 +438,7 @@ int run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, co
     console.line(fmt::format("surface: reused the surface in {} (bed, [contacts] and [surface] unchanged)", dir.string()));
     report.set_stage("surface", surface_reused);
   } else if (write_stl || (scene.needs_mesh() && mesh_reused.is_null())) {
-    surface = add_surface(pack.bed, scene.surface, kVersion, write_stl, report, files, console);
+    surface = add_surface(pack.bed, scene.surface, kVersion, write_stl, dir, report, files, console);
     report.set_cache_key("surface", surface_key);
   }
 #endif
@@ -594,7 +622,7 @@ int run_command_line(int argc, char** argv) {
   surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
   std::optional<std::string> treatment, wall_treatment;
   std::optional<double> shrink_factor, enlarge_factor, bridge_diameter_d, bridge_gap_d, cap_gap_d, edge_length_d,
-      contact_edge_length_d, inlet_length_d, outlet_length_d;
+      contact_edge_length_d, inlet_length_d, outlet_length_d, min_angle_deg;
   surface->add_option("--contacts", treatment,
                       "bridge|cap|shrink|enlarge|none, contact treatment (sets contacts.treatment); default shrink");
   surface->add_option("--wall-contacts", wall_treatment,
@@ -616,6 +644,9 @@ int run_command_line(int argc, char** argv) {
   surface->add_option("--contact-edge-length-d", contact_edge_length_d,
                       "FLOAT in [0.001,1], edge where treated contacts meet, in diameters (sets "
                       "surface.contact_edge_length_d); default 0.025");
+  surface->add_option("--min-angle-deg", min_angle_deg,
+                      "FLOAT in [0,30], quality gate: smallest triangle angle allowed in degrees, else the stage fails "
+                      "and writes bad_triangles.vtp (sets surface.min_angle_deg); default 2");
   surface->add_option("--inlet-length-d", inlet_length_d,
                       "FLOAT >= 0, empty section below the bed in diameters (sets surface.inlet_length_d); default 1");
   surface->add_option("--outlet-length-d", outlet_length_d,
@@ -711,6 +742,7 @@ int run_command_line(int argc, char** argv) {
     if (cap_gap_d) override_key(table, "contacts.cap_gap_d", *cap_gap_d);
     if (edge_length_d) override_key(table, "surface.edge_length_d", *edge_length_d);
     if (contact_edge_length_d) override_key(table, "surface.contact_edge_length_d", *contact_edge_length_d);
+    if (min_angle_deg) override_key(table, "surface.min_angle_deg", *min_angle_deg);
     if (inlet_length_d) override_key(table, "surface.inlet_length_d", *inlet_length_d);
     if (outlet_length_d) override_key(table, "surface.outlet_length_d", *outlet_length_d);
     if (!clip_window_d.empty()) {
@@ -725,7 +757,7 @@ int run_command_line(int argc, char** argv) {
     const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
     contacts.finish();
     surf.finish();
-    add_surface(in.bed, params, kVersion, true, report, files, console);
+    add_surface(in.bed, params, kVersion, true, d, report, files, console);
     files.write(d);
     report.save(d);
     return 0;

@@ -69,6 +69,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.clip_shift_d = s.number("clip_shift_d", p.clip_shift_d, Range::closed(0.0, 1.0));
   p.clip_clearance_d = s.number("clip_clearance_d", p.clip_clearance_d, Range::closed(0.0, 0.1));
   p.self_intersection_limit = s.integer("self_intersection_limit", p.self_intersection_limit, 0, 1'000'000'000);
+  p.min_angle_deg = s.number("min_angle_deg", p.min_angle_deg, Range::closed(0.0, 30.0));
   return p;
 }
 
@@ -89,7 +90,8 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"clip_window_d", p.clip ? nlohmann::json::array({p.clip_bottom_d, p.clip_top_d}) : nlohmann::json(nullptr)},
           {"clip_shift_d", p.clip_shift_d},
           {"clip_clearance_d", p.clip_clearance_d},
-          {"self_intersection_limit", p.self_intersection_limit}};
+          {"self_intersection_limit", p.self_intersection_limit},
+          {"min_angle_deg", p.min_angle_deg}};
 }
 
 namespace {

@@ -34,6 +34,9 @@ struct SurfaceParams {
   double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
   long self_intersection_limit = 5'000'000;  // triangles above which the CGAL self-intersection test is skipped
+  // Quality gate: a surface with a smaller angle fails, its triangles written to
+  // bad_triangles.vtp (0 turns the gate off).
+  double min_angle_deg = 2.0;
 };
 const char* treatment_name(SurfaceParams::Treatment t);
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);

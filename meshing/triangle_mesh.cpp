@@ -72,18 +72,27 @@ void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen:
   }
 }
 
+double min_angle_deg(const TriangleMesh& m, std::size_t t) {
+  double smallest = 180.0;
+  const auto& tri = m.triangles[t];
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d& a = m.points[tri[k]];
+    const Eigen::Vector3d u = m.points[tri[(k + 1) % 3]] - a, v = m.points[tri[(k + 2) % 3]] - a;
+    const double c = u.dot(v) / std::max(u.norm() * v.norm(), 1e-300);
+    smallest = std::min(smallest, std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+  }
+  return smallest;
+}
+
 MeshQuality mesh_quality(const TriangleMesh& m) {
   MeshQuality q;
   q.min_edge = std::numeric_limits<double>::infinity();
-  for (const auto& t : m.triangles) {
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& a = m.points[t[k]];
-      const Eigen::Vector3d u = m.points[t[(k + 1) % 3]] - a, v = m.points[t[(k + 2) % 3]] - a;
-      const double lu = u.norm();
-      q.min_edge = std::min(q.min_edge, lu), q.max_edge = std::max(q.max_edge, lu);
-      const double c = u.dot(v) / std::max(lu * v.norm(), 1e-300);
-      q.min_angle_deg = std::min(q.min_angle_deg, std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+      const double l = (m.points[m.triangles[t][(k + 1) % 3]] - m.points[m.triangles[t][k]]).norm();
+      q.min_edge = std::min(q.min_edge, l), q.max_edge = std::max(q.max_edge, l);
     }
+    q.min_angle_deg = std::min(q.min_angle_deg, min_angle_deg(m, t));
   }
   if (m.triangles.empty()) q.min_edge = 0.0;
   return q;

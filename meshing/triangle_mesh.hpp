@@ -36,5 +36,7 @@ struct MeshQuality {
   double min_angle_deg = 180.0, min_edge = 0.0, max_edge = 0.0;
 };
 MeshQuality mesh_quality(const TriangleMesh& mesh);
+// Smallest interior angle of triangle t of `mesh` (degrees).
+double min_angle_deg(const TriangleMesh& mesh, std::size_t t);
 
 }  // namespace bedforge::meshing

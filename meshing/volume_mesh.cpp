@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "meshing/defect_locations.hpp"
 
 namespace bedforge::meshing {
 
@@ -328,21 +329,11 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     }
     // Say where the bad cells are: the nearest particle surface to each.
     const std::vector<Eigen::Vector3d> centres = cell_centres(out.mesh);
-    std::vector<int> nearest(bad.size(), -1);
-    std::map<int, int> by_particle;
-    for (std::size_t k = 0; k < bad.size(); ++k) {
-      double best = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < bed.size(); ++i) {
-        const double gap = (centres[bad[k]] - bed.centres[i]).norm() - 0.5 * bed.diameters[i];
-        if (gap < best) best = gap, nearest[k] = static_cast<int>(i);
-      }
-      ++by_particle[nearest[k]];
-    }
-    std::vector<std::pair<int, int>> worst(by_particle.begin(), by_particle.end());
-    std::sort(worst.begin(), worst.end(), [](auto a, auto b) { return a.second > b.second; });
-    std::string near;
-    for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
-      near += fmt::format("{}particle {} ({} cells)", k ? ", " : "", worst[k].first, worst[k].second);
+    std::vector<Eigen::Vector3d> at;
+    for (int c : bad) at.push_back(centres[c]);
+    const DefectLocations where = locate_defects(bed, at, "cells");
+    const std::vector<int>& nearest = where.nearest;
+    const std::string& near = where.summary;
     if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, nearest);
     failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "

@@ -1,0 +1,29 @@
+// Triangle quality measures against triangles whose angles are known.
+#include "meshing/triangle_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace bedforge::meshing;
+
+TEST(TriangleMesh, AnglesAndEdgesOfKnownTriangles) {
+  TriangleMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5, std::sqrt(3.0) / 2.0, 0}};
+  m.triangles = {{0, 1, 2}, {0, 1, 3}};
+  m.patch = {0, 0};
+  m.patches = {"particles"};
+  EXPECT_NEAR(min_angle_deg(m, 0), 45.0, 1e-12);  // right isosceles
+  EXPECT_NEAR(min_angle_deg(m, 1), 60.0, 1e-12);  // equilateral
+  const MeshQuality q = mesh_quality(m);
+  EXPECT_NEAR(q.min_angle_deg, 45.0, 1e-12);
+  EXPECT_NEAR(q.min_edge, 1.0, 1e-12);
+  EXPECT_NEAR(q.max_edge, std::sqrt(2.0), 1e-12);
+  // A needle, isosceles with base 1 and height 0.01: its base angles are atan(0.01 / 0.5).
+  m.points.insert(m.points.end(), {{5, 0, 0}, {6, 0, 0}, {5.5, 0.01, 0}});
+  m.triangles.push_back({4, 5, 6});
+  m.patch.push_back(0);
+  const double expected = std::atan(0.02) * 180.0 / M_PI;
+  EXPECT_NEAR(min_angle_deg(m, 2), expected, 1e-9);
+  EXPECT_NEAR(mesh_quality(m).min_angle_deg, expected, 1e-9);
+}
