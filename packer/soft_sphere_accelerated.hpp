@@ -28,8 +28,9 @@ namespace bedforge::packer {
 // then the band check); final (the same settling test, then overlaps < tolerance, stiffening
 // again if not). The faithful schedule ends with an rms net force of 0.1-0.25 weights
 // (docs/validation.md), so the default force_tolerance = 0.2 asks as much balance of the
-// accelerated bed; what is left is mostly surface spheres still sliding under the weak gravity
-// of the final stiffness, in both modes. Divergence (non-finite
+// accelerated bed. What is left is spread through the bed and largest on spheres held by few
+// contacts (1e4 spheres, a = 14: rms 0.41 weights with one contact, 0.22 with four; 0.20 in
+// the bulk, 0.10-0.11 within 2 d of the floor and in the top 5 d). Divergence (non-finite
 // values) returns to the last good window with a halved step, as in the faithful mode.
 // Input: s with x from the generation stage. Output: s.x packed; returns {"stiffness_ratio",
 // "smallest_C_k"} (the smallest C_k the stability limit allowed).
