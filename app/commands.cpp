@@ -22,11 +22,11 @@
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
 #include "cases/openfoam_case.hpp"
+#include "meshing/defect_locations.hpp"
 #include "meshing/fluid_surface.hpp"
 #include "meshing/stl_io.hpp"
-#include "meshing/vtp_io.hpp"
-#include "meshing/defect_locations.hpp"
 #include "meshing/surface_checks.hpp"
+#include "meshing/vtp_io.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
 #include "meshing/volume_mesh.hpp"
@@ -201,17 +201,10 @@ std::shared_ptr<const meshing::FluidSurface> add_surface(const Bed& bed, const m
   if (j["min_angle_deg"].get<double>() < p.min_angle_deg) {
     // Say where the needles and slivers are: the nearest particle to each, and all of them in a
     // file for ParaView.
-    meshing::TriangleMesh bad;
-    bad.patches = fs.fluid.patches;
+    const meshing::TriangleMesh bad = meshing::triangles_below_angle(fs.fluid, p.min_angle_deg);
     std::vector<Eigen::Vector3d> centroids;
-    for (std::size_t t = 0; t < fs.fluid.triangles.size(); ++t) {
-      if (meshing::min_angle_deg(fs.fluid, t) >= p.min_angle_deg) continue;
-      const int first = static_cast<int>(bad.points.size());
-      for (int v : fs.fluid.triangles[t]) bad.points.push_back(fs.fluid.points[v]);
-      bad.triangles.push_back({first, first + 1, first + 2});
-      bad.patch.push_back(fs.fluid.patch[t]);
-      centroids.push_back((bad.points[first] + bad.points[first + 1] + bad.points[first + 2]) / 3.0);
-    }
+    for (std::size_t v = 0; v < bad.points.size(); v += 3)
+      centroids.push_back((bad.points[v] + bad.points[v + 1] + bad.points[v + 2]) / 3.0);
     const meshing::DefectLocations where = meshing::locate_defects(bed, centroids, "triangles");
     const std::filesystem::path path = dir / "bad_triangles.vtp";
     write_file_atomically(path, [&](std::ostream& out) {

@@ -96,14 +96,21 @@ std::vector<Wall> walls_of(const Container& c) {
                                c.kind()));
 }
 
-// What a treated contact occupies in z (m): a clip plane must keep clear of it.
+// A contact of a bed of n spheres as one number: spheres i < j, or sphere i and wall w as
+// j = n + w; and back.
+long long contact_key(std::size_t i, std::size_t j, std::size_t n) { return static_cast<long long>(i) * (n + 8) + j; }
+std::pair<std::size_t, std::size_t> contact_of(long long k, std::size_t n) {
+  return {static_cast<std::size_t>(k) / (n + 8), static_cast<std::size_t>(k) % (n + 8)};
+}
+
+// What a treated contact occupies in z (m), by contact key: a clip plane must keep clear of it.
 using Extents = std::unordered_map<long long, std::pair<double, double>>;
 
 // Contacts a clip plane cuts through, opened instead of treated (see treat_contacts): their
 // spheres shrink by contacts.shrink_factor and the contacts are left as gaps.
 struct Opening {
   std::vector<char> spheres;              // per sphere
-  std::unordered_set<long long> contacts;  // keys as Treater::key
+  std::unordered_set<long long> contacts;  // by contact_key
 };
 
 class Treater {
@@ -275,15 +282,7 @@ class Treater {
     cut_angle_[i].push_back(angle);
   }
 
-  // A contact's key: spheres i < j, or sphere i and wall w as j = n + w.
-  long long key(std::size_t i, std::size_t j) const { return static_cast<long long>(i) * (bed_.size() + 8) + j; }
-
- public:
-  static std::pair<std::size_t, std::size_t> unkey(long long k, std::size_t n) {
-    return {static_cast<std::size_t>(k) / (n + 8), static_cast<std::size_t>(k) % (n + 8)};
-  }
-
- private:
+  long long key(std::size_t i, std::size_t j) const { return contact_key(i, j, bed_.size()); }
 
   // How much geometry there is before a contact is treated, so its extent can be taken after.
   struct Marks {
@@ -689,12 +688,12 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   const TreatedBed whole = survey.run();
   const double d = sauter_mean(bed.diameters), d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
   const double clearance = p.clip_clearance_d * d;
-  std::vector<std::pair<double, double>> sphere_ends, everything;
+  std::vector<std::pair<double, double>> sphere_ends;
   for (std::size_t i = 0; i < n; ++i) {
     const double z = bed.centres[i].z(), r = whole.radius[i];
     for (double e : {z - r, z + r}) sphere_ends.push_back({e, e});
   }
-  everything = sphere_ends;
+  auto everything = sphere_ends;
   for (const auto& [k, range] : survey.extents()) everything.push_back(range);
   // A packed bed has bridges or caps at every height, so a plane often finds no height clear of
   // them. Such a plane then keeps clear of the spheres' tops and bottoms only (at either radius)
@@ -730,7 +729,7 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
       for (const auto& [k, range] : survey.extents()) {
         if (!(range.first < h.z + clearance + moved && range.second > h.z - clearance - moved)) continue;
         opening.contacts.insert(k);
-        const auto [i, j] = Treater::unkey(k, n);
+        const auto [i, j] = contact_of(k, n);
         opening.spheres[i] = 1;
         if (j < n) opening.spheres[j] = 1;
         ++opened;
@@ -740,7 +739,8 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   }
   if (!(planes.z1 > planes.z0))
     throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
-  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false, opening.contacts.empty() ? nullptr : &opening).run();
+  const Opening* opened = opening.contacts.empty() ? nullptr : &opening;
+  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false, opened).run();
   out.report["clip"] = clip_report;
   return out;
 }

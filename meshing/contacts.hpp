@@ -44,13 +44,14 @@ struct TreatedBed {
 // contacts beyond it are left out. Where no height is clear of the treated contacts, the plane
 // keeps clear of the spheres' ends (at their radius and shrunk by contacts.shrink_factor) and
 // the contacts near it are opened: both spheres shrink by shrink_factor and the contact is left
-// as a gap (not with enlarge, whose grown neighbours a shrunk sphere would still overlap). Pairs and wall contacts closer than the treatment's gap tolerance get
-// its geometry; every other gap is left as it is and the narrowest is reported. Volumes and
-// areas are exact (closed forms, or quadrature to 1e-10 for bridges to a curved wall and
-// spheres crossing one). InputError naming the particles when the treatment cannot give a
-// valid solid: contacts left touching, overlaps too deep, a bridge through a third sphere, a
-// sphere or bridge reaching an unclipped inlet or outlet plane, no clear height for a clip
-// plane, an opened contact still overlapping, cuts on one sphere that overlap, a periodic box.
+// as a gap (not with enlarge, whose grown neighbours a shrunk sphere would still overlap).
+// Pairs and wall contacts closer than the treatment's gap tolerance get its geometry; every
+// other gap is left as it is and the narrowest is reported. Volumes and areas are exact
+// (closed forms, or quadrature to 1e-10 for bridges to a curved wall and spheres crossing one).
+// InputError naming the particles when the treatment cannot give a valid solid: contacts left
+// touching, overlaps too deep, a bridge through a third sphere, a sphere or bridge reaching an
+// unclipped inlet or outlet plane, no clear height for a clip plane, an opened contact still
+// overlapping, cuts on one sphere that overlap, a periodic box.
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes);
 
 }  // namespace bedforge::meshing

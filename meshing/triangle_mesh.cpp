@@ -84,6 +84,19 @@ double min_angle_deg(const TriangleMesh& m, std::size_t t) {
   return smallest;
 }
 
+TriangleMesh triangles_below_angle(const TriangleMesh& m, double limit_deg) {
+  TriangleMesh out;
+  out.patches = m.patches;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    if (min_angle_deg(m, t) >= limit_deg) continue;
+    const int first = static_cast<int>(out.points.size());
+    for (int v : m.triangles[t]) out.points.push_back(m.points[v]);
+    out.triangles.push_back({first, first + 1, first + 2});
+    out.patch.push_back(m.patch[t]);
+  }
+  return out;
+}
+
 MeshQuality mesh_quality(const TriangleMesh& m) {
   MeshQuality q;
   q.min_edge = std::numeric_limits<double>::infinity();

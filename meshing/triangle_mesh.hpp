@@ -38,5 +38,8 @@ struct MeshQuality {
 MeshQuality mesh_quality(const TriangleMesh& mesh);
 // Smallest interior angle of triangle t of `mesh` (degrees).
 double min_angle_deg(const TriangleMesh& mesh, std::size_t t);
+// The triangles of `mesh` with an angle below `limit_deg`, each with its own three vertices,
+// patches and labels kept (for a diagnostic file).
+TriangleMesh triangles_below_angle(const TriangleMesh& mesh, double limit_deg);
 
 }  // namespace bedforge::meshing

@@ -332,16 +332,14 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     std::vector<Eigen::Vector3d> at;
     for (int c : bad) at.push_back(centres[c]);
     const DefectLocations where = locate_defects(bed, at, "cells");
-    const std::vector<int>& nearest = where.nearest;
-    const std::string& near = where.summary;
-    if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, nearest);
+    if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, where.nearest);
     failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
                           "most near {}; cells written to {}",
                           algorithm_name(algorithm), bad.size(), out.mesh.cells, out.quality.max_non_orthogonality_deg,
                           p.gate.max_non_orthogonality_deg, out.quality.max_skewness, p.gate.max_skewness,
                           out.quality.max_aspect_ratio, p.gate.max_aspect_ratio,
-                          out.quality.min_volume / (d_ref * d_ref * d_ref), p.gate.min_volume_d3, near,
+                          out.quality.min_volume / (d_ref * d_ref * d_ref), p.gate.min_volume_d3, where.summary,
                           bad_cells_path.string());
     failure += ". ";
   }

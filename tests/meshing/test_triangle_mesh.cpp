@@ -27,3 +27,20 @@ TEST(TriangleMesh, AnglesAndEdgesOfKnownTriangles) {
   EXPECT_NEAR(min_angle_deg(m, 2), expected, 1e-9);
   EXPECT_NEAR(mesh_quality(m).min_angle_deg, expected, 1e-9);
 }
+
+TEST(TriangleMesh, TrianglesBelowAnAngleKeepTheirVerticesAndPatches) {
+  // A right isosceles triangle (45 degrees) on patch 0 and a needle (atan(0.02), about 1.15
+  // degrees) on patch 1: below 10 degrees only the needle, below 50 both.
+  TriangleMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 0, 0}, {6, 0, 0}, {5.5, 0.01, 0}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
+  m.patch = {0, 1};
+  m.patches = {"wall", "particles"};
+  const TriangleMesh needles = triangles_below_angle(m, 10.0);
+  ASSERT_EQ(needles.triangles.size(), 1u);
+  EXPECT_EQ(needles.patches, m.patches);
+  EXPECT_EQ(needles.patch, (std::vector<int>{1}));
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(needles.points[needles.triangles[0][k]], m.points[m.triangles[1][k]]);
+  EXPECT_EQ(triangles_below_angle(m, 50.0).triangles.size(), 2u);
+  EXPECT_TRUE(triangles_below_angle(m, 1.0).triangles.empty());
+}
