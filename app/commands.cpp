@@ -615,7 +615,7 @@ int run_command_line(int argc, char** argv) {
   surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
   std::optional<std::string> treatment, wall_treatment;
   std::optional<double> shrink_factor, enlarge_factor, bridge_diameter_d, bridge_gap_d, cap_gap_d, edge_length_d,
-      contact_edge_length_d, inlet_length_d, outlet_length_d, min_angle_deg;
+      contact_edge_length_d, inlet_length_d, outlet_length_d, min_angle_deg, cells_per_gap;
   surface->add_option("--contacts", treatment,
                       "bridge|cap|shrink|enlarge|none, contact treatment (sets contacts.treatment); default shrink");
   surface->add_option("--wall-contacts", wall_treatment,
@@ -636,7 +636,11 @@ int run_command_line(int argc, char** argv) {
                       "FLOAT in [0.001,1], target triangle edge in diameters (sets surface.edge_length_d); default 0.1");
   surface->add_option("--contact-edge-length-d", contact_edge_length_d,
                       "FLOAT in [0.001,1], edge where treated contacts meet, in diameters (sets "
-                      "surface.contact_edge_length_d); default 0.025");
+                      "surface.contact_edge_length_d); default 0.033");
+  surface->add_option("--cells-per-gap", cells_per_gap,
+                      "FLOAT in [0,20], cells across narrow gaps: edges shrink to gap / this where a surface faces "
+                      "another closer than this x the edge length, not below the contact edge; 0 for none (sets "
+                      "surface.cells_per_gap); default 0");
   surface->add_option("--min-angle-deg", min_angle_deg,
                       "FLOAT in [0,30], quality gate: smallest triangle angle allowed in degrees, else the stage fails "
                       "and writes bad_triangles.vtp (sets surface.min_angle_deg); default 2");
@@ -735,6 +739,7 @@ int run_command_line(int argc, char** argv) {
     if (cap_gap_d) override_key(table, "contacts.cap_gap_d", *cap_gap_d);
     if (edge_length_d) override_key(table, "surface.edge_length_d", *edge_length_d);
     if (contact_edge_length_d) override_key(table, "surface.contact_edge_length_d", *contact_edge_length_d);
+    if (cells_per_gap) override_key(table, "surface.cells_per_gap", *cells_per_gap);
     if (min_angle_deg) override_key(table, "surface.min_angle_deg", *min_angle_deg);
     if (inlet_length_d) override_key(table, "surface.inlet_length_d", *inlet_length_d);
     if (outlet_length_d) override_key(table, "surface.outlet_length_d", *outlet_length_d);

@@ -8,11 +8,13 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <tuple>
 
 #include "analysis/void_fraction.hpp"
 #include "core/error.hpp"
 #include "meshing/contacts.hpp"
+#include "meshing/gap_spacing.hpp"
 #include "meshing/primitives.hpp"
 #include "meshing/wall_mesh.hpp"
 
@@ -50,6 +52,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.edge_length_d = s.number("edge_length_d", p.edge_length_d, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", p.contact_edge_length_d, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
+  p.cells_per_gap = s.number("cells_per_gap", p.cells_per_gap, Range::closed(0.0, 20.0));
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
   if (const std::vector<double> w = s.numbers("clip_window_d", Range::non_negative()); !w.empty()) {
@@ -85,6 +88,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"edge_length_d", p.edge_length_d},
           {"contact_edge_length_d", p.contact_edge_length_d},
           {"growth", p.growth},
+          {"cells_per_gap", p.cells_per_gap},
           {"inlet_length_d", p.inlet_length_d},
           {"outlet_length_d", p.outlet_length_d},
           {"clip_window_d", p.clip ? nlohmann::json::array({p.clip_bottom_d, p.clip_top_d}) : nlohmann::json(nullptr)},
@@ -145,6 +149,15 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
                                  "treatment that leaves a wider gap",
                                  p.edge_length_d, wall_sag / d, tb.min_concave_wall_gap / d));
 
+  // Edges shortened where the surface faces another across a narrow gap.
+  std::optional<GapSpacing> gaps;
+  if (p.cells_per_gap > 0.0)
+    gaps.emplace(bed.centres, tb.radius, tb.kept, c, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
+  auto field = [&](int self) {
+    return gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
+                : SpacingField{};
+  };
+
   // Spheres, each on its own (in parallel), stopping at their cuts.
   const std::size_t n = bed.size();
   std::vector<TriangleMesh> spheres(n);
@@ -154,7 +167,8 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   for (std::size_t i = 0; i < n; ++i) {
     if (!tb.kept[i]) continue;
     try {
-      spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles");
+      spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
+                               field(static_cast<int>(i)));
       chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
     } catch (const CutConflict& e) {
       failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
@@ -192,11 +206,13 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       const auto& [normal, a, b] = sides[k];
       const auto loop = box_face_loop({corner(a, z0), corner(b, z0), corner(b, z1), corner(a, z1)}, edge);
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
-      add("wall", [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall"); });
+      add("wall", [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
     }
   } else {
-    add("wall", [&] { return wall_mesh(R, z0, z1, edge, tb.wall_holes[0], p.growth, true, "wall"); });
-    if (ann) add("inner_wall", [&] { return wall_mesh(r_in, z0, z1, edge, tb.wall_holes[1], p.growth, false, "inner_wall"); });
+    add("wall", [&] { return wall_mesh(R, z0, z1, edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
+    if (ann)
+      add("inner_wall",
+          [&] { return wall_mesh(r_in, z0, z1, edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
   }
   // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
   using Loops = std::vector<std::vector<Eigen::Vector3d>>;

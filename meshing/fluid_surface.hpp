@@ -25,6 +25,10 @@ struct SurfaceParams {
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
   double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
   double growth = 1.5;                  // edge growth per ring away from those loops
+  // Cells across narrow gaps: where a sphere or wall faces another surface closer than
+  // cells_per_gap x edge_length_d, its edge shrinks to gap / cells_per_gap (not below
+  // contact_edge_length_d), and the volume mesh follows. 0: edge_length_d everywhere.
+  double cells_per_gap = 0.0;
   double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
   double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
   // Height window of the bed (above the floor, d) whose planes are the inlet and outlet,

@@ -135,7 +135,7 @@ std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n) {
 }
 
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
-                         double growth, bool outward, const std::string& patch) {
+                         double growth, bool outward, const std::string& patch, const SpacingField& field) {
   const int n_lattice =
       std::max(48, static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (edge * edge * std::sqrt(3.0) / 2.0))));
   const double h = std::min(edge, std::sqrt(4.0 * std::numbers::pi * r * r / (n_lattice * std::sqrt(3.0) / 2.0)));
@@ -155,16 +155,37 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   // 2. Rings graded from each loop's spacing to h.
   std::vector<double> spacing;
   for (const auto& cut : cuts) spacing.push_back(cut.spacing);
+  auto wanted = [&](const Eigen::Vector3d& p, double s) { return field ? std::min(s, field.at(p)) : s; };
   graded_rings(spacing, h, growth, [&](std::size_t k, int ring, double offset, double next) {
-    for (const auto& p : offset_loop(cuts[k], c, r, offset, next, ring % 2 == 1))
-      if (!is_removed(p) && pts.fits(p, next)) pts.add(p, next), owner.push_back(-1);
+    for (const auto& p : offset_loop(cuts[k], c, r, offset, next, ring % 2 == 1)) {
+      const double s = wanted(p, next);
+      if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
+    }
   });
-  // 3. The Fibonacci lattice.
+  // 3. The Fibonacci lattice: of the field's finest spacing where it asks for less than h
+  // (finest first, so the coarser vertices grade away from the finer), then of spacing h.
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  auto lattice = [&](int count, int k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / count, rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return Eigen::Vector3d(c + r * Eigen::Vector3d(rho * std::cos(k * golden), rho * std::sin(k * golden), z));
+  };
+  if (field && field.finest < h) {
+    const int n_fine = static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (field.finest * field.finest * std::sqrt(3.0) / 2.0)));
+    std::vector<std::pair<double, int>> fine;
+    for (int k = 0; k < n_fine; ++k) {
+      const double s = field.at(lattice(n_fine, k));
+      if (s < h) fine.emplace_back(s, k);
+    }
+    std::sort(fine.begin(), fine.end());
+    for (const auto& [s, k] : fine) {
+      const Eigen::Vector3d p = lattice(n_fine, k);
+      if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
+    }
+  }
   for (int k = 0; k < n_lattice; ++k) {
-    const double z = 1.0 - (2.0 * k + 1.0) / n_lattice, rho = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Eigen::Vector3d p = c + r * Eigen::Vector3d(rho * std::cos(k * golden), rho * std::sin(k * golden), z);
-    if (!is_removed(p) && pts.fits(p, h)) pts.add(p, h), owner.push_back(-1);
+    const Eigen::Vector3d p = lattice(n_lattice, k);
+    const double s = wanted(p, h);
+    if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
   }
   // 4. Convex hull less the faces spanning one loop; where the thinning left a gap (a face
   // whose circumradius exceeds 0.7 x its vertices' spacing), its circumcentre on the sphere

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "meshing/spaced_points.hpp"
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -54,9 +55,11 @@ struct CutConflict : std::runtime_error {
 // rings graded away from each loop (spacing growing by `growth` per ring up to `edge`), and a
 // spherical Fibonacci lattice of spacing `edge` elsewhere, thinned so no two lie closer than
 // 0.8 x their mean spacing; the triangles are their convex hull (the Delaunay triangulation on
-// the sphere) less the faces spanning a loop. At least 48 vertices.
+// the sphere) less the faces spanning a loop. At least 48 vertices. With a `field`, no vertex
+// is spaced wider than it asks: where it asks for less than `edge`, candidates come from a
+// lattice of spacing field.finest, those asking for the least first.
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
-                         double growth, bool outward, const std::string& patch);
+                         double growth, bool outward, const std::string& patch, const SpacingField& field = {});
 
 // Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper
 // bound of the chordal deviation of an inscribed mesh.

@@ -48,6 +48,15 @@ class SpacedPoints {
   std::vector<double> spacing_;
 };
 
+// Edge length wanted at a point of a surface being meshed (m), between `finest` and the
+// mesher's own edge; empty: the mesher's edge everywhere. The meshers take candidate vertices
+// `finest` apart where the field asks for less than their edge, finest first.
+struct SpacingField {
+  std::function<double(const Eigen::Vector3d&)> at;
+  double finest = 0.0;
+  explicit operator bool() const { return static_cast<bool>(at); }
+};
+
 // Rings graded away from loops (sphere cuts, wall holes) until their spacing reaches `full`:
 // ring by ring across all loops, spacing times `growth` per ring, rings sqrt(3)/2 of their
 // mean spacing apart. Calls emit(loop, ring, offset from the loop, spacing); odd rings are

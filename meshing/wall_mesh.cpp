@@ -25,7 +25,7 @@ double wrap_pi(double a) { return wrap_2pi(a + std::numbers::pi) - std::numbers:
 }  // namespace
 
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
-                   bool outward, const std::string& patch) {
+                   bool outward, const std::string& patch, const SpacingField& field) {
   const int n = ring_points(R, edge);
   // Sites lie on a dyadic grid in s whose step divides the period, so a site's copy one period
   // on is its exact translate: the exact predicates then see the two ends of the strip alike
@@ -120,12 +120,17 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   }
   const PolygonIndex hole_index(polygons);
   auto in_hole = [&](const Eigen::Vector2d& q) { return hole_index.contains(q); };
+  auto on_wall = [&](const Eigen::Vector2d& q) {
+    const double theta = seam + q.x() / R;
+    return Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y());
+  };
+  // The spacing asked for at q: `spacing`, or less where the field asks for less.
   auto try_add = [&](Eigen::Vector2d q, double spacing) {
     q.x() = R * wrap_2pi(q.x() / R);
+    if (field) spacing = std::min(spacing, field.at(on_wall(q)));
     if (q.y() < z0 + 0.4 * spacing || q.y() > z1 - 0.4 * spacing) return;
     if (in_hole(q) || in_hole(q + Eigen::Vector2d(period, 0.0)) || !fits(q, spacing)) return;
-    const double theta = seam + q.x() / R;
-    add_vertex(Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y()), q, spacing, true);
+    add_vertex(on_wall(q), q, spacing, true);
   };
   // 2. Rings graded away from the holes (around the first copy of each).
   std::vector<double> spacing;
@@ -133,7 +138,21 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   graded_rings(spacing, step, growth, [&](std::size_t h, int ring, double offset, double next) {
     for (const auto& q : offset_polygon(polygons[original[h]], offset, next, ring % 2 == 1)) try_add(q, next);
   });
-  // 3. The staggered lattice.
+  // 3. The staggered lattice: of the field's finest spacing where it asks for less than the
+  // step (finest first), then of the step.
+  if (field && field.finest < step) {
+    const int nf = static_cast<int>(std::ceil(period / field.finest));
+    const double row = std::sqrt(3.0) / 2.0 * field.finest;
+    std::vector<std::pair<double, Eigen::Vector2d>> fine;
+    for (int k = 1; z0 + k * row < z1; ++k)
+      for (int j = 0; j < nf; ++j) {
+        const Eigen::Vector2d q(period * (j + 0.5 * (k % 2)) / nf, z0 + k * row);
+        const double s = field.at(on_wall(q));
+        if (s < step) fine.emplace_back(s, q);
+      }
+    std::stable_sort(fine.begin(), fine.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [s, q] : fine) try_add(q, s);
+  }
   for (int k = 1; k < nz; ++k)
     for (int j = 0; j < n; ++j)
       try_add(Eigen::Vector2d(R * ((j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row_z(k)), step);
@@ -174,7 +193,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
 }
 
 WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
-                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch) {
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch,
+                    const SpacingField& field) {
   auto local = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - f.origin).dot(f.u), (p - f.origin).dot(f.v)); };
   std::vector<Eigen::Vector3d> points;  // 3D vertices, one per site
   std::vector<Eigen::Vector2d> uv;      // their sites
@@ -217,6 +237,7 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
   const PolygonIndex hole_index(polygons);
   auto try_add = [&](const Eigen::Vector2d& q, double spacing) {
     const Eigen::Vector3d s(q.x(), q.y(), 0.0);
+    if (field) spacing = std::min(spacing, field.at(f.to_world(s)));
     if (!in_region(q) || hole_index.contains(q) || !spaced.fits(s, spacing)) return;
     add_vertex(f.to_world(s), q, spacing);
   };
@@ -226,13 +247,26 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
   graded_rings(spacing, edge, growth, [&](std::size_t h, int ring, double offset, double next) {
     for (const auto& q : offset_polygon(polygons[h], offset, next, ring % 2 == 1)) try_add(q, next);
   });
-  // 3. The staggered lattice over the outer loop's bounding box.
+  // 3. The staggered lattice over the outer loop's bounding box: of the field's finest spacing
+  // where it asks for less than the edge (finest first), then of the edge.
   Eigen::Vector2d lo = outline[0][0], hi = lo;
   for (const auto& q : outline[0]) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
-  const double row = std::sqrt(3.0) / 2.0 * edge;
-  for (int k = 0; lo.y() + k * row <= hi.y(); ++k)
-    for (int j = 0; lo.x() + (j + 0.5 * (k % 2)) * edge <= hi.x(); ++j)
-      try_add(Eigen::Vector2d(lo.x() + (j + 0.5 * (k % 2)) * edge, lo.y() + k * row), edge);
+  auto staggered = [&](double step, const std::function<void(const Eigen::Vector2d&)>& visit) {
+    const double row = std::sqrt(3.0) / 2.0 * step;
+    for (int k = 0; lo.y() + k * row <= hi.y(); ++k)
+      for (int j = 0; lo.x() + (j + 0.5 * (k % 2)) * step <= hi.x(); ++j)
+        visit(Eigen::Vector2d(lo.x() + (j + 0.5 * (k % 2)) * step, lo.y() + k * row));
+  };
+  if (field && field.finest < edge) {
+    std::vector<std::pair<double, Eigen::Vector2d>> fine;
+    staggered(field.finest, [&](const Eigen::Vector2d& q) {
+      const double s = field.at(f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)));
+      if (s < edge) fine.emplace_back(s, q);
+    });
+    std::stable_sort(fine.begin(), fine.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [s, q] : fine) try_add(q, s);
+  }
+  staggered(edge, [&](const Eigen::Vector2d& q) { try_add(q, edge); });
 
   // 4. Constrained Delaunay triangulation; faces inside a hole go to `inside`.
   Cdt cdt;

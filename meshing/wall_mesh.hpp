@@ -29,9 +29,9 @@ struct WallMesh {
 // constrained Delaunay triangulation with the loops as constraints (no vertex is added). The
 // unrolled strip is cut along a lattice generator clear of every hole; its two sides share
 // their vertices. `outward` = normals away from the axis. CutConflict when a hole crosses the
-// strip's ends or no generator is clear of the holes.
+// strip's ends or no generator is clear of the holes. With a `field`, spacing as in sphere_mesh.
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
-                   bool outward, const std::string& patch);
+                   bool outward, const std::string& patch, const SpacingField& field = {});
 
 // Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
 // the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the
@@ -43,6 +43,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
 // hole may come as close to the boundary as its own loop's chords allow (a sphere 0.005 d off
 // the wall): the triangles in that gap are as narrow as the gap.
 WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
-                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch);
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch,
+                    const SpacingField& field = {});
 
 }  // namespace bedforge::meshing

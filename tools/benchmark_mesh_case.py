@@ -5,12 +5,16 @@ side, and the whole pipeline at scale; writes docs/mesh_case_benchmark.md, .json
     /usr/bin/python3 tools/benchmark_mesh_case.py                    # every section (about an hour on 2 cores)
     /usr/bin/python3 tools/benchmark_mesh_case.py --only sizes       # some sections, keep the others' results
     /usr/bin/python3 tools/benchmark_mesh_case.py --edges 0.2 0.15   # other surface edge lengths (d)
+    /usr/bin/python3 tools/benchmark_mesh_case.py --only gaps --gap-cells 2 3
 
 sizes:  a = 5, N = 500 (seed 1), bridges, packed once; for each surface edge length (the mesh
         follows the surface, refined 3x where contacts meet) a real `bedforge run` to a case that
         simpleFoam solves on 2 processes (Re_p = 1, water). Per level: cells, time per stage,
         checkMesh, dp/L over the bed section against Eisfeld & Schnitzlein at the section's own
         meshed void fraction, and against the finest level.
+gaps:   the same bed, surface edge 0.2 d, refined only where surfaces face each other across
+        narrow gaps (surface.cells_per_gap = 2 and 3), solved the same way: the pressure drop
+        against cells and time, next to the uniformly refined levels.
 snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
         the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
@@ -35,11 +39,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "snappy", "scale"]
+SECTIONS = ["sizes", "gaps", "snappy", "scale"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
-def scene(a, n, treatment, edge, run):
+def scene(a, n, treatment, edge, run, cells_per_gap=0):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -53,6 +57,7 @@ treatment = "{treatment}"
 [surface]
 edge_length_d = {edge}
 contact_edge_length_d = {edge / 3:.4g}
+cells_per_gap = {cells_per_gap}
 [mesh]
 algorithm = "hxt"
 [case]
@@ -93,17 +98,19 @@ def stage_times(report):
     return {k: v["time_s"] for k, v in report["stages"].items() if "time_s" in v}
 
 
-def sizes(tmp, edges):
+def sizes(tmp, levels):
+    """levels: (surface edge in d, cells per gap) pairs."""
     rows = []
-    for edge in edges:
-        path = os.path.join(tmp, f"bridge_{edge}")
-        open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True))
+    for edge, gap_cells in levels:
+        path = os.path.join(tmp, f"bridge_{edge}_{gap_cells}")
+        open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, gap_cells))
         wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
         rep = json.load(open(os.path.join(path, "report.json")))
         mb = peak_mb(rep)
         ok, cells, non_ortho, skew, _ = check_mesh(os.path.join(path, "case"))
         flow = rep["stages"]["case"]["flow"]
-        rows.append({"route": "gmsh", "edge_d": edge, "cells": cells, "wall_s": wall, "peak_mb": mb,
+        rows.append({"route": "gmsh", "edge_d": edge, "cells_per_gap": gap_cells, "cells": cells, "wall_s": wall,
+                     "peak_mb": mb,
                      "stages_s": stage_times(rep), "solve_s": flow["time_s"], "mesh_ok": ok,
                      "max_non_orthogonality": non_ortho, "max_skewness": skew,
                      "iterations": flow["iterations"], "converged": flow["converged"],
@@ -112,16 +119,13 @@ def sizes(tmp, edges):
                      "flow_rate_error": flow["flow_rate_relative_error"],
                      "volume_error": rep["stages"]["mesh"]["fluid_volume_relative_error"]})
         print(rows[-1], flush=True)
-    finest = min(rows, key=lambda r: r["edge_d"])["dp_dz_pa_m"]
-    for r in rows:
-        r["ratio_finest"] = r["dp_dz_pa_m"] / finest
     return rows
 
 
 def snappy(tmp, edge):
     """The bed and surface of the finest gmsh level (made again when the sizes section did not
     run), meshed by snappyHexMesh and solved."""
-    path = os.path.join(tmp, f"bridge_{edge}")
+    path = os.path.join(tmp, f"bridge_{edge}_0")
     if not os.path.exists(os.path.join(path, "fluid.msh")):
         open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, False))
         timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
@@ -173,7 +177,9 @@ def write(results):
                   "| surface edge (d) | cells | surface s | mesh s | case s | simpleFoam s (its) | checkMesh | "
                   "max non-ortho | dp/L (Pa/m) | / E&S | / finest | eps section | peak MB |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        finest = min(results["sizes"], key=lambda r: r["edge_d"])["dp_dz_pa_m"]
         for r in results["sizes"]:
+            r["ratio_finest"] = r["dp_dz_pa_m"] / finest
             st = r["stages_s"]
             lines.append(f"| {r['edge_d']} | {r['cells']} | {st.get('surface', 0):.1f} | {st.get('mesh', 0):.1f} | "
                          f"{st['case'] - r['solve_s']:.1f} | {r['solve_s']:.0f} ({r['iterations']}"
@@ -182,6 +188,19 @@ def write(results):
                          f"{r['ratio_finest']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
         lines += ["", "![dp against run time](mesh_case_convergence.png)", ""]
         plot(results)
+    if "gaps" in results:
+        lines += ["## The same bed, refined across the narrow gaps only (`surface.cells_per_gap`)", "",
+                  "Surface edge 0.2 d, shortened to gap / cells_per_gap (not below the contact edge, 0.0667 d) "
+                  "wherever a sphere or the wall faces another surface across a narrow gap.", "",
+                  "| cells per gap | cells | surface s | mesh s | simpleFoam s (its) | checkMesh | max non-ortho | "
+                  "dp/L (Pa/m) | / E&S | eps section | peak MB |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in results["gaps"]:
+            st = r["stages_s"]
+            lines.append(f"| {r['cells_per_gap']} | {r['cells']} | {st.get('surface', 0):.1f} | {st.get('mesh', 0):.1f} | "
+                         f"{r['solve_s']:.0f} ({r['iterations']}{'' if r['converged'] else ', not converged'}) | "
+                         f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
+                         f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
+        lines.append("")
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
         lines += ["## The same bed by the snappyHexMesh route", "",
@@ -224,6 +243,13 @@ def plot(results):
     for t, r in zip(total, rows):
         ax.annotate(f"{r['edge_d']} d, {r['cells'] / 1e6:.2f} M cells", (t, r["ratio_es"]), fontsize=8,
                     textcoords="offset points", xytext=(4, 4))
+    if "gaps" in results:
+        g = sorted(results["gaps"], key=lambda r: r["cells_per_gap"])
+        t = [sum(r["stages_s"].values()) for r in g]
+        ax.plot(t, [r["ratio_es"] for r in g], "^-", label="0.2 d, refined across gaps")
+        for x, r in zip(t, g):
+            ax.annotate(f"{r['cells_per_gap']} per gap, {r['cells'] / 1e6:.2f} M cells", (x, r["ratio_es"]), fontsize=8,
+                        textcoords="offset points", xytext=(4, -10))
     if "snappy" in results:
         s = results["snappy"]
         ax.plot([s["wall_s"]], [s["ratio_es"]], "s", label="snappyHexMesh route")
@@ -241,11 +267,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS)
     ap.add_argument("--edges", type=float, nargs="+", default=[0.2, 0.15, 0.1])
+    ap.add_argument("--gap-cells", type=float, nargs="+", default=[2, 3])
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
         if "sizes" in args.only:
-            results["sizes"] = sizes(tmp, args.edges)
+            results["sizes"] = sizes(tmp, [(e, 0) for e in args.edges])
+            write(results)
+        if "gaps" in args.only:
+            results["gaps"] = sizes(tmp, [(0.2, c) for c in args.gap_cells])
             write(results)
         if "snappy" in args.only:
             results["snappy"] = snappy(tmp, min(args.edges))

@@ -1,0 +1,38 @@
+#pragma once
+#include <Eigen/Core>
+
+#include <unordered_map>
+#include <vector>
+
+#include "core/container.hpp"
+
+namespace bedforge::meshing {
+
+// Edge length on the fluid surface from the width of the gap it faces, so that the volume mesh
+// has about `cells_per_gap` cells across every narrow gap ([surface] cells_per_gap): the
+// tetrahedra follow the surface's edge, and a gap spanned by edges as long as itself gets one.
+//
+// Inputs (m): the treated spheres' `centres` and `radii` (N each), `kept` (N, spheres left out
+// of the surface are ignored), the container (its lateral walls), `cells_per_gap` (> 0), and
+// the `finest` and `coarsest` edge.
+// at(p, self), p on the surface: clamp(g / cells_per_gap, finest, coarsest), g the distance
+// from p to the nearest sphere surface other than sphere `self`'s, and for a point on a sphere
+// (self >= 0) to the lateral walls too; self = -1 for a point on a wall. Thread-safe.
+class GapSpacing {
+ public:
+  GapSpacing(const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& radii,
+             const std::vector<char>& kept, const Container& container, double cells_per_gap, double finest,
+             double coarsest);
+  double at(const Eigen::Vector3d& p, int self) const;
+  double finest() const { return finest_; }
+
+ private:
+  long key(long x, long y, long z) const { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
+  const std::vector<Eigen::Vector3d>& centres_;
+  const std::vector<double>& radii_;
+  const Container& container_;
+  double cells_, finest_, coarsest_, cell_;
+  std::unordered_map<long, std::vector<int>> grid_;  // kept spheres by the cell of their centre
+};
+
+}  // namespace bedforge::meshing
