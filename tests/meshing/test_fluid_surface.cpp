@@ -484,4 +484,10 @@ TEST(FluidSurface, CellsPerGapShortensTheEdgesFacingANarrowGap) {
   const MeshQuality q = mesh_quality(graded.fluid);
   EXPECT_GE(q.min_edge, 0.5 * 0.02);
   EXPECT_GE(q.min_angle_deg, 15.0);
+  // A box's flat walls are graded the same way: the same two spheres in a box 3.2 wide.
+  b.container = std::make_shared<Box>(3.2, 3.2, false, false);
+  const FluidSurface boxed = build_fluid_surface(b, p);
+  EXPECT_TRUE(check_surface(boxed.fluid, 10'000'000).closed);
+  EXPECT_LE(longest_edge_near(boxed.fluid, "wall", {1.6, 0.0, 0.6}), 1.6 * 0.05);
+  EXPECT_LE(longest_edge_near(boxed.fluid, "particles", {1.5, 0.0, 0.6}), 1.6 * 0.05);
 }
