@@ -196,7 +196,7 @@ def write(results):
                   "dp/L (Pa/m) | / E&S | eps section | peak MB |", "|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in results["gaps"]:
             st = r["stages_s"]
-            lines.append(f"| {r['cells_per_gap']} | {r['cells']} | {st.get('surface', 0):.1f} | {st.get('mesh', 0):.1f} | "
+            lines.append(f"| {r['cells_per_gap']:g} | {r['cells']} | {st.get('surface', 0):.1f} | {st.get('mesh', 0):.1f} | "
                          f"{r['solve_s']:.0f} ({r['iterations']}{'' if r['converged'] else ', not converged'}) | "
                          f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
@@ -248,8 +248,8 @@ def plot(results):
         t = [sum(r["stages_s"].values()) for r in g]
         ax.plot(t, [r["ratio_es"] for r in g], "^-", label="0.2 d, refined across gaps")
         for x, r in zip(t, g):
-            ax.annotate(f"{r['cells_per_gap']} per gap, {r['cells'] / 1e6:.2f} M cells", (x, r["ratio_es"]), fontsize=8,
-                        textcoords="offset points", xytext=(4, -10))
+            ax.annotate(f"{r['cells_per_gap']:g} per gap, {r['cells'] / 1e6:.2f} M cells", (x, r["ratio_es"]), fontsize=8,
+                        textcoords="offset points", xytext=(-6, 4), ha="right")
     if "snappy" in results:
         s = results["snappy"]
         ax.plot([s["wall_s"]], [s["ratio_es"]], "s", label="snappyHexMesh route")
@@ -258,7 +258,7 @@ def plot(results):
     ax.set_xlabel("run time, scene to solved case (s)")
     ax.set_ylabel("dp/L over Eisfeld & Schnitzlein")
     ax.set_title("a = 5, N = 500, bridges, Re_p = 1")
-    ax.legend()
+    ax.legend(loc="upper left")
     fig.tight_layout()
     fig.savefig(os.path.join(DOCS, "mesh_case_convergence.png"), dpi=120)
 
