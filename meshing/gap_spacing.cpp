@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "meshing/spaced_points.hpp"
+
 namespace bedforge::meshing {
 
 GapSpacing::GapSpacing(const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& radii,
@@ -18,7 +20,7 @@ GapSpacing::GapSpacing(const std::vector<Eigen::Vector3d>& centres, const std::v
   for (std::size_t i = 0; i < centres.size(); ++i) {
     if (!kept[i]) continue;
     const Eigen::Vector3d& c = centres[i];
-    grid_[key(std::lround(std::floor(c.x() / cell_)), std::lround(std::floor(c.y() / cell_)),
+    grid_[grid_cell_key(std::lround(std::floor(c.x() / cell_)), std::lround(std::floor(c.y() / cell_)),
               std::lround(std::floor(c.z() / cell_)))]
         .push_back(static_cast<int>(i));
   }
@@ -32,7 +34,7 @@ double GapSpacing::at(const Eigen::Vector3d& p, int self) const {
   for (long dx = -1; dx <= 1; ++dx)
     for (long dy = -1; dy <= 1; ++dy)
       for (long dz = -1; dz <= 1; ++dz) {
-        const auto it = grid_.find(key(x + dx, y + dy, z + dz));
+        const auto it = grid_.find(grid_cell_key(x + dx, y + dy, z + dz));
         if (it == grid_.end()) continue;
         for (int j : it->second)
           if (j != self) gap = std::min(gap, std::max(0.0, (p - centres_[j]).norm() - radii_[j]));

@@ -27,7 +27,6 @@ class GapSpacing {
   double finest() const { return finest_; }
 
  private:
-  long key(long x, long y, long z) const { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
   const std::vector<Eigen::Vector3d>& centres_;
   const std::vector<double>& radii_;
   const Container& container_;

@@ -140,6 +140,19 @@ PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<st
   return m;
 }
 
+std::vector<std::array<int, 4>> cell_tets(const PolyMesh& m) {
+  std::vector<std::array<int, 4>> cells(m.cells, {-1, -1, -1, -1});
+  std::vector<int> filled(m.cells, 0);
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
+      if (c < 0) continue;
+      auto& cell = cells[c];
+      for (int v : m.faces[f])
+        if (std::find(cell.begin(), cell.begin() + filled[c], v) == cell.begin() + filled[c]) cell[filled[c]++] = v;
+    }
+  return cells;
+}
+
 std::vector<double> cell_volumes(const PolyMesh& m) {
   // Divergence theorem over each cell's faces: V = sum (x_f . S_f) / 3, sign by owner/neighbour.
   std::vector<double> vol(m.cells, 0.0);

@@ -40,6 +40,8 @@ PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<st
                              const std::vector<std::array<int, 3>>& boundary, const std::vector<int>& patch,
                              const std::vector<std::string>& names, const std::vector<std::string>& types);
 
+// The four point indices of each tetrahedral cell, C x 4, in no particular order.
+std::vector<std::array<int, 4>> cell_tets(const PolyMesh& mesh);
 // Cell centres and volumes of the tetrahedral cells (m, m^3); volumes are signed.
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);
 std::vector<double> cell_volumes(const PolyMesh& mesh);

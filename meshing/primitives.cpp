@@ -136,8 +136,10 @@ std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n) {
 
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
                          double growth, bool outward, const std::string& patch, const SpacingField& field) {
-  const int n_lattice =
-      std::max(48, static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (edge * edge * std::sqrt(3.0) / 2.0))));
+  auto lattice_count = [&](double spacing) {
+    return static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (spacing * spacing * std::sqrt(3.0) / 2.0)));
+  };
+  const int n_lattice = std::max(48, lattice_count(edge));
   const double h = std::min(edge, std::sqrt(4.0 * std::numbers::pi * r * r / (n_lattice * std::sqrt(3.0) / 2.0)));
   SpacedPoints pts(h);
   auto is_removed = [&](const Eigen::Vector3d& p) {
@@ -170,17 +172,16 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     return Eigen::Vector3d(c + r * Eigen::Vector3d(rho * std::cos(k * golden), rho * std::sin(k * golden), z));
   };
   if (field && field.finest < h) {
-    const int n_fine = static_cast<int>(std::ceil(4.0 * std::numbers::pi * r * r / (field.finest * field.finest * std::sqrt(3.0) / 2.0)));
-    std::vector<std::pair<double, int>> fine;
-    for (int k = 0; k < n_fine; ++k) {
-      const double s = field.at(lattice(n_fine, k));
-      if (s < h) fine.emplace_back(s, k);
-    }
-    std::sort(fine.begin(), fine.end());
-    for (const auto& [s, k] : fine) {
-      const Eigen::Vector3d p = lattice(n_fine, k);
-      if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
-    }
+    const int n_fine = lattice_count(field.finest);
+    offer_finest_first<Eigen::Vector3d>(
+        field, h,
+        [&](const auto& visit) {
+          for (int k = 0; k < n_fine; ++k) visit(lattice(n_fine, k));
+        },
+        [](const Eigen::Vector3d& p) { return p; },
+        [&](const Eigen::Vector3d& p, double s) {
+          if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
+        });
   }
   for (int k = 0; k < n_lattice; ++k) {
     const Eigen::Vector3d p = lattice(n_lattice, k);

@@ -10,6 +10,9 @@
 
 namespace bedforge::meshing {
 
+// Hash key of the grid cell (x, y, z), for grids kept in a hash map.
+inline long grid_cell_key(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
+
 // Candidate mesh vertices (spheres, walls), accepted in order when no accepted vertex lies closer
 // than 0.8 x the mean of their spacings (a Poisson-disk rule with local sizes): a uniform grid
 // of cell `cell` >= every spacing keeps the test to the 27 neighbouring cells.
@@ -21,7 +24,7 @@ class SpacedPoints {
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = grid_.find(pack(k[0] + dx, k[1] + dy, k[2] + dz));
+          const auto it = grid_.find(grid_cell_key(k[0] + dx, k[1] + dy, k[2] + dz));
           if (it == grid_.end()) continue;
           for (int q : it->second)
             if ((points[q] - p).norm() < 0.4 * (spacing + spacing_[q])) return false;
@@ -30,7 +33,7 @@ class SpacedPoints {
   }
   void add(const Eigen::Vector3d& p, double spacing) {
     const auto k = key(p);
-    grid_[pack(k[0], k[1], k[2])].push_back(static_cast<int>(points.size()));
+    grid_[grid_cell_key(k[0], k[1], k[2])].push_back(static_cast<int>(points.size()));
     points.push_back(p);
     spacing_.push_back(spacing);
   }
@@ -42,7 +45,6 @@ class SpacedPoints {
     return {static_cast<long>(std::floor(p.x() / cell_)), static_cast<long>(std::floor(p.y() / cell_)),
             static_cast<long>(std::floor(p.z() / cell_))};
   }
-  static long pack(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
   double cell_;
   std::unordered_map<long, std::vector<int>> grid_;
   std::vector<double> spacing_;
@@ -56,6 +58,24 @@ struct SpacingField {
   double finest = 0.0;
   explicit operator bool() const { return static_cast<bool>(at); }
 };
+
+// The candidate sites (of any type) that each_site(visit) visits, a lattice of spacing
+// field.finest, offered to add(site, spacing) where the field asks (at to_world(site)) for
+// less than `coarse`, finest first and then in visiting order: the coarser vertices then grade
+// away from the finer ones.
+template <class Site>
+void offer_finest_first(const SpacingField& field, double coarse,
+                        const std::function<void(const std::function<void(const Site&)>&)>& each_site,
+                        const std::function<Eigen::Vector3d(const Site&)>& to_world,
+                        const std::function<void(const Site&, double)>& add) {
+  std::vector<std::pair<double, Site>> asked;
+  each_site([&](const Site& q) {
+    const double s = field.at(to_world(q));
+    if (s < coarse) asked.emplace_back(s, q);
+  });
+  std::stable_sort(asked.begin(), asked.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [s, q] : asked) add(q, s);
+}
 
 // Rings graded away from loops (sphere cuts, wall holes) until their spacing reaches `full`:
 // ring by ring across all loops, spacing times `growth` per ring, rings sqrt(3)/2 of their

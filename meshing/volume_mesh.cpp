@@ -205,16 +205,7 @@ PolyMesh extract_poly_mesh() {
 // Legacy VTK of the given cells, with their quality and the nearest particle, for ParaView.
 void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
                      const std::vector<int>& bad, const std::vector<int>& nearest) {
-  std::vector<std::array<int, 4>> cells(m.cells, {-1, -1, -1, -1});
-  std::vector<int> filled(m.cells, 0);
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
-      if (c < 0) continue;
-      for (int v : m.faces[f]) {
-        auto& cell = cells[c];
-        if (std::find(cell.begin(), cell.begin() + filled[c], v) == cell.begin() + filled[c]) cell[filled[c]++] = v;
-      }
-    }
+  const std::vector<std::array<int, 4>> cells = cell_tets(m);
   std::ofstream out(path);
   out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   out << "POINTS " << 4 * bad.size() << " double\n";

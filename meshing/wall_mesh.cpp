@@ -143,15 +143,13 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   if (field && field.finest < step) {
     const int nf = static_cast<int>(std::ceil(period / field.finest));
     const double row = std::sqrt(3.0) / 2.0 * field.finest;
-    std::vector<std::pair<double, Eigen::Vector2d>> fine;
-    for (int k = 1; z0 + k * row < z1; ++k)
-      for (int j = 0; j < nf; ++j) {
-        const Eigen::Vector2d q(period * (j + 0.5 * (k % 2)) / nf, z0 + k * row);
-        const double s = field.at(on_wall(q));
-        if (s < step) fine.emplace_back(s, q);
-      }
-    std::stable_sort(fine.begin(), fine.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [s, q] : fine) try_add(q, s);
+    offer_finest_first<Eigen::Vector2d>(
+        field, step,
+        [&](const auto& visit) {
+          for (int k = 1; z0 + k * row < z1; ++k)
+            for (int j = 0; j < nf; ++j) visit(Eigen::Vector2d(period * (j + 0.5 * (k % 2)) / nf, z0 + k * row));
+        },
+        on_wall, try_add);
   }
   for (int k = 1; k < nz; ++k)
     for (int j = 0; j < n; ++j)
@@ -257,15 +255,10 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
       for (int j = 0; lo.x() + (j + 0.5 * (k % 2)) * step <= hi.x(); ++j)
         visit(Eigen::Vector2d(lo.x() + (j + 0.5 * (k % 2)) * step, lo.y() + k * row));
   };
-  if (field && field.finest < edge) {
-    std::vector<std::pair<double, Eigen::Vector2d>> fine;
-    staggered(field.finest, [&](const Eigen::Vector2d& q) {
-      const double s = field.at(f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)));
-      if (s < edge) fine.emplace_back(s, q);
-    });
-    std::stable_sort(fine.begin(), fine.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [s, q] : fine) try_add(q, s);
-  }
+  if (field && field.finest < edge)
+    offer_finest_first<Eigen::Vector2d>(
+        field, edge, [&](const auto& visit) { staggered(field.finest, visit); },
+        [&](const Eigen::Vector2d& q) { return f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)); }, try_add);
   staggered(edge, [&](const Eigen::Vector2d& q) { try_add(q, edge); });
 
   // 4. Constrained Delaunay triangulation; faces inside a hole go to `inside`.

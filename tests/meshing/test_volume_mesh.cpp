@@ -119,15 +119,7 @@ namespace {
 // Longest piece of the segment a-b inside one cell of `m`, as a fraction of the segment, from
 // 1000 points along it.
 double longest_piece_in_a_cell(const PolyMesh& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  std::vector<std::array<int, 4>> tets(m.cells);
-  std::vector<int> filled(m.cells, 0);
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
-      if (c < 0) continue;
-      for (int v : m.faces[f])
-        if (std::find(tets[c].begin(), tets[c].begin() + filled[c], v) == tets[c].begin() + filled[c])
-          tets[c][filled[c]++] = v;
-    }
+  const std::vector<std::array<int, 4>> tets = cell_tets(m);
   std::map<int, int> samples;  // per cell crossed
   constexpr int kSamples = 1000;
   for (int k = 0; k < kSamples; ++k) {
