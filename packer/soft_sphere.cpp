@@ -28,6 +28,11 @@ SoftSphereParams read_soft_sphere_params(SceneSection& s) {
   p.mass_centre_samples = static_cast<int>(s.integer("mass_centre_samples", p.mass_centre_samples, 2, 10'000));
   p.mass_centre_tolerance = s.number("mass_centre_tolerance", p.mass_centre_tolerance, positive);
   p.force_tolerance = s.number("force_tolerance", p.force_tolerance, positive);
+  p.final_momentum_bound = s.number("final_momentum_bound", p.final_momentum_bound, Range::non_negative());
+  if (p.final_momentum_bound > 0.0 && p.final_momentum_bound < 1.0)
+    throw InputError(fmt::format("{}: final_momentum_bound = {} is not allowed; allowed: 0 (no bound) or >= 1 "
+                                 "(Nesterov's t starts at 1)",
+                                 s.name(), p.final_momentum_bound));
   p.max_iterations = s.integer("max_iterations", p.max_iterations, 1, 1'000'000'000'000);
   p.max_recoveries = static_cast<int>(s.integer("max_recoveries", p.max_recoveries, 0, 60));
   // At most half a diameter, so a periodic side of 3 diameters holds each pair once.
@@ -55,6 +60,7 @@ nlohmann::json to_json(const SoftSphereParams& p) {
           {"mass_centre_samples", p.mass_centre_samples},
           {"mass_centre_tolerance", p.mass_centre_tolerance},
           {"force_tolerance", p.force_tolerance},
+          {"final_momentum_bound", p.final_momentum_bound},
           {"max_iterations", p.max_iterations},
           {"max_recoveries", p.max_recoveries},
           {"neighbour_skin_d", p.neighbour_skin_d}};

@@ -268,14 +268,20 @@ def write_report(R):
                   "The number of iterations varies with rounding, because the settling bed creeps and the mass-centre "
                   "test ends each stage at a chaotic moment: on 2026-11-22 the same seed took 44100 iterations, then "
                   "57200 after a change that only reordered the neighbour list, with the same void fraction (0.3686 "
-                  "and 0.3683 central). At N = 1e5 compaction's creep after the fall takes 24000 of the 57200 "
-                  "iterations and the final stage's settling 20000. Tried on 2026-11-22, none adopted: holding "
-                  "Nesterov's momentum t at 2 H / d in the final stage (1e4 spheres: 31300 to 20400 iterations; 1e5: 57200 to "
-                  "41700, 388 s, same void fraction) made the paper's a = 5, N = 500 beds half again slower (10 "
-                  "seeds: 106700 to 158200 iterations), and bounds of 4 or 8 H / d lost the gain at 1e4; bounding it "
-                  "in compaction, restarting per sphere, restarting when the residual rises, ending the final stage "
-                  "once the bed stops expanding (residual 2.7 weights instead of 0.2), dynamic scheduling and a "
-                  "packed (x, y, z, r) array in the force loop were slower or worse."]
+                  "and 0.3683 central). Where the time goes at N = 1e5 (2026-11-22, seed 1): compaction 35600 "
+                  "iterations (the fall about 6000, then the creep of the settling bed, which moves its mass centre "
+                  "down by 0.43 d, a void fraction change of about 0.008, so it cannot be cut short without changing "
+                  "the bed), the final stage 7400 since its momentum is capped (`final_momentum_bound`, "
+                  "docs/defaults.md; 21400 without the cap, 418 s in all). The force loop takes two thirds of an "
+                  "iteration, 7 ms for 1e5 spheres on 2 threads, bound by the square roots and divisions of the "
+                  "6 touching pairs per sphere and by loading the 10 listed neighbours. Tried on 2026-11-22, none "
+                  "adopted: the same cap in compaction too (every size slower), restarting when the speed falls "
+                  "(a = 5, N = 500: 6 times the iterations), the pair arithmetic split into a loop the compiler "
+                  "vectorises, spheres renumbered cell by cell instead of by height, and interleaved chunks for the "
+                  "two threads (all three within the machine's timing noise of about 10 %); earlier, restarting per "
+                  "sphere, restarting when the residual rises, ending the final stage once the bed stops expanding "
+                  "(residual 2.7 weights instead of 0.2), dynamic scheduling and a packed (x, y, z, r) array in the "
+                  "force loop were slower or worse."]
     lines.append("")
     open(os.path.join(DOCS, "validation.md"), "w").write("\n".join(lines))
     print("\n".join(lines))

@@ -56,6 +56,20 @@ TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
                InputError);
 }
 
+TEST(Scene, MomentumBoundIsZeroOrAtLeastOne) {
+  const std::string base = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n[packing.soft_sphere]\n";
+  EXPECT_EQ(read(base + "final_momentum_bound = 0\n").soft_sphere.final_momentum_bound, 0.0);
+  EXPECT_EQ(read(base + "final_momentum_bound = 1\n").soft_sphere.final_momentum_bound, 1.0);
+  for (const char* bad : {"0.5", "-1"}) {
+    try {
+      read(base + "final_momentum_bound = " + bad + "\n");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("final_momentum_bound"), std::string::npos) << e.what();
+    }
+  }
+}
+
 #ifdef BEDFORGE_HAVE_CGAL
 TEST(Scene, ContactTreatmentsAndTheirErrors) {
   const std::string base = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
