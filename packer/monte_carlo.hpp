@@ -36,7 +36,7 @@ struct MonteCarloParams {
   double settle_tolerance_d = 1e-3;
   long max_settle_cycles = 20'000;                 // per shake; reported when reached
   long settling_cycles = 100'000;
-  double target_acceptance = 0.3;                  // the maximum displacement adapts to hold it
+  double target_acceptance = 0.05;                 // the maximum displacement adapts to hold it
   double max_displacement_d = 0.5;
 };
 

@@ -227,6 +227,10 @@ def write(R):
               f"{a['mean_abs_difference_first_3d']:.3f}", ""]
     if "segregation" in R:
         L += ["## Segregation: diameter ratio 1.2, equal numbers, N = 1000", "",
+              "Abreu et al. (1999): almost complete segregation after 100 shakes, and about the same with "
+              "periodic sides instead of the cylinder wall. Danckwerts' intensity: 0 mixed, 1 fully segregated; "
+              "the unshaken control is the same bed after its fall alone. Why the default target acceptance "
+              "(0.05) decides it: docs/monte_carlo.md.", "",
               "![](monte_carlo_segregation.png)", "",
               "| container | Danckwerts intensity | mass-centre height large / small (d) | time (s) |", "|---|---|---|---|"]
         for where, s in R["segregation"].items():
