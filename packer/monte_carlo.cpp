@@ -41,7 +41,7 @@ MonteCarloParams read_monte_carlo_params(SceneSection& s) {
   p.initial_void_fraction = s.number("initial_void_fraction", p.initial_void_fraction, Range{0.7, 1.0, false, true});
   p.mixing_height_d = s.optional_number("mixing_height_d", positive);
   p.mixing_cycles = s.integer("mixing_cycles", p.mixing_cycles, 0, 1'000'000'000);
-  p.shakes = s.integer("shakes", p.shakes, 0, 1'000'000);
+  if (s.has("shakes")) p.shakes = s.integer("shakes", 0, 0, 1'000'000);
   p.shake_amplitude_d = s.number("shake_amplitude_d", p.shake_amplitude_d, Range::non_negative());
   p.shake_dilation = s.number("shake_dilation", p.shake_dilation, Range::closed(0.0, 100.0));
   p.settle_block_cycles = s.integer("settle_block_cycles", p.settle_block_cycles, 1, 1'000'000);
@@ -60,7 +60,7 @@ nlohmann::json to_json(const MonteCarloParams& p) {
           {"initial_void_fraction", p.initial_void_fraction},
           {"mixing_height_d", p.mixing_height_d ? nlohmann::json(*p.mixing_height_d) : nlohmann::json()},
           {"mixing_cycles", p.mixing_cycles},
-          {"shakes", p.shakes},
+          {"shakes", p.shakes ? nlohmann::json(*p.shakes) : nlohmann::json(nullptr)},
           {"shake_amplitude_d", p.shake_amplitude_d},
           {"shake_dilation", p.shake_dilation},
           {"settle_block_cycles", p.settle_block_cycles},
@@ -87,6 +87,13 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
 
   // Species and their buoyancy-corrected masses, relative to a sphere of d_ref of the first density.
   const bool per_species = params.particle_density.size() > 1;
+  // The paper's schedule unless the scene sets the shakes: 10 for equal spheres, 100 for
+  // mixtures of sizes or densities (Abreu et al. 1999, step b).
+  const bool equal_spheres = !per_species && (sizes.kind == SizeDistribution::Kind::monodisperse ||
+                                              (sizes.kind == SizeDistribution::Kind::discrete && sizes.diameters_m.size() == 1));
+  MonteCarloParams used = params;
+  used.shakes = params.shakes.value_or(equal_spheres ? 10 : 100);
+  const long shake_count = *used.shakes;
   if (per_species && (sizes.kind != SizeDistribution::Kind::discrete ||
                       sizes.diameters_m.size() != params.particle_density.size()))
     throw InputError(fmt::format("packing.monte_carlo.particle_densities has {} values; allowed: one per diameter of "
@@ -140,7 +147,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   const double t_star = params.temperature, target = params.target_acceptance;
   const double delta_lo = 1e-4 * d_min, delta_hi = params.max_displacement_d * d_min;
   chain.set_displacement(delta_hi);
-  const long total_cycles = params.mixing_cycles + params.settling_cycles + params.shakes * params.max_settle_cycles;
+  const long total_cycles = params.mixing_cycles + params.settling_cycles + shake_count * params.max_settle_cycles;
   long cycles = 0;
   nlohmann::json history = nlohmann::json::array(), shakes = nlohmann::json::array();
   nlohmann::json stages = nlohmann::json::object();
@@ -178,7 +185,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   const double settle_tol = params.settle_tolerance_d * d_min;
   long unsettled = 0;
   timed("shaking", [&] {
-    for (long k = 0; k < params.shakes; ++k) {
+    for (long k = 0; k < shake_count; ++k) {
       chain.lift(amplitude, params.shake_dilation);
       double before = chain.mass_centre();
       long used = 0;
@@ -226,7 +233,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   }
   const double time = elapsed();
   out.info = {{"algorithm", "monte-carlo"},
-              {"parameters", to_json(params)},
+              {"parameters", to_json(used)},
               {"reference_diameter_m", d_ref},
               {"smallest_diameter_m", sizes.smallest()},
               {"mixing_height_d", lid},

@@ -29,7 +29,7 @@ struct MonteCarloParams {
   double initial_void_fraction = 0.88;             // of the volume below the lid during mixing
   std::optional<double> mixing_height_d;           // lid height in reference diameters (overrides the above)
   long mixing_cycles = 10'000;
-  long shakes = 10;                                // the paper: 10 for equal spheres, 100 for mixtures
+  std::optional<long> shakes;                      // unset: the paper's 10 for equal spheres, 100 for mixtures
   double shake_amplitude_d = 1.5;
   double shake_dilation = 0.0;                     // 0: a rigid lift
   long settle_block_cycles = 100;

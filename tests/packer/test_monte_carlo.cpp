@@ -157,3 +157,21 @@ TEST(MonteCarlo, ShakenBinaryMixtureSegregatesLargeOnTop) {
   EXPECT_GT(shaken.intensity, 0.2);
   EXPECT_GT(shaken.intensity, 3 * fallen.intensity) << "fallen " << fallen.intensity << ", shaken " << shaken.intensity;
 }
+
+TEST(MonteCarlo, DefaultShakesFollowThePaper) {
+  // Abreu et al. (1999), step (b): 10 shakes for equal spheres, 100 for binary mixtures; a
+  // number in the scene wins.
+  const Cylinder c(0.002);
+  MonteCarloParams p;
+  p.mixing_cycles = 20;
+  p.settling_cycles = 20;
+  p.max_settle_cycles = 200;
+  auto shakes = [&](const SizeDistribution& s) { return pack(c, 20, 1, p, s).info["shakes"].size(); };
+  EXPECT_EQ(shakes(spheres({0.001})), 10u);
+  EXPECT_EQ(shakes(spheres({0.0012, 0.001}, {0.5, 0.5})), 100u);
+  p.particle_density = {1000.0, 2000.0};
+  EXPECT_EQ(shakes(spheres({0.001, 0.0010001}, {0.5, 0.5})), 100u);  // a mixture of densities
+  p.particle_density = {1000.0};
+  p.shakes = 3;
+  EXPECT_EQ(shakes(spheres({0.0012, 0.001}, {0.5, 0.5})), 3u);
+}
