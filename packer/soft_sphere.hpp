@@ -26,7 +26,8 @@ struct SoftSphereParams {
   int mass_centre_samples = 10;              // successive samples that must agree
   double mass_centre_tolerance = 1e-6;       // relative spread allowed among them (1e-4 %)
   double force_tolerance = 0.2;              // accelerated: rms net force / own weight that ends a stage
-  double final_momentum_bound = 100;         // accelerated: cap on Nesterov's t in the final stage (0: none)
+  double final_momentum_bound = 100;         // accelerated: cap on Nesterov's t in the final stage at the default
+                                             // tolerance, scaled by 1e-4 d / tolerance below it (0: none)
   long max_iterations = 5'000'000;           // all stages together
   int max_recoveries = 8;                    // step halvings allowed after detected divergence
   double neighbour_skin_d = 0.2;             // Verlet skin
