@@ -486,7 +486,9 @@ struct Overrides {
     cmd.add_flag("--periodic", periodic, "box with periodic sides (sets container.periodic_x and periodic_y)");
     cmd.add_option("--temperature", temperature,
                    "FLOAT > 0, Monte Carlo kT / (m* g d) (sets packing.monte_carlo.temperature); default 0.01");
-    cmd.add_option("--shakes", shakes, "INT >= 0, Monte Carlo shakes (sets packing.monte_carlo.shakes); default 10 for equal spheres, 100 for mixtures");
+    cmd.add_option("--shakes", shakes,
+                   "INT >= 0, Monte Carlo shakes (sets packing.monte_carlo.shakes); default 10 for equal spheres, "
+                   "100 for mixtures");
     cmd.add_option("--mixing-cycles", mixing_cycles,
                    "INT >= 0, Monte Carlo cycles without gravity (sets packing.monte_carlo.mixing_cycles); default 10000");
     cmd.add_option("--settling-cycles", settling_cycles,

@@ -87,19 +87,18 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
 
   // Species and their buoyancy-corrected masses, relative to a sphere of d_ref of the first density.
   const bool per_species = params.particle_density.size() > 1;
-  // The paper's schedule unless the scene sets the shakes: 10 for equal spheres, 100 for
-  // mixtures of sizes or densities (Abreu et al. 1999, step b).
-  const bool equal_spheres = !per_species && (sizes.kind == SizeDistribution::Kind::monodisperse ||
-                                              (sizes.kind == SizeDistribution::Kind::discrete && sizes.diameters_m.size() == 1));
-  MonteCarloParams used = params;
-  used.shakes = params.shakes.value_or(equal_spheres ? 10 : 100);
-  const long shake_count = *used.shakes;
   if (per_species && (sizes.kind != SizeDistribution::Kind::discrete ||
                       sizes.diameters_m.size() != params.particle_density.size()))
     throw InputError(fmt::format("packing.monte_carlo.particle_densities has {} values; allowed: one per diameter of "
                                  "a discrete mixture (particles.diameters has {})",
                                  params.particle_density.size(),
                                  sizes.kind == SizeDistribution::Kind::discrete ? sizes.diameters_m.size() : 0));
+  // The paper's schedule unless the scene sets the shakes: 10 for equal spheres, 100 for
+  // mixtures of sizes or densities (Abreu et al. 1999, step b). The report records the number.
+  const bool equal_spheres = !per_species && sizes.smallest() == sizes.largest();
+  const long shake_count = params.shakes.value_or(equal_spheres ? 10 : 100);
+  MonteCarloParams used = params;
+  used.shakes = shake_count;
   Rng rng(seed);
   std::vector<double> d = sizes.sample(count, rng);
   // Largest first: random placement finds room for them while the container is still empty.

@@ -24,13 +24,13 @@ class AcceleratedDescent {
   AcceleratedDescent(Spheres& s, const Container& c, const SoftSphereSettings& p, RunLog& log)
       : s_(s), c_(c), p_(p), log_(log), nl_(p.skin), requested_(0.5 * p.given.stiffness_step), step_(requested_) {}
 
-  // Minimises C_k E_el + C_g sum w_i z_i (C_g = C_k / kappa, or 0 without gravity) until
-  // `done`; no sphere moves more than `max_step` in one iteration. Nesterov's t is held at or
-  // below `momentum_bound` (0: unbounded, restarts alone reset it).
   // Smallest C_k the stability limit allowed (C_k = 2 x the momentum step).
   double smallest_stiffness_step() const { return 2.0 * smallest_; }
   long neighbour_list_builds() const { return nl_.builds(); }
 
+  // Minimises C_k E_el + C_g sum w_i z_i (C_g = C_k / kappa, or 0 without gravity) until
+  // `done`; no sphere moves more than `max_step` in one iteration. Nesterov's t is held at or
+  // below `momentum_bound` (0: unbounded, restarts alone reset it).
   Relaxed relax(double kappa, bool gravity, double max_step, double momentum_bound,
                 const std::function<bool(const Relaxed&)>& done) {
     const std::size_t n = s_.size();
@@ -184,7 +184,8 @@ nlohmann::json run_accelerated(Spheres& s, const Container& container, const Sof
   // stage in proportion, so gravity moves the spheres that much less per iteration and the
   // momentum must persist as much longer: at 1e-5 d a bound of 100 doubled the iterations and
   // 1000 matched the unbounded run. Looser tolerances keep 100 (at 1e-3 d, 10 doubled them).
-  const double bound = p.given.final_momentum_bound * std::max(1.0, 1e-4 / p.given.overlap_tolerance_d);
+  const double bound = p.given.final_momentum_bound *
+                       std::max(1.0, SoftSphereParams{}.overlap_tolerance_d / p.given.overlap_tolerance_d);
   log.begin_stage("final");
   const double target = 0.5 * tol;
   for (int round = 0;; ++round) {
