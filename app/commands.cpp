@@ -309,12 +309,18 @@ std::shared_ptr<const meshing::VolumeMesh> add_mesh(const meshing::TriangleMesh&
   j["fluid_volume_exact_m3"] = exact_volume;
   j["fluid_volume_relative_error"] = (vm->quality.total_volume - exact_volume) / exact_volume;
   const auto& q = j["quality"];
-  const std::string line = fmt::format(
+  std::string line = fmt::format(
       "mesh ({}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
       "max aspect ratio {:.1f}, volume error {:.2e}",
       j["algorithm"].get<std::string>(), vm->mesh.cells, q["max_non_orthogonality_deg"].get<double>(),
       q["mean_non_orthogonality_deg"].get<double>(), q["faces_over_70_deg"].get<long>(), q["max_skewness"].get<double>(),
       q["max_aspect_ratio"].get<double>(), j["fluid_volume_relative_error"].get<double>());
+  if (j.contains("layers")) {
+    const auto& l = j["layers"];
+    line += fmt::format("; {} prism layers, mean thickness {:.3g} d, {} of {} stacks at full thickness",
+                        p.layers.count, l["mean_thickness_d"].get<double>(), l["stacks_at_full_thickness"].get<long>(),
+                        l["stacks"].get<long>());
+  }
   finish_stage(j, meter, line, console);
   report.set_stage("mesh", j);
   return vm;
@@ -683,7 +689,8 @@ int run_command_line(int argc, char** argv) {
                                                   "gate: writes DIR/fluid.msh (bad_cells.vtk when the gate fails)");
   mesh_cmd->add_option("dir", dir, "directory holding fluid.stl and bed.csv (as written by surface)")->required();
   std::optional<std::string> mesh_algorithm;
-  std::optional<double> max_size_d, max_non_orthogonality;
+  std::optional<double> max_size_d, max_non_orthogonality, layer_thickness_d;
+  std::optional<int> layers;
   mesh_cmd->add_option("--algorithm", mesh_algorithm,
                        "hxt|delaunay, first 3D algorithm tried, the other is the fallback (sets mesh.algorithm); "
                        "default hxt");
@@ -691,6 +698,11 @@ int run_command_line(int argc, char** argv) {
                        "FLOAT in [0.01,10], largest cell edge in diameters (sets mesh.max_size_d); default 0.25");
   mesh_cmd->add_option("--max-non-orthogonality", max_non_orthogonality,
                        "FLOAT in (0,90), quality gate in degrees (sets mesh.gate.max_non_orthogonality_deg); default 85");
+  mesh_cmd->add_option("--layers", layers,
+                       "INT in [0,20], prism layers on the particle surfaces (sets mesh.layers.count); default 0");
+  mesh_cmd->add_option("--layer-thickness-d", layer_thickness_d,
+                       "FLOAT in (0,0.5), total thickness of the prism layers in diameters where the gaps allow it "
+                       "(sets mesh.layers.thickness_d); default 0.02");
 #endif
 
   try {
@@ -791,6 +803,8 @@ int run_command_line(int argc, char** argv) {
     if (mesh_algorithm) override_key(table, "mesh.algorithm", *mesh_algorithm);
     if (max_size_d) override_key(table, "mesh.max_size_d", *max_size_d);
     if (max_non_orthogonality) override_key(table, "mesh.gate.max_non_orthogonality_deg", *max_non_orthogonality);
+    if (layers) override_key(table, "mesh.layers.count", static_cast<long long>(*layers));
+    if (layer_thickness_d) override_key(table, "mesh.layers.thickness_d", *layer_thickness_d);
     SceneSection section(table["mesh"].as_table(), "mesh");
     const meshing::VolumeMeshParams params = meshing::read_volume_mesh_params(section);
     section.finish();

@@ -64,17 +64,20 @@ void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& 
     if (binary) {
       // Binary faces are a compact list: N+1 offsets, then the vertex labels of all faces.
       out << foam_header("faceCompactList", loc, "faces", note, true);
-      std::vector<std::int32_t> offsets(m.faces.size() + 1), labels(3 * m.faces.size());
-      for (std::size_t f = 0; f <= m.faces.size(); ++f) offsets[f] = static_cast<std::int32_t>(3 * f);
-      for (std::size_t f = 0; f < m.faces.size(); ++f)
-        for (int k = 0; k < 3; ++k) labels[3 * f + k] = m.faces[f][k];
+      std::vector<std::int32_t> offsets{0}, labels;
+      offsets.reserve(m.faces.size() + 1);
+      labels.reserve(3 * m.faces.size());
+      for (const auto& f : m.faces) {
+        labels.insert(labels.end(), f.begin(), f.end());
+        offsets.push_back(static_cast<std::int32_t>(labels.size()));
+      }
       write_list(out, offsets, true, [](std::string&, std::int32_t) {});
       out << "\n";
       write_list(out, labels, true, [](std::string&, std::int32_t) {});
     } else {
       out << foam_header("faceList", loc, "faces", note, false);
-      write_list(out, m.faces, false, [](std::string& b, const std::array<int, 3>& f) {
-        fmt::format_to(std::back_inserter(b), "3({} {} {})", f[0], f[1], f[2]);
+      write_list(out, m.faces, false, [](std::string& b, const meshing::Face& f) {
+        fmt::format_to(std::back_inserter(b), "{}({})", f.size(), fmt::join(f, " "));
       });
     }
   }

@@ -12,8 +12,9 @@ constexpr double kRootVSmall = 1e-150;  // OpenFOAM's ROOTVSMALL, guards divisio
 
 CellQuality cell_quality(const PolyMesh& m) {
   CellQuality q;
-  const std::vector<Eigen::Vector3d> cc = cell_centres(m);
-  q.volume = cell_volumes(m);
+  CellGeometry geometry = cell_geometry(m);
+  const std::vector<Eigen::Vector3d>& cc = geometry.centres;
+  q.volume = std::move(geometry.volumes);
   q.non_orthogonality_deg.assign(m.cells, 0.0);
   q.skewness.assign(m.cells, 0.0);
   q.aspect_ratio.assign(m.cells, 0.0);
@@ -23,8 +24,7 @@ CellQuality cell_quality(const PolyMesh& m) {
 
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     const auto& t = m.faces[f];
-    const Eigen::Vector3d fc = (m.points[t[0]] + m.points[t[1]] + m.points[t[2]]) / 3.0;
-    const Eigen::Vector3d area = 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]);
+    const auto [fc, area] = face_geometry(m, t);
     const int own = m.owner[f];
     const bool internal = f < m.neighbour.size();
     sum_mag_area[own] += area.cwiseAbs();

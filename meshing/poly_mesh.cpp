@@ -3,87 +3,178 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <climits>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
 
 namespace bedforge::meshing {
 
+Face::Face(std::initializer_list<int> points) : n(static_cast<int>(points.size())) {
+  if (n < 3 || n > 4) throw std::invalid_argument("a face has 3 or 4 points");
+  std::copy(points.begin(), points.end(), v.begin());
+}
+
 namespace {
 
-using Tri = std::array<int, 3>;
-
-Tri sorted(Tri t) {
-  std::sort(t.begin(), t.end());
-  return t;
+// A face's points sorted, the key under which the two cells sharing it meet.
+using Key = std::array<int, 4>;
+Key key_of(const Face& f) {
+  Key k{INT_MAX, INT_MAX, INT_MAX, INT_MAX};
+  std::copy(f.begin(), f.end(), k.begin());
+  std::sort(k.begin(), k.end());
+  return k;
 }
 
-// The four faces of a positively oriented tet (a, b, c, d), each with its normal pointing out.
-std::array<Tri, 4> outward_faces(const std::array<int, 4>& t) {
-  return {{{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
-}
-
-double signed_volume(const std::vector<Eigen::Vector3d>& p, const std::array<int, 4>& t) {
-  return (p[t[1]] - p[t[0]]).dot((p[t[2]] - p[t[0]]).cross(p[t[3]] - p[t[0]])) / 6.0;
-}
-
-struct TriHash {
-  std::size_t operator()(const Tri& t) const {
-    return static_cast<std::size_t>(t[0]) * 0x9E3779B97F4A7C15ULL ^ static_cast<std::size_t>(t[1]) * 0xC2B2AE3D27D4EB4FULL ^
-           static_cast<std::size_t>(t[2]);
+struct KeyHash {
+  std::size_t operator()(const Key& k) const {
+    std::size_t h = 0;
+    for (int v : k) h = h * 0x9E3779B97F4A7C15ULL ^ static_cast<std::size_t>(v);
+    return h;
   }
 };
 
+// The faces of a cell in gmsh's node order, in no particular orientation.
+std::vector<Face> faces_of(const VolumeCell& c) {
+  const auto& v = c.v;
+  switch (c.n) {
+    case 4:
+      return {{v[0], v[2], v[1]}, {v[0], v[1], v[3]}, {v[0], v[3], v[2]}, {v[1], v[2], v[3]}};
+    case 5:
+      return {{v[0], v[3], v[2], v[1]}, {v[0], v[1], v[4]}, {v[1], v[2], v[4]}, {v[2], v[3], v[4]}, {v[3], v[0], v[4]}};
+    case 6:
+      return {{v[0], v[2], v[1]}, {v[3], v[4], v[5]}, {v[0], v[1], v[4], v[3]}, {v[1], v[2], v[5], v[4]},
+              {v[2], v[0], v[3], v[5]}};
+    default:
+      throw std::invalid_argument(fmt::format("a cell of {} points is no tetrahedron, pyramid or prism", c.n));
+  }
+}
+
+Eigen::Vector3d vertex_mean(const std::vector<Eigen::Vector3d>& p, const int* first, int n) {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (int k = 0; k < n; ++k) s += p[first[k]];
+  return s / n;
+}
+
 }  // namespace
 
-PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<std::array<int, 4>> tets,
-                             const std::vector<std::array<int, 3>>& boundary, const std::vector<int>& patch,
-                             const std::vector<std::string>& names, const std::vector<std::string>& types) {
+FaceGeometry face_geometry(const PolyMesh& m, const Face& f) {
+  const auto& p = m.points;
+  if (f.size() == 3)
+    return {(p[f[0]] + p[f[1]] + p[f[2]]) / 3.0, 0.5 * (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]])};
+  const Eigen::Vector3d mean = vertex_mean(p, f.begin(), f.size());
+  Eigen::Vector3d sum_n = Eigen::Vector3d::Zero(), sum_ac = Eigen::Vector3d::Zero();
+  double sum_a = 0.0;
+  for (int k = 0; k < f.size(); ++k) {
+    const Eigen::Vector3d& a = p[f[k]];
+    const Eigen::Vector3d& b = p[f[(k + 1) % f.size()]];
+    const Eigen::Vector3d n = (b - a).cross(mean - a);
+    const double area = n.norm();
+    sum_n += n;
+    sum_a += area;
+    sum_ac += area * (a + b + mean);
+  }
+  if (sum_a < 1e-150) return {mean, Eigen::Vector3d::Zero()};
+  return {sum_ac / (3.0 * sum_a), 0.5 * sum_n};
+}
+
+CellGeometry cell_geometry(const PolyMesh& m) {
+  std::vector<FaceGeometry> fg(m.faces.size());
+  for (std::size_t f = 0; f < m.faces.size(); ++f) fg[f] = face_geometry(m, m.faces[f]);
+  std::vector<Eigen::Vector3d> estimate(m.cells, Eigen::Vector3d::Zero());
+  std::vector<int> count(m.cells, 0);
+  for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    estimate[m.owner[f]] += fg[f].centre, ++count[m.owner[f]];
+    if (f < m.neighbour.size()) estimate[m.neighbour[f]] += fg[f].centre, ++count[m.neighbour[f]];
+  }
+  for (int c = 0; c < m.cells; ++c) estimate[c] /= std::max(1, count[c]);
+  CellGeometry g{std::vector<Eigen::Vector3d>(m.cells, Eigen::Vector3d::Zero()), std::vector<double>(m.cells, 0.0)};
+  auto add = [&](int c, const FaceGeometry& face, double sign) {
+    const double pyramid3 = sign * face.area.dot(face.centre - estimate[c]);  // 3 x the pyramid's volume
+    g.centres[c] += pyramid3 * (0.75 * face.centre + 0.25 * estimate[c]);
+    g.volumes[c] += pyramid3;
+  };
+  for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    add(m.owner[f], fg[f], 1.0);
+    if (f < m.neighbour.size()) add(m.neighbour[f], fg[f], -1.0);
+  }
+  for (int c = 0; c < m.cells; ++c) {
+    g.centres[c] = std::abs(g.volumes[c]) > 1e-300 ? Eigen::Vector3d(g.centres[c] / g.volumes[c]) : estimate[c];
+    g.volumes[c] /= 3.0;
+  }
+  return g;
+}
+
+std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& m) { return cell_geometry(m).centres; }
+std::vector<double> cell_volumes(const PolyMesh& m) { return cell_geometry(m).volumes; }
+
+std::vector<std::vector<int>> cell_points(const PolyMesh& m) {
+  std::vector<std::vector<int>> cells(m.cells);
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
+      if (c < 0) continue;
+      for (int v : m.faces[f])
+        if (std::find(cells[c].begin(), cells[c].end(), v) == cells[c].end()) cells[c].push_back(v);
+    }
+  return cells;
+}
+
+PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& input,
+                              const std::vector<Face>& boundary, const std::vector<int>& patch,
+                              const std::vector<std::string>& names, const std::vector<std::string>& types) {
   // Cells bottom to top.
-  std::vector<double> zc(tets.size());
-  for (std::size_t c = 0; c < tets.size(); ++c)
-    zc[c] = points[tets[c][0]].z() + points[tets[c][1]].z() + points[tets[c][2]].z() + points[tets[c][3]].z();
-  std::vector<int> order(tets.size());
+  std::vector<double> zc(input.size());
+  for (std::size_t c = 0; c < input.size(); ++c) zc[c] = vertex_mean(points, input[c].v.data(), input[c].n).z();
+  std::vector<int> order(input.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return zc[a] < zc[b]; });
-  std::vector<std::array<int, 4>> cells(tets.size());
-  for (std::size_t c = 0; c < order.size(); ++c) {
-    cells[c] = tets[order[c]];
-    if (signed_volume(points, cells[c]) < 0.0) std::swap(cells[c][2], cells[c][3]);
-  }
 
-  // Every cell face, keyed by its sorted vertices: a key met twice is an internal face.
+  // Every cell face, turned to point out of its cell and keyed by its sorted points: a key met
+  // twice is an internal face.
   struct CellFace {
-    Tri key, face;
+    Key key;
+    Face face;
     int cell;
   };
   std::vector<CellFace> all;
-  all.reserve(4 * cells.size());
-  for (int c = 0; c < static_cast<int>(cells.size()); ++c)
-    for (const Tri& f : outward_faces(cells[c])) all.push_back({sorted(f), f, c});
+  all.reserve(4 * input.size());
+  for (int c = 0; c < static_cast<int>(order.size()); ++c) {
+    const VolumeCell& cell = input[order[c]];
+    const Eigen::Vector3d centre = vertex_mean(points, cell.v.data(), cell.n);
+    for (Face f : faces_of(cell)) {
+      const Eigen::Vector3d a = points[f[0]], n = (points[f[1]] - a).cross(points[f[2]] - a);
+      if (f.size() == 4) {  // a quad's normal from its two diagonals, robust when it is warped
+        const Eigen::Vector3d nq = (points[f[2]] - a).cross(points[f[3]] - points[f[1]]);
+        if (nq.dot(vertex_mean(points, f.begin(), 4) - centre) < 0.0) std::reverse(f.begin(), f.end());
+      } else if (n.dot(a - centre) < 0.0) {
+        std::reverse(f.begin(), f.end());
+      }
+      all.push_back({key_of(f), f, c});
+    }
+  }
   std::sort(all.begin(), all.end(), [](const CellFace& a, const CellFace& b) {
     return a.key != b.key ? a.key < b.key : a.cell < b.cell;
   });
 
-  std::unordered_map<Tri, int, TriHash> patch_of;
+  std::unordered_map<Key, int, KeyHash> patch_of;
   patch_of.reserve(boundary.size());
-  for (std::size_t b = 0; b < boundary.size(); ++b) patch_of.emplace(sorted(boundary[b]), patch[b]);
+  for (std::size_t b = 0; b < boundary.size(); ++b) patch_of.emplace(key_of(boundary[b]), patch[b]);
 
-  auto where = [&](const Tri& f) {
-    const Eigen::Vector3d c = (points[f[0]] + points[f[1]] + points[f[2]]) / 3.0;
+  auto where = [&](const Face& f) {
+    const Eigen::Vector3d c = vertex_mean(points, f.begin(), f.size());
     return fmt::format("({:.6g}, {:.6g}, {:.6g}) m", c.x(), c.y(), c.z());
   };
   struct Internal {
     int owner, neighbour;
-    Tri face;
+    Face face;
   };
   struct Boundary {
     int patch, owner;
-    Tri face;
+    Face face;
   };
   std::vector<Internal> internal;
   std::vector<Boundary> bnd;
-  internal.reserve(2 * cells.size());
+  internal.reserve(2 * input.size());
   for (std::size_t i = 0; i < all.size();) {
     std::size_t j = i + 1;
     while (j < all.size() && all[j].key == all[i].key) ++j;
@@ -108,7 +199,7 @@ PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<st
   });
 
   PolyMesh m;
-  m.cells = static_cast<int>(cells.size());
+  m.cells = static_cast<int>(input.size());
   m.faces.reserve(internal.size() + bnd.size());
   for (const Internal& f : internal) {
     m.faces.push_back(f.face);
@@ -140,43 +231,5 @@ PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<st
   return m;
 }
 
-std::vector<std::array<int, 4>> cell_tets(const PolyMesh& m) {
-  std::vector<std::array<int, 4>> cells(m.cells, {-1, -1, -1, -1});
-  std::vector<int> filled(m.cells, 0);
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
-      if (c < 0) continue;
-      auto& cell = cells[c];
-      for (int v : m.faces[f])
-        if (std::find(cell.begin(), cell.begin() + filled[c], v) == cell.begin() + filled[c]) cell[filled[c]++] = v;
-    }
-  return cells;
-}
-
-std::vector<double> cell_volumes(const PolyMesh& m) {
-  // Divergence theorem over each cell's faces: V = sum (x_f . S_f) / 3, sign by owner/neighbour.
-  std::vector<double> vol(m.cells, 0.0);
-  for (std::size_t f = 0; f < m.faces.size(); ++f) {
-    const auto& t = m.faces[f];
-    const Eigen::Vector3d& a = m.points[t[0]];
-    const double v = a.dot((m.points[t[1]] - a).cross(m.points[t[2]] - a)) / 6.0;
-    vol[m.owner[f]] += v;
-    if (f < m.neighbour.size()) vol[m.neighbour[f]] -= v;
-  }
-  return vol;
-}
-
-std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& m) {
-  // A tet's centre is the mean of its four vertices; each vertex appears in three of its faces.
-  std::vector<Eigen::Vector3d> c(m.cells, Eigen::Vector3d::Zero());
-  for (std::size_t f = 0; f < m.faces.size(); ++f) {
-    const auto& t = m.faces[f];
-    const Eigen::Vector3d s = m.points[t[0]] + m.points[t[1]] + m.points[t[2]];
-    c[m.owner[f]] += s;
-    if (f < m.neighbour.size()) c[m.neighbour[f]] += s;
-  }
-  for (auto& x : c) x /= 12.0;
-  return c;
-}
 
 }  // namespace bedforge::meshing

@@ -3,15 +3,39 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
 namespace bedforge::meshing {
 
-// A tetrahedral volume mesh in OpenFOAM's face-addressed form (constant/polyMesh): every face
-// once, internal faces first in upper-triangular order (by owner, then neighbour), then the
-// boundary faces patch by patch. A face's normal (right-hand rule) points out of its owner,
-// so boundary normals point out of the domain.
+// A face of a tetrahedron, pyramid or prism: 3 or 4 point indices, in order around it.
+struct Face {
+  std::array<int, 4> v{-1, -1, -1, -1};
+  int n = 0;
+  Face() = default;
+  Face(std::initializer_list<int> points);
+  explicit Face(const std::array<int, 3>& t) : v{t[0], t[1], t[2], -1}, n(3) {}
+  int size() const { return n; }
+  int operator[](int k) const { return v[k]; }
+  int& operator[](int k) { return v[k]; }
+  const int* begin() const { return v.data(); }
+  const int* end() const { return v.data() + n; }
+  int* begin() { return v.data(); }
+  int* end() { return v.data() + n; }
+};
+
+// A cell by its points in gmsh's node order: tetrahedron (4), pyramid (5: the base quad, then
+// the apex) or prism (6: a triangle, then the opposite one, point k + 3 across from point k).
+struct VolumeCell {
+  std::array<int, 6> v{-1, -1, -1, -1, -1, -1};
+  int n = 0;
+};
+
+// A volume mesh in OpenFOAM's face-addressed form (constant/polyMesh): every face once,
+// internal faces first in upper-triangular order (by owner, then neighbour), then the boundary
+// faces patch by patch. A face's normal (right-hand rule) points out of its owner, so boundary
+// normals point out of the domain.
 struct PolyMesh {
   struct Patch {
     std::string name;
@@ -19,7 +43,7 @@ struct PolyMesh {
     int start = 0, size = 0;
   };
   std::vector<Eigen::Vector3d> points;  // m
-  std::vector<std::array<int, 3>> faces;
+  std::vector<Face> faces;
   std::vector<int> owner;               // per face
   std::vector<int> neighbour;           // per internal face
   std::vector<Patch> patches;
@@ -27,22 +51,38 @@ struct PolyMesh {
   int internal_faces() const { return static_cast<int>(neighbour.size()); }
 };
 
-// Tetrahedra with labelled boundary triangles into a PolyMesh.
+// Cells with labelled boundary faces into a PolyMesh.
 //   points      P x 3, m
-//   tets        T x 4 point indices, either orientation
-//   boundary    B x 3 point indices, the domain's boundary triangles
-//   patch       B, index into `names` for each boundary triangle
+//   cells       C cells, either orientation (each face is turned to point away from its cell's
+//               vertex mean, right for the convex and nearly convex cells meshers make)
+//   boundary    B faces, the domain's boundary
+//   patch       B, index into `names` for each boundary face
 //   names/types patch names and OpenFOAM types, in the order the patches are written
 // Cells are numbered bottom to top (by centroid z), which keeps the matrix bandwidth small in a
-// column. std::runtime_error when a tet face is on the boundary but in no patch, or a face is
-// shared by more than two tets, with its location.
-PolyMesh poly_mesh_from_tets(std::vector<Eigen::Vector3d> points, std::vector<std::array<int, 4>> tets,
-                             const std::vector<std::array<int, 3>>& boundary, const std::vector<int>& patch,
-                             const std::vector<std::string>& names, const std::vector<std::string>& types);
+// column. std::runtime_error when a cell face is on the boundary but in no patch, or a face is
+// shared by more than two cells, with its location.
+PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& cells,
+                              const std::vector<Face>& boundary, const std::vector<int>& patch,
+                              const std::vector<std::string>& names, const std::vector<std::string>& types);
 
-// The four point indices of each tetrahedral cell, C x 4, in no particular order.
-std::vector<std::array<int, 4>> cell_tets(const PolyMesh& mesh);
-// Cell centres and volumes of the tetrahedral cells (m, m^3); volumes are signed.
+// The distinct point indices of each cell, in no particular order.
+std::vector<std::vector<int>> cell_points(const PolyMesh& mesh);
+
+// Face centre and area vector (|S| = area, along the normal) as OpenFOAM computes them
+// (primitiveMeshFaceCentresAndAreas): exact for a triangle; a polygon is split into triangles
+// about its vertex mean and their area-weighted centres averaged.
+struct FaceGeometry {
+  Eigen::Vector3d centre, area;
+};
+FaceGeometry face_geometry(const PolyMesh& mesh, const Face& face);
+
+// Cell centres and volumes (m, m^3; volumes signed) as OpenFOAM computes them
+// (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres.
+struct CellGeometry {
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> volumes;
+};
+CellGeometry cell_geometry(const PolyMesh& mesh);
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);
 std::vector<double> cell_volumes(const PolyMesh& mesh);
 

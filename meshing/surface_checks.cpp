@@ -9,6 +9,7 @@
 #include <CGAL/boost/graph/helpers.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <tuple>
 #include <cstdint>
 
@@ -74,6 +75,21 @@ SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) 
     out.self_intersections_checked = true;
     out.self_intersecting = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
   }
+  return out;
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_triangles(const TriangleMesh& m) {
+  Mesh mesh;
+  mesh.reserve(m.points.size(), 3 * m.triangles.size() / 2, m.triangles.size());
+  for (const auto& p : m.points) mesh.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
+  for (const auto& t : m.triangles)
+    if (mesh.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]), Mesh::Vertex_index(t[2])) == Mesh::null_face())
+      throw std::invalid_argument("self_intersecting_triangles: the surface is not manifold");
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  PMP::self_intersections<CGAL::Parallel_if_available_tag>(mesh, std::back_inserter(pairs));
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  for (const auto& [a, b] : pairs) out.emplace_back(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+  std::sort(out.begin(), out.end());  // the parallel search reports in no fixed order
   return out;
 }
 

@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "meshing/triangle_mesh.hpp"
@@ -28,6 +29,10 @@ struct SurfaceCheck {
 };
 
 SurfaceCheck check_surface(const TriangleMesh& mesh, long self_intersection_limit);
+
+// Pairs of triangles of `mesh` (closed and manifold) that meet other than in a shared edge or
+// vertex, as indices into mesh.triangles; CGAL's box-intersection test, on every core.
+std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_triangles(const TriangleMesh& mesh);
 
 // "(x, y, z) m used by k triangles;" for the first `count` defective edges, for error messages.
 std::string describe_defects(const SurfaceCheck& check, std::size_t count = 5);

@@ -8,7 +8,9 @@
 #include <fstream>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
+#include <unordered_map>
 #include <thread>
 
 #include "core/error.hpp"
@@ -36,6 +38,8 @@ VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
   p.gate.max_aspect_ratio = g.number("max_aspect_ratio", p.gate.max_aspect_ratio, Range{1.0, 1e12, false, false});
   p.gate.min_volume_d3 = g.number("min_volume_d3", p.gate.min_volume_d3, Range::positive());
   g.finish();
+  SceneSection layers = s.sub("layers");
+  p.layers = read_prism_layer_params(layers);
   return p;
 }
 
@@ -50,7 +54,8 @@ nlohmann::json to_json(const VolumeMeshParams& p) {
            {{"max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg},
             {"max_skewness", p.gate.max_skewness},
             {"max_aspect_ratio", p.gate.max_aspect_ratio},
-            {"min_volume_d3", p.gate.min_volume_d3}}}};
+            {"min_volume_d3", p.gate.min_volume_d3}}},
+          {"layers", to_json(p.layers)}};
 }
 
 namespace {
@@ -88,8 +93,8 @@ std::vector<int> shells(const TriangleMesh& s) {
 }
 
 // The discrete surfaces (one per shell and patch, so that HXT sees each closed shell on its own),
-// their physical groups, and the fluid volume bounded by them.
-void load_surface(const TriangleMesh& s) {
+// their physical groups, and the fluid volume bounded by them; returns the volume's tag.
+int load_surface(const TriangleMesh& s) {
   const std::vector<int> shell = shells(s);
   const int n_patches = static_cast<int>(s.patches.size());
   const int inlet = static_cast<int>(std::find(s.patches.begin(), s.patches.end(), "inlet") - s.patches.begin());
@@ -145,6 +150,82 @@ void load_surface(const TriangleMesh& s) {
   }
   const int fluid = gmsh::model::addPhysicalGroup(3, {volume});
   gmsh::model::setPhysicalName(3, fluid, "fluid");
+  return volume;
+}
+
+// The physical group of that dimension and name, or -1.
+int physical_group(int dim, const std::string& name) {
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups, dim);
+  for (const auto& [d, tag] : groups) {
+    std::string n;
+    gmsh::model::getPhysicalName(d, tag, n);
+    if (n == name) return tag;
+  }
+  return -1;
+}
+
+// The prism layers into the model after the tetrahedra have filled the space above them: their
+// points below the tops (new nodes; the tops are the surface's nodes, tag = index + 1), their
+// cells (a discrete volume joining `fluid`), and the particle triangles at their feet (a
+// discrete surface that becomes the `particles` group; the tops are now inside the fluid).
+void insert_layers(const PrismLayers& layers) {
+  const std::size_t n_top = layers.top.points.size();
+  {
+    std::vector<std::size_t> triangle_tags, triangle_nodes;
+    gmsh::model::mesh::getElementsByType(2, triangle_tags, triangle_nodes);
+    if (triangle_tags.size() != layers.top.triangles.size())
+      throw std::runtime_error(fmt::format("the tetrahedra changed the surface ({} triangles, {} given), so the prism "
+                                           "layers cannot be joined to them",
+                                           triangle_tags.size(), layers.top.triangles.size()));
+  }
+  std::vector<std::size_t> tags;
+  std::vector<double> xyz, uvw;
+  gmsh::model::mesh::getNodes(tags, xyz, uvw, -1, -1, false, false);
+  std::size_t checked = 0, next = 0;
+  for (std::size_t k = 0; k < tags.size(); ++k) {
+    next = std::max(next, tags[k] + 1);
+    if (tags[k] < 1 || tags[k] > n_top) continue;
+    const Eigen::Vector3d& p = layers.top.points[tags[k] - 1];
+    if (p != Eigen::Vector3d(xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]))
+      throw std::runtime_error("volume mesh: gmsh renumbered the surface nodes; the prism layers cannot be joined");
+    ++checked;
+  }
+  if (checked != n_top) throw std::runtime_error("volume mesh: gmsh dropped surface nodes; the prism layers cannot be joined");
+  auto tag_of = [&](int i) {
+    return static_cast<std::size_t>(i) < n_top ? static_cast<std::size_t>(i) + 1 : next + (static_cast<std::size_t>(i) - n_top);
+  };
+
+  const int volume = gmsh::model::addDiscreteEntity(3);
+  std::vector<std::size_t> new_tags;
+  std::vector<double> coords;
+  for (std::size_t i = 0; i < layers.below.size(); ++i) {
+    new_tags.push_back(next + i);
+    coords.insert(coords.end(), {layers.below[i].x(), layers.below[i].y(), layers.below[i].z()});
+  }
+  gmsh::model::mesh::addNodes(3, volume, new_tags, coords);
+  // gmsh's element types: 4 tetrahedron, 7 pyramid, 6 prism.
+  for (const auto& [points, type] : {std::pair{4, 4}, std::pair{5, 7}, std::pair{6, 6}}) {
+    std::vector<std::size_t> nodes;
+    for (const VolumeCell& c : layers.cells)
+      if (c.n == points)
+        for (int k = 0; k < c.n; ++k) nodes.push_back(tag_of(c.v[k]));
+    if (!nodes.empty()) gmsh::model::mesh::addElementsByType(volume, type, {}, nodes);
+  }
+  const int feet = gmsh::model::addDiscreteEntity(2);
+  std::vector<std::size_t> nodes;
+  for (const Face& f : layers.particle_faces)
+    for (int v : f) nodes.push_back(tag_of(v));
+  gmsh::model::mesh::addElementsByType(feet, 2, {}, nodes);
+
+  // The groups: `particles` is now the feet, `fluid` the tetrahedra and the layers.
+  const int particles = physical_group(2, "particles"), fluid = physical_group(3, "fluid");
+  std::vector<int> fluid_entities;
+  gmsh::model::getEntitiesForPhysicalGroup(3, fluid, fluid_entities);
+  fluid_entities.push_back(volume);
+  gmsh::model::removePhysicalGroups({{2, particles}, {3, fluid}});
+  gmsh::model::setPhysicalName(2, gmsh::model::addPhysicalGroup(2, {feet}), "particles");
+  gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, fluid_entities), "fluid");
 }
 
 // The current gmsh model's tetrahedra and physical boundary triangles as a PolyMesh.
@@ -159,16 +240,23 @@ PolyMesh extract_poly_mesh() {
     index.emplace(node_tags[k], static_cast<int>(k));
     points[k] = {xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
   }
-  std::vector<std::size_t> element_tags, element_nodes;
-  gmsh::model::mesh::getElementsByType(4, element_tags, element_nodes);
-  std::vector<std::array<int, 4>> tets(element_tags.size());
-  for (std::size_t e = 0; e < tets.size(); ++e)
-    for (int k = 0; k < 4; ++k) tets[e][k] = index.at(element_nodes[4 * e + k]);
+  // gmsh's element types: 4 tetrahedron, 7 pyramid, 6 prism (prism layers).
+  std::vector<VolumeCell> cells;
+  for (const auto& [type, points] : {std::pair{4, 4}, std::pair{7, 5}, std::pair{6, 6}}) {
+    std::vector<std::size_t> element_tags, element_nodes;
+    gmsh::model::mesh::getElementsByType(type, element_tags, element_nodes);
+    for (std::size_t e = 0; e < element_tags.size(); ++e) {
+      VolumeCell c;
+      c.n = points;
+      for (int k = 0; k < points; ++k) c.v[k] = index.at(element_nodes[points * e + k]);
+      cells.push_back(c);
+    }
+  }
 
   gmsh::vectorpair groups;
   gmsh::model::getPhysicalGroups(groups, 2);
   std::vector<std::string> names, types;
-  std::vector<std::array<int, 3>> boundary;
+  std::vector<Face> boundary;
   std::vector<int> patch;
   // Patches in a fixed order whatever gmsh's group numbering: inlet, outlet, walls, particles.
   std::vector<std::pair<std::string, int>> named;
@@ -193,39 +281,52 @@ PolyMesh extract_poly_mesh() {
       std::vector<std::size_t> triangle_tags, triangle_nodes;
       gmsh::model::mesh::getElementsByType(2, triangle_tags, triangle_nodes, e);
       for (std::size_t t = 0; 3 * t + 2 < triangle_nodes.size(); ++t) {
-        boundary.push_back({index.at(triangle_nodes[3 * t]), index.at(triangle_nodes[3 * t + 1]),
-                            index.at(triangle_nodes[3 * t + 2])});
+        boundary.push_back(Face{index.at(triangle_nodes[3 * t]), index.at(triangle_nodes[3 * t + 1]),
+                                index.at(triangle_nodes[3 * t + 2])});
         patch.push_back(p);
       }
     }
   }
-  return poly_mesh_from_tets(std::move(points), std::move(tets), boundary, patch, names, types);
+  return poly_mesh_from_cells(std::move(points), cells, boundary, patch, names, types);
 }
 
-// Legacy VTK of the given cells, with their quality and the nearest particle, for ParaView.
+// Legacy VTK of the given cells as the polygons of their faces (any cell type), each carrying
+// its cell's quality and nearest particle, for ParaView.
 void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
                      const std::vector<int>& bad, const std::vector<int>& nearest) {
-  const std::vector<std::array<int, 4>> cells = cell_tets(m);
+  std::unordered_map<int, int> rank;  // cell -> position in `bad`
+  for (std::size_t k = 0; k < bad.size(); ++k) rank.emplace(bad[k], static_cast<int>(k));
+  std::vector<std::pair<int, int>> polygons;  // (position in bad, face)
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1})
+      if (const auto it = rank.find(c); c >= 0 && it != rank.end()) polygons.emplace_back(it->second, static_cast<int>(f));
+  std::sort(polygons.begin(), polygons.end());
+  std::size_t corners = 0;
+  for (const auto& [k, f] : polygons) corners += m.faces[f].size();
   std::ofstream out(path);
-  out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate\nASCII\nDATASET UNSTRUCTURED_GRID\n";
-  out << "POINTS " << 4 * bad.size() << " double\n";
-  for (int c : bad)
-    for (int v : cells[c]) out << fmt::format("{:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
-  out << "CELLS " << bad.size() << " " << 5 * bad.size() << "\n";
-  for (std::size_t k = 0; k < bad.size(); ++k)
-    out << fmt::format("4 {} {} {} {}\n", 4 * k, 4 * k + 1, 4 * k + 2, 4 * k + 3);
-  out << "CELL_TYPES " << bad.size() << "\n";
-  for (std::size_t k = 0; k < bad.size(); ++k) out << "10\n";
-  out << "CELL_DATA " << bad.size() << "\n";
+  out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate, as their faces\nASCII\nDATASET POLYDATA\n";
+  out << "POINTS " << corners << " double\n";
+  for (const auto& [k, f] : polygons)
+    for (int v : m.faces[f])
+      out << fmt::format("{:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
+  out << "POLYGONS " << polygons.size() << " " << polygons.size() + corners << "\n";
+  std::size_t next = 0;
+  for (const auto& [k, f] : polygons) {
+    out << m.faces[f].size();
+    for (int j = 0; j < m.faces[f].size(); ++j) out << " " << next++;
+    out << "\n";
+  }
+  out << "CELL_DATA " << polygons.size() << "\n";
   auto field = [&](const char* name, const auto& value) {
     out << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
-    for (std::size_t k = 0; k < bad.size(); ++k) out << fmt::format("{:.6g}\n", static_cast<double>(value(k)));
+    for (const auto& [k, f] : polygons) out << fmt::format("{:.6g}\n", static_cast<double>(value(k)));
   };
-  field("non_orthogonality_deg", [&](std::size_t k) { return q.non_orthogonality_deg[bad[k]]; });
-  field("skewness", [&](std::size_t k) { return q.skewness[bad[k]]; });
-  field("aspect_ratio", [&](std::size_t k) { return q.aspect_ratio[bad[k]]; });
-  field("volume_m3", [&](std::size_t k) { return q.volume[bad[k]]; });
-  field("nearest_particle", [&](std::size_t k) { return nearest[k]; });
+  field("cell", [&](int k) { return bad[k]; });
+  field("non_orthogonality_deg", [&](int k) { return q.non_orthogonality_deg[bad[k]]; });
+  field("skewness", [&](int k) { return q.skewness[bad[k]]; });
+  field("aspect_ratio", [&](int k) { return q.aspect_ratio[bad[k]]; });
+  field("volume_m3", [&](int k) { return q.volume[bad[k]]; });
+  field("nearest_particle", [&](int k) { return nearest[k]; });
 }
 
 }  // namespace
@@ -237,15 +338,24 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
   if (p.fallback)
     tries.push_back(p.algorithm == VolumeMeshParams::Algorithm::hxt ? VolumeMeshParams::Algorithm::delaunay
                                                                      : VolumeMeshParams::Algorithm::hxt);
+  // The prism layers do not depend on the algorithm: built once, the tetrahedra fill what is
+  // left above them.
+  std::optional<PrismLayers> layers;
+  if (p.layers.count > 0) {
+    progress.update(fmt::format("prism layers: {} on the particles", p.layers.count));
+    layers = build_prism_layers(surface, d_ref, p.layers);
+  }
+  const TriangleMesh& boundary = layers ? layers->top : surface;
   nlohmann::json attempts = nlohmann::json::array();
   std::string failure;  // one sentence per attempt
   for (const auto algorithm : tries) {
     const auto t0 = std::chrono::steady_clock::now();
-    progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), surface.triangles.size()));
+    progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), boundary.triangles.size()));
     GmshSession session;
+    int tetrahedra = 0;
     try {
       gmsh::model::add("bedforge");
-      load_surface(surface);
+      tetrahedra = load_surface(boundary);
       gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == VolumeMeshParams::Algorithm::hxt ? 10 : 1);
       gmsh::option::setNumber("General.NumThreads",
                               p.threads > 0 ? p.threads : std::max(1u, std::thread::hardware_concurrency()));
@@ -253,9 +363,14 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       gmsh::option::setNumber("Mesh.Optimize", 0);  // optimised below, pass by pass, each pass measured
       progress.update(fmt::format("{}: tetrahedra", algorithm_name(algorithm)));
       gmsh::model::mesh::generate(3);
+      if (layers) insert_layers(*layers);
     } catch (const std::string& e) {  // gmsh's API throws its last error message
       attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e}});
       failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), e);
+      continue;
+    } catch (const std::runtime_error& e) {
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e.what()}});
+      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), e.what());
       continue;
     }
     const double generated_at = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -271,7 +386,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
         if (pass > 0) {
           progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", algorithm_name(algorithm), pass,
                                       bad.size()));
-          gmsh::model::mesh::optimize("", true, 1);
+          gmsh::model::mesh::optimize("", true, 1, {{3, tetrahedra}});  // the layers are left as built
         }
         progress.update(fmt::format("{}: checking cells", algorithm_name(algorithm)));
         out.mesh = extract_poly_mesh();
@@ -316,6 +431,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       }
       out.report = attempt;
       out.report["attempts"] = attempts;
+      if (layers) out.report["layers"] = layers->report;
       return out;
     }
     // Say where the bad cells are: the nearest particle surface to each.

@@ -8,6 +8,7 @@
 #include "core/scene_section.hpp"
 #include "meshing/cell_quality.hpp"
 #include "meshing/poly_mesh.hpp"
+#include "meshing/prism_layers.hpp"
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -27,6 +28,7 @@ struct VolumeMeshParams {
   int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
   int threads = 0;                       // 0: every core
   QualityGate gate;
+  PrismLayerParams layers;               // [mesh.layers]; none by default
 };
 const char* algorithm_name(VolumeMeshParams::Algorithm a);
 VolumeMeshParams read_volume_mesh_params(SceneSection& mesh);
@@ -39,7 +41,7 @@ struct VolumeMesh {
 };
 
 // Meshes the inside of `surface` (closed, labelled by patch; the fluid surface of the surface
-// stage). `bed` names the particles near bad cells; `d_ref` (m) scales the parameters. Writes
+// stage), with prism layers on the particles first when params.layers.count > 0. `bed` names the particles near bad cells; `d_ref` (m) scales the parameters. Writes
 // the gmsh mesh (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty.
 // Tries the algorithms in turn; when none passes the gate, throws std::runtime_error saying
 // how many cells fail which limit and near which particles, after writing them as a legacy VTK

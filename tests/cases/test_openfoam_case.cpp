@@ -175,6 +175,31 @@ TEST(OpenFoamCase, ACaseWithoutAMeshAndAMeshWithoutAClosedSurfaceAreRefused) {
   EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
 }
 
+// Prism layers on the particles: checkMesh passes the mixed mesh (prisms, pyramids,
+// tetrahedra) and its quality figures are the mesh stage's own.
+TEST(OpenFoamCase, PrismLayersGiveACaseCheckMeshPasses) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const fs::path dir = fresh_dir("layers");
+  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
+  ASSERT_EQ(bedforge("--quiet surface " + dir.string() + " --edge-length-d 0.1").status, 0);
+  const Result m = bedforge("mesh " + dir.string() + " --layers 3 --layer-thickness-d 0.02");
+  ASSERT_EQ(m.status, 0) << m.output;
+  EXPECT_NE(m.output.find("3 prism layers"), std::string::npos) << m.output;
+  ASSERT_EQ(bedforge("--quiet case " + dir.string()).status, 0);
+  const Result c = check_mesh(dir / "case");
+  ASSERT_NE(c.output.find("Mesh OK."), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("prisms:"), std::string::npos) << c.output;
+  auto number_after = [&](const std::string& key) {
+    const auto at = c.output.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(c.output.substr(at + key.size()));
+  };
+  EXPECT_GT(number_after("prisms:"), 0.0) << c.output;
+  const auto q = nlohmann::json::parse(read(dir / "report.json"))["stages"]["mesh"]["quality"];
+  EXPECT_NEAR(q["max_non_orthogonality_deg"].get<double>(), number_after("Mesh non-orthogonality Max:"), 1e-6);
+  EXPECT_NEAR(q["max_skewness"].get<double>(), number_after("Max skewness ="), 1e-6);
+  EXPECT_NEAR(q["max_aspect_ratio"].get<double>(), number_after("Max aspect ratio ="), 1e-6);
+}
+
 // A walled box: checkMesh passes, and the correlation sees the box through its cross-section
 // (3 d x 4 d: area 12 d^2, hydraulic diameter 4 A / P = 24/7 d).
 TEST(OpenFoamCase, AWalledBoxGivesACaseCheckMeshPasses) {

@@ -57,6 +57,17 @@ Grid kuhn_grid(int n) {
   return g;
 }
 
+// The tetrahedra and boundary triangles in poly_mesh_from_cells's terms.
+PolyMesh poly_mesh_from_tets(const std::vector<Eigen::Vector3d>& points, const std::vector<std::array<int, 4>>& tets,
+                             const std::vector<std::array<int, 3>>& boundary, const std::vector<int>& patch,
+                             const std::vector<std::string>& names, const std::vector<std::string>& types) {
+  std::vector<VolumeCell> cells;
+  for (const auto& t : tets) cells.push_back({{t[0], t[1], t[2], t[3], -1, -1}, 4});
+  std::vector<Face> faces;
+  for (const auto& t : boundary) faces.emplace_back(t);
+  return poly_mesh_from_cells(points, cells, faces, patch, names, types);
+}
+
 const std::vector<std::string> kNames{"x0", "x1", "y0", "y1", "z0", "z1"};
 const std::vector<std::string> kTypes{"patch", "patch", "wall", "wall", "wall", "wall"};
 

@@ -74,6 +74,35 @@ TEST(VolumeMesh, CellsFillTheSurfaceAndKeepEveryPatch) {
   EXPECT_FALSE(fs::exists(dir / "bad_cells.vtk"));
 }
 
+TEST(VolumeMesh, PrismLayersAndTetrahedraFillTheSurfaceTogether) {
+  const Bed b = small_bed();
+  const FluidSurface s = coarse_surface(b);
+  const fs::path dir = scratch("layers");
+  VolumeMeshParams p;
+  p.layers.count = 3;
+  p.layers.thickness_d = 0.02;
+  Progress quiet("mesh", false);
+  const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, p, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
+  // The layers and the tetrahedra above them fill exactly what the surface encloses, every cell
+  // positive, and the particles keep their triangles (now the feet of the stacks).
+  const double enclosed = check_surface(s.fluid, 0).volume;
+  EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
+  EXPECT_GT(vm.quality.min_volume, 0.0);
+  for (int d : patch_counts(s.fluid, vm.mesh)) EXPECT_EQ(d, 0);
+  const long prisms = vm.report["layers"]["cells"]["prisms"].get<long>();
+  EXPECT_GT(prisms, 0);
+  // Quads are the prisms' sides: each prism has three, shared with its neighbours in the stack
+  // ring or lying on no boundary.
+  long quads = 0;
+  for (const auto& f : vm.mesh.faces) quads += f.size() == 4;
+  EXPECT_GE(quads, 3 * prisms / 2);
+  // What gmsh wrote reads back as the same mesh, layers included.
+  const PolyMesh again = read_msh(dir / "fluid.msh");
+  EXPECT_EQ(again.cells, vm.mesh.cells);
+  EXPECT_EQ(again.faces.size(), vm.mesh.faces.size());
+  EXPECT_NEAR(cell_quality(again).total_volume, enclosed, 1e-9 * enclosed);
+}
+
 TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
   const Bed b = small_bed();
   const FluidSurface s = coarse_surface(b);
@@ -94,7 +123,7 @@ TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
   std::ifstream vtk(dir / "bad_cells.vtk");
   std::stringstream text;
   text << vtk.rdbuf();
-  EXPECT_NE(text.str().find("DATASET UNSTRUCTURED_GRID"), std::string::npos);
+  EXPECT_NE(text.str().find("DATASET POLYDATA"), std::string::npos);
   EXPECT_NE(text.str().find("SCALARS nearest_particle"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
 }
@@ -119,7 +148,7 @@ namespace {
 // Longest piece of the segment a-b inside one cell of `m`, as a fraction of the segment, from
 // 1000 points along it.
 double longest_piece_in_a_cell(const PolyMesh& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const std::vector<std::array<int, 4>> tets = cell_tets(m);
+  const std::vector<std::vector<int>> tets = cell_points(m);
   std::map<int, int> samples;  // per cell crossed
   constexpr int kSamples = 1000;
   for (int k = 0; k < kSamples; ++k) {
