@@ -13,9 +13,9 @@ namespace bedforge::meshing {
 // diameters d. Each vertex of the `particles` patch is pushed into the fluid along its normal
 // by a stack of `count` layers growing by `growth`; the tetrahedra then fill the rest. Where
 // there is no room the stack thins: it takes at most `gap_fraction` of the gap in front of it
-// (none where that is under half of `thickness_d`: the narrow gaps near contacts keep their
-// tetrahedra), changes by at most half the distance between neighbouring vertices (so side faces
-// stay upright), and is zero on the edges the particles share with other patches (a bridge's
+// and leaves the tetrahedra at least one local surface edge of it (none where that is under
+// half of `thickness_d`: narrow gaps keep their tetrahedra), changes by at most half the
+// distance between neighbouring vertices (so side faces stay upright), and is zero on the edges the particles share with other patches (a bridge's
 // foot on a wall, a sphere cut by the inlet). Next to a stack of no height prisms collapse to
 // pyramids and tetrahedra.
 struct PrismLayerParams {

@@ -6,6 +6,7 @@ side, and the whole pipeline at scale; writes docs/mesh_case_benchmark.md, .json
     /usr/bin/python3 tools/benchmark_mesh_case.py --only sizes       # some sections, keep the others' results
     /usr/bin/python3 tools/benchmark_mesh_case.py --edges 0.2 0.15   # other surface edge lengths (d)
     /usr/bin/python3 tools/benchmark_mesh_case.py --only gaps --gap-cells 2 3
+    /usr/bin/python3 tools/benchmark_mesh_case.py --only layers --layer-thickness 0.02 0.05
 
 sizes:  a = 5, N = 500 (seed 1), bridges, packed once; for each surface edge length (the mesh
         follows the surface, refined 3x where contacts meet) a real `bedforge run` to a case that
@@ -15,6 +16,8 @@ sizes:  a = 5, N = 500 (seed 1), bridges, packed once; for each surface edge len
 gaps:   the same bed, surface edge 0.2 d, refined only where surfaces face each other across
         narrow gaps (surface.cells_per_gap = 2 and 3), solved the same way: the pressure drop
         against cells and time, next to the uniformly refined levels.
+layers: the same bed, surface edge 0.2 d, without and with 3 prism layers on the particles
+        ([mesh.layers] thickness_d as given), solved the same way.
 snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
         the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
@@ -39,11 +42,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "snappy", "scale"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
-def scene(a, n, treatment, edge, run, cells_per_gap=0):
+def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -60,6 +63,9 @@ contact_edge_length_d = {edge / 3:.4g}
 cells_per_gap = {cells_per_gap}
 [mesh]
 algorithm = "hxt"
+[mesh.layers]
+count = {layers}
+thickness_d = {layer_thickness}
 [case]
 reynolds = 1.0
 processors = 2
@@ -99,17 +105,21 @@ def stage_times(report):
 
 
 def sizes(tmp, levels):
-    """levels: (surface edge in d, cells per gap) pairs."""
+    """levels: (surface edge in d, cells per gap, prism layers, their thickness in d)."""
     rows = []
-    for edge, gap_cells in levels:
-        path = os.path.join(tmp, f"bridge_{edge}_{gap_cells}")
-        open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, gap_cells))
+    for edge, gap_cells, layers, thickness in levels:
+        path = os.path.join(tmp, f"bridge_{edge}_{gap_cells}_{layers}_{thickness}")
+        open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, gap_cells, layers, thickness))
         wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
         rep = json.load(open(os.path.join(path, "report.json")))
         mb = peak_mb(rep)
         ok, cells, non_ortho, skew, _ = check_mesh(os.path.join(path, "case"))
         flow = rep["stages"]["case"]["flow"]
-        rows.append({"route": "gmsh", "edge_d": edge, "cells_per_gap": gap_cells, "cells": cells, "wall_s": wall,
+        mesh = rep["stages"]["mesh"]
+        rows.append({"route": "gmsh", "edge_d": edge, "cells_per_gap": gap_cells, "layers": layers,
+                     "layer_thickness_d": thickness if layers else 0, "layer_cells": mesh.get("layers", {}).get("cells"),
+                     "layer_mean_thickness_d": mesh.get("layers", {}).get("mean_thickness_d"), "cells": cells,
+                     "wall_s": wall,
                      "peak_mb": mb,
                      "stages_s": stage_times(rep), "solve_s": flow["time_s"], "mesh_ok": ok,
                      "max_non_orthogonality": non_ortho, "max_skewness": skew,
@@ -125,7 +135,7 @@ def sizes(tmp, levels):
 def snappy(tmp, edge):
     """The bed and surface of the finest gmsh level (made again when the sizes section did not
     run), meshed by snappyHexMesh and solved."""
-    path = os.path.join(tmp, f"bridge_{edge}_0")
+    path = os.path.join(tmp, f"bridge_{edge}_0_0_0.02")
     if not os.path.exists(os.path.join(path, "fluid.msh")):
         open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, False))
         timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
@@ -201,6 +211,26 @@ def write(results):
                          f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
         lines.append("")
+    if "layers" in results:
+        lines += ["## The same bed with prism layers on the particles (`[mesh.layers]`)", "",
+                  "Surface edge 0.2 d, 3 layers growing by 1.2, at most 0.2 of the gap ahead of each stack "
+                  "(`gap_fraction`), none where that leaves under half the thickness; the first row has none. "
+                  "*/ finest* compares with the finest level of the table above.", "",
+                  "| layers | thickness (d), mean reached | cells (prisms, pyramids, tets in the layers) | mesh s | "
+                  "simpleFoam s (its) | whole run s | checkMesh | max non-ortho | dp/L (Pa/m) | / E&S | / finest | "
+                  "eps section |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        finest = min(results["sizes"], key=lambda r: r["edge_d"]) if "sizes" in results else None
+        for r in results["layers"]:
+            st, lc = r["stages_s"], r.get("layer_cells") or {}
+            reached = f"{r['layer_thickness_d']:g}, {r['layer_mean_thickness_d']:.3f}" if r["layers"] else "-"
+            cells = f"{r['cells']} ({lc.get('prisms', 0)}, {lc.get('pyramids', 0)}, {lc.get('tetrahedra', 0)})" \
+                if r["layers"] else f"{r['cells']}"
+            to_finest = f"{r['dp_dz_pa_m'] / finest['dp_dz_pa_m']:.3f}" if finest else "-"
+            lines.append(f"| {r['layers']} | {reached} | {cells} | {st.get('mesh', 0):.1f} | {r['solve_s']:.0f} "
+                         f"({r['iterations']}{'' if r['converged'] else ', not converged'}) | {r['wall_s']:.0f} | "
+                         f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
+                         f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {to_finest} | {r['eps_section']:.4f} |")
+        lines.append("")
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
         lines += ["## The same bed by the snappyHexMesh route", "",
@@ -250,6 +280,13 @@ def plot(results):
         for x, r in zip(t, g):
             ax.annotate(f"{r['cells_per_gap']:g} per gap, {r['cells'] / 1e6:.2f} M cells", (x, r["ratio_es"]), fontsize=8,
                         textcoords="offset points", xytext=(-6, 4), ha="right")
+    if "layers" in results:
+        g = [r for r in results["layers"] if r["layers"]]
+        t = [sum(r["stages_s"].values()) for r in g]
+        ax.plot(t, [r["ratio_es"] for r in g], "D", label="0.2 d, 3 prism layers")
+        for x, r in zip(t, g):
+            ax.annotate(f"{r['layer_thickness_d']:g} d, {r['cells'] / 1e6:.2f} M cells", (x, r["ratio_es"]), fontsize=8,
+                        textcoords="offset points", xytext=(4, -10))
     if "snappy" in results:
         s = results["snappy"]
         ax.plot([s["wall_s"]], [s["ratio_es"]], "s", label="snappyHexMesh route")
@@ -268,14 +305,18 @@ def main():
     ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS)
     ap.add_argument("--edges", type=float, nargs="+", default=[0.2, 0.15, 0.1])
     ap.add_argument("--gap-cells", type=float, nargs="+", default=[2, 3])
+    ap.add_argument("--layer-thickness", type=float, nargs="+", default=[0.02, 0.05])
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
         if "sizes" in args.only:
-            results["sizes"] = sizes(tmp, [(e, 0) for e in args.edges])
+            results["sizes"] = sizes(tmp, [(e, 0, 0, 0.02) for e in args.edges])
             write(results)
         if "gaps" in args.only:
-            results["gaps"] = sizes(tmp, [(0.2, c) for c in args.gap_cells])
+            results["gaps"] = sizes(tmp, [(0.2, c, 0, 0.02) for c in args.gap_cells])
+            write(results)
+        if "layers" in args.only:
+            results["layers"] = sizes(tmp, [(0.2, 0, 0, 0.02)] + [(0.2, 0, 3, t) for t in args.layer_thickness])
             write(results)
         if "snappy" in args.only:
             results["snappy"] = snappy(tmp, min(args.edges))

@@ -125,9 +125,9 @@ def main():
                                 [dict(a=a, n=count_for(a, 12), seed=s, mode="accelerated") for a in a_large
                                  for s in range(1, 3 if quick else 4)]),
         # 4. Speed against N (accelerated, both cores); N = 1e5 at a = 40 as the issue asks (a bed
-        # about 70 d tall), the smaller ones about 20 d tall.
-        "speed": lambda: run_all([dict(a=a, n=n, seed=1, mode="accelerated", threads=2, analyse=False)
-                                  for n, a in sizes], workers=1),
+        # about 70 d tall, three seeds: its iteration count is chaotic), the smaller ones about 20 d tall.
+        "speed": lambda: run_all([dict(a=a, n=n, seed=s, mode="accelerated", threads=2, analyse=False)
+                                  for n, a in sizes for s in (range(1, 4) if n == 100000 else (1,))], workers=1),
     }
     results.setdefault("minutes", {})
     for name in SECTIONS:
@@ -256,19 +256,26 @@ def write_report(R):
 
     # 4. Speed.
     lines += ["## Time against N (accelerated, 2 threads)", "",
-              "| N | a | iterations | time (s) | iterations per second | eps central |", "|---|---|---|---|---|---|"]
+              "| N | a | seed | iterations | time (s) | iterations per second | eps central |",
+              "|---|---|---|---|---|---|---|"]
     for r in ok(R["speed"]):
-        lines.append(f"| {r['n']} | {r['a']} | {r['iterations']} | {r['time_s']:.1f} | {r['iterations'] / r['time_s']:.0f} | "
-                     f"{r['eps_central']:.4f} |")
+        lines.append(f"| {r['n']} | {r['a']} | {r['seed']} | {r['iterations']} | {r['time_s']:.1f} | "
+                     f"{r['iterations'] / r['time_s']:.0f} | {r['eps_central']:.4f} |")
     big = [r for r in ok(R["speed"]) if r["n"] == 100000]
     if big:
-        met = big[0]["time_s"] < 300.0
-        lines += ["", f"The issue's target for N = 1e5 (a about 40), under 5 minutes, is {'met' if met else 'not met'}: "
-                  f"{big[0]['time_s']:.0f} s, {1000 * big[0]['time_s'] / big[0]['iterations']:.1f} ms per iteration. "
+        mean = sum(r["time_s"] for r in big) / len(big)
+        met = mean < 300.0
+        lines += ["", f"The issue's target for N = 1e5 (a about 40), under 5 minutes, is {'met' if met else 'not met'} "
+                  f"on the mean of {len(big)} seeds: {mean:.0f} s ("
+                  + ", ".join(f"seed {r['seed']} {r['time_s']:.0f} s" for r in big) + f"; "
+                  f"{sum(1 for r in big if r['time_s'] < 300.0)} of {len(big)} under 300 s), "
+                  f"{1000 * sum(r['time_s'] for r in big) / sum(r['iterations'] for r in big):.1f} ms per iteration. "
                   "The number of iterations varies with rounding, because the settling bed creeps and the mass-centre "
                   "test ends each stage at a chaotic moment: on 2026-11-22 the same seed took 44100 iterations, then "
                   "57200 after a change that only reordered the neighbour list, with the same void fraction (0.3686 "
-                  "and 0.3683 central). Where the time goes at N = 1e5 (2026-11-22, seed 1): compaction 35600 "
+                  "and 0.3683 central); a Verlet skin of 0.1 d instead of 0.2 d (which changes the order in which the "
+                  "cells are scanned, not the forces) took seed 1 from 43200 iterations to 34700 at the same 7.7 ms "
+                  "per iteration. Where the time goes at N = 1e5 (2026-11-22, seed 1): compaction 35600 "
                   "iterations (the fall about 6000, then the creep of the settling bed, which moves its mass centre "
                   "down by 0.43 d, a void fraction change of about 0.008, so it cannot be cut short without changing "
                   "the bed), the final stage 7400 since its momentum is capped (`final_momentum_bound`, "
