@@ -64,8 +64,9 @@ BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, dou
     throw InputError(fmt::format("case.section_exclude_d = {}: leaves a bed section of {:.3g} d (bed height {:.3g} d); "
                                  "the pressure drop needs at least 0.5 d, lower it",
                                  exclude_d, (s.z_high - s.z_low) / g.d_ref, g.bed_top / g.d_ref));
-  const std::vector<Eigen::Vector3d> c = meshing::cell_centres(mesh);
-  const std::vector<double> v = meshing::cell_volumes(mesh);
+  const meshing::CellGeometry cells = meshing::cell_geometry(mesh);
+  const std::vector<Eigen::Vector3d>& c = cells.centres;
+  const std::vector<double>& v = cells.volumes;
   double fluid = 0.0;
   for (int k = 0; k < mesh.cells; ++k)
     if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
@@ -291,9 +292,9 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
                       "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
                       "    writeObj            no;\n}\n"));
-      const std::vector<double> volumes = meshing::cell_volumes(mesh);
+      const meshing::CellGeometry g = meshing::cell_geometry(mesh);
       const Eigen::Vector3d inside =
-          meshing::cell_centres(mesh)[std::max_element(volumes.begin(), volumes.end()) - volumes.begin()];
+          g.centres[std::max_element(g.volumes.begin(), g.volumes.end()) - g.volumes.begin()];
       std::string regions, levels;
       for (const auto& patch : mesh.patches) {
         const bool wall = patch.type == "wall";

@@ -88,7 +88,7 @@ CellGeometry cell_geometry(const PolyMesh& m) {
     if (f < m.neighbour.size()) estimate[m.neighbour[f]] += fg[f].centre, ++count[m.neighbour[f]];
   }
   for (int c = 0; c < m.cells; ++c) estimate[c] /= std::max(1, count[c]);
-  CellGeometry g{std::vector<Eigen::Vector3d>(m.cells, Eigen::Vector3d::Zero()), std::vector<double>(m.cells, 0.0)};
+  CellGeometry g{std::vector<Eigen::Vector3d>(m.cells, Eigen::Vector3d::Zero()), std::vector<double>(m.cells, 0.0), {}};
   auto add = [&](int c, const FaceGeometry& face, double sign) {
     const double pyramid3 = sign * face.area.dot(face.centre - estimate[c]);  // 3 x the pyramid's volume
     g.centres[c] += pyramid3 * (0.75 * face.centre + 0.25 * estimate[c]);
@@ -102,22 +102,12 @@ CellGeometry cell_geometry(const PolyMesh& m) {
     g.centres[c] = std::abs(g.volumes[c]) > 1e-300 ? Eigen::Vector3d(g.centres[c] / g.volumes[c]) : estimate[c];
     g.volumes[c] /= 3.0;
   }
+  g.faces = std::move(fg);
   return g;
 }
 
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& m) { return cell_geometry(m).centres; }
 std::vector<double> cell_volumes(const PolyMesh& m) { return cell_geometry(m).volumes; }
-
-std::vector<std::vector<int>> cell_points(const PolyMesh& m) {
-  std::vector<std::vector<int>> cells(m.cells);
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
-      if (c < 0) continue;
-      for (int v : m.faces[f])
-        if (std::find(cells[c].begin(), cells[c].end(), v) == cells[c].end()) cells[c].push_back(v);
-    }
-  return cells;
-}
 
 PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& input,
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
@@ -142,13 +132,11 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
     const VolumeCell& cell = input[order[c]];
     const Eigen::Vector3d centre = vertex_mean(points, cell.v.data(), cell.n);
     for (Face f : faces_of(cell)) {
-      const Eigen::Vector3d a = points[f[0]], n = (points[f[1]] - a).cross(points[f[2]] - a);
-      if (f.size() == 4) {  // a quad's normal from its two diagonals, robust when it is warped
-        const Eigen::Vector3d nq = (points[f[2]] - a).cross(points[f[3]] - points[f[1]]);
-        if (nq.dot(vertex_mean(points, f.begin(), 4) - centre) < 0.0) std::reverse(f.begin(), f.end());
-      } else if (n.dot(a - centre) < 0.0) {
-        std::reverse(f.begin(), f.end());
-      }
+      const Eigen::Vector3d& a = points[f[0]];
+      // A quad's normal from its two diagonals, robust when it is warped.
+      const Eigen::Vector3d n = f.size() == 4 ? (points[f[2]] - a).cross(points[f[3]] - points[f[1]])
+                                              : (points[f[1]] - a).cross(points[f[2]] - a);
+      if (n.dot(vertex_mean(points, f.begin(), f.size()) - centre) < 0.0) std::reverse(f.begin(), f.end());
       all.push_back({key_of(f), f, c});
     }
   }

@@ -65,9 +65,6 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
                               const std::vector<std::string>& names, const std::vector<std::string>& types);
 
-// The distinct point indices of each cell, in no particular order.
-std::vector<std::vector<int>> cell_points(const PolyMesh& mesh);
-
 // Face centre and area vector (|S| = area, along the normal) as OpenFOAM computes them
 // (primitiveMeshFaceCentresAndAreas): exact for a triangle; a polygon is split into triangles
 // about its vertex mean and their area-weighted centres averaged.
@@ -77,10 +74,12 @@ struct FaceGeometry {
 FaceGeometry face_geometry(const PolyMesh& mesh, const Face& face);
 
 // Cell centres and volumes (m, m^3; volumes signed) as OpenFOAM computes them
-// (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres.
+// (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres;
+// with the face geometry they were built from.
 struct CellGeometry {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> volumes;
+  std::vector<FaceGeometry> faces;  // per face of the mesh
 };
 CellGeometry cell_geometry(const PolyMesh& mesh);
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);

@@ -206,6 +206,7 @@ PrismLayers build_prism_layers(const TriangleMesh& surface, double d_ref, const 
     level[k] = p.growth == 1.0 ? static_cast<double>(k) / L : (std::pow(p.growth, k) - 1.0) / (std::pow(p.growth, L) - 1.0);
 
   PrismLayers out;
+  out.top = surface;
   std::vector<int> first_below(nv, -1);  // index into `below` of level 0 of each stack; -1: none
   auto id = [&](int v, int k) {
     if (k == L || first_below[v] < 0) return v;
@@ -218,7 +219,7 @@ PrismLayers build_prism_layers(const TriangleMesh& surface, double d_ref, const 
   for (;; ++rounds) {
     taper();
     // Points of every level; a stack thinner than 2 % of the target collapses.
-    out.top = surface;
+    out.top.points = surface.points;
     out.below.clear();
     for (std::size_t v = 0; v < nv; ++v) {
       if (h[v] < 0.02 * target) h[v] = 0.0;

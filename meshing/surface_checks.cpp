@@ -19,6 +19,21 @@ namespace PMP = CGAL::Polygon_mesh_processing;
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
+namespace {
+
+// `m` as a CGAL mesh, face k = triangle k; false when a triangle would make an edge or vertex
+// non-manifold (CGAL refuses it, and the faces after it are not added).
+bool to_cgal(const TriangleMesh& m, Mesh& mesh) {
+  mesh.reserve(m.points.size(), 3 * m.triangles.size() / 2, m.triangles.size());
+  for (const auto& p : m.points) mesh.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
+  for (const auto& t : m.triangles)
+    if (mesh.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]), Mesh::Vertex_index(t[2])) == Mesh::null_face())
+      return false;
+  return true;
+}
+
+}  // namespace
+
 nlohmann::json SurfaceCheck::to_json() const {
   return {{"manifold", manifold},
           {"closed", closed},
@@ -55,13 +70,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) 
   // face by face (a face that would make an edge or vertex non-manifold is refused).
   out.closed = out.defects.empty();
   Mesh mesh;
-  mesh.reserve(m.points.size(), 3 * m.triangles.size() / 2, m.triangles.size());
-  for (const auto& p : m.points) mesh.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
-  out.manifold = out.closed;
-  for (const auto& t : m.triangles)
-    if (out.manifold && mesh.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]), Mesh::Vertex_index(t[2])) ==
-                            Mesh::null_face())
-      out.manifold = false;
+  out.manifold = out.closed && to_cgal(m, mesh);
   if (out.manifold) {
     std::vector<Mesh::Halfedge_index> pinched;
     PMP::non_manifold_vertices(mesh, std::back_inserter(pinched));
@@ -80,11 +89,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, long self_intersection_limit) 
 
 std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_triangles(const TriangleMesh& m) {
   Mesh mesh;
-  mesh.reserve(m.points.size(), 3 * m.triangles.size() / 2, m.triangles.size());
-  for (const auto& p : m.points) mesh.add_vertex(Kernel::Point_3(p.x(), p.y(), p.z()));
-  for (const auto& t : m.triangles)
-    if (mesh.add_face(Mesh::Vertex_index(t[0]), Mesh::Vertex_index(t[1]), Mesh::Vertex_index(t[2])) == Mesh::null_face())
-      throw std::invalid_argument("self_intersecting_triangles: the surface is not manifold");
+  if (!to_cgal(m, mesh)) throw std::invalid_argument("self_intersecting_triangles: the surface is not manifold");
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
   PMP::self_intersections<CGAL::Parallel_if_available_tag>(mesh, std::back_inserter(pairs));
   std::vector<std::pair<std::size_t, std::size_t>> out;

@@ -97,8 +97,8 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   // mixtures of sizes or densities (Abreu et al. 1999, step b). The report records the number.
   const bool equal_spheres = !per_species && sizes.smallest() == sizes.largest();
   const long shake_count = params.shakes.value_or(equal_spheres ? 10 : 100);
-  MonteCarloParams used = params;
-  used.shakes = shake_count;
+  MonteCarloParams resolved = params;
+  resolved.shakes = shake_count;
   Rng rng(seed);
   std::vector<double> d = sizes.sample(count, rng);
   // Largest first: random placement finds room for them while the container is still empty.
@@ -232,7 +232,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   }
   const double time = elapsed();
   out.info = {{"algorithm", "monte-carlo"},
-              {"parameters", to_json(used)},
+              {"parameters", to_json(resolved)},
               {"reference_diameter_m", d_ref},
               {"smallest_diameter_m", sizes.smallest()},
               {"mixing_height_d", lid},

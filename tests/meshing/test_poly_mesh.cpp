@@ -87,8 +87,9 @@ TEST(PolyMesh, FacesOfAGridOfTetsFollowOpenFoamsRules) {
     EXPECT_GT(area.dot(fc - cc[m.owner[f]]), 0.0) << "face " << f << " does not point out of its owner";
     if (f < m.internal_faces()) {
       EXPECT_LT(m.owner[f], m.neighbour[f]);
-      if (f > 0)  // upper-triangular order
+      if (f > 0) {  // upper-triangular order
         EXPECT_TRUE(m.owner[f - 1] < m.owner[f] || (m.owner[f - 1] == m.owner[f] && m.neighbour[f - 1] < m.neighbour[f]));
+      }
     }
   }
   // Each patch holds exactly the faces on its side of the cube, facing out.

@@ -145,6 +145,18 @@ TEST(VolumeMesh, AnAnnulusMeshesWithItsInnerWall) {
 }
 
 namespace {
+// The distinct point indices of each cell of `m`.
+std::vector<std::vector<int>> cell_points(const PolyMesh& m) {
+  std::vector<std::vector<int>> cells(m.cells);
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1}) {
+      if (c < 0) continue;
+      for (int v : m.faces[f])
+        if (std::find(cells[c].begin(), cells[c].end(), v) == cells[c].end()) cells[c].push_back(v);
+    }
+  return cells;
+}
+
 // Longest piece of the segment a-b inside one cell of `m`, as a fraction of the segment, from
 // 1000 points along it.
 double longest_piece_in_a_cell(const PolyMesh& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
