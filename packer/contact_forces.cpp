@@ -14,17 +14,26 @@ namespace {
 // energy share and raises max_pair. Two passes over chunks of the list: first, without a
 // branch, the neighbours that touch (about half the listed ones, a pattern no branch predictor
 // follows); then the square roots and divisions for those only. Measured on a packed bed of
-// 1e4 spheres, one thread: 106 ns per sphere against 172 for the one-pass loop. Templated on
-// periodicity so walls on every side (the common case) carry no wrap-around in the innermost
-// loop.
+// 1e4 spheres, one thread: 106 ns per sphere against 172 for the one-pass loop. The loop waits
+// mostly on loading the neighbours' centres and radii, so those of sphere i + 2 are prefetched
+// while i is summed, and the first pass keeps the squared distances for the second: on a packed
+// bed of 1e5 spheres 14 % less time on one thread, 8-13 % on two (median of 25 interleaved
+// rounds; the sums are unchanged, bit for bit). Templated on periodicity so walls on every side
+// (the common case) carry no wrap-around in the innermost loop.
 template <bool kPeriodic>
 double gather_pairs(const Spheres& s, const NeighbourList& nl, const Periodicity& per, std::size_t i,
                     Eigen::Vector3d& push, double& max_pair) {
   const Eigen::Vector3d xi = s.x[i];
   const double ri = s.r[i];
   auto separation = [&](int j) { return kPeriodic ? per.separation(xi, s.x[j]) : Eigen::Vector3d(xi - s.x[j]); };
-  constexpr std::size_t kChunk = 64;
+  constexpr std::size_t kChunk = 64, kAhead = 2;
+  if (i + kAhead < s.size())
+    for (int j : nl.of(i + kAhead)) {
+      __builtin_prefetch(&s.x[j]);
+      __builtin_prefetch(&s.r[j]);
+    }
   int touching[kChunk];
+  double dist2[kChunk];
   double e = 0.0;
   push.setZero();
   const std::span<const int> list = nl.of(i);
@@ -35,12 +44,13 @@ double gather_pairs(const Spheres& s, const NeighbourList& nl, const Periodicity
       const int j = list[k];
       const double reach = ri + s.r[j];
       touching[m] = j;
-      m += separation(j).squaredNorm() < reach * reach;
+      dist2[m] = separation(j).squaredNorm();
+      m += dist2[m] < reach * reach;
     }
     for (std::size_t k = 0; k < m; ++k) {
       const int j = touching[k];
       const Eigen::Vector3d d = separation(j);
-      const double dist = d.norm(), overlap = ri + s.r[j] - dist;
+      const double dist = std::sqrt(dist2[k]), overlap = ri + s.r[j] - dist;
       push += dist > 0.0 ? Eigen::Vector3d(overlap / dist * d)  // coincident centres: apart along z, by index
                          : Eigen::Vector3d(0.0, 0.0, static_cast<std::size_t>(j) < i ? overlap : -overlap);
       e += 0.25 * overlap * overlap;  // each pair is seen from both spheres
