@@ -57,18 +57,17 @@ nlohmann::json to_json(const CaseParams& p) {
           {"run", p.run},                   {"run_mesh", p.run_snappy ? "snappy" : "gmsh"}};
 }
 
-BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d) {
+BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d) {
   // The bed between its floor and top, or the part of it a clip window kept.
   BedSection s{std::max(0.0, g.inlet_z) + exclude_d * g.d_ref, std::min(g.bed_top, g.outlet_z) - exclude_d * g.d_ref, 0.0};
   if (s.z_high - s.z_low < 0.5 * g.d_ref)
     throw InputError(fmt::format("case.section_exclude_d = {}: leaves a bed section of {:.3g} d (bed height {:.3g} d); "
                                  "the pressure drop needs at least 0.5 d, lower it",
                                  exclude_d, (s.z_high - s.z_low) / g.d_ref, g.bed_top / g.d_ref));
-  const meshing::CellGeometry cells = meshing::cell_geometry(mesh);
   const std::vector<Eigen::Vector3d>& c = cells.centres;
   const std::vector<double>& v = cells.volumes;
   double fluid = 0.0;
-  for (int k = 0; k < mesh.cells; ++k)
+  for (std::size_t k = 0; k < c.size(); ++k)
     if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
   s.void_fraction = fluid / (g.cross_section_area * (s.z_high - s.z_low));
   return s;
@@ -188,7 +187,8 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
-  const BedSection section = bed_section(mesh, g, p.section_exclude_d);
+  const meshing::CellGeometry geometry = meshing::cell_geometry(mesh);
+  const BedSection section = bed_section(geometry, g, p.section_exclude_d);
   try {
     write_poly_mesh(tmp / "constant/polyMesh", mesh, p.binary, note);
     const std::string fmt_word = p.binary ? "binary" : "ascii";
@@ -292,9 +292,8 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
                       "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
                       "    writeObj            no;\n}\n"));
-      const meshing::CellGeometry g = meshing::cell_geometry(mesh);
       const Eigen::Vector3d inside =
-          g.centres[std::max_element(g.volumes.begin(), g.volumes.end()) - g.volumes.begin()];
+          geometry.centres[std::max_element(geometry.volumes.begin(), geometry.volumes.end()) - geometry.volumes.begin()];
       std::string regions, levels;
       for (const auto& patch : mesh.patches) {
         const bool wall = patch.type == "wall";

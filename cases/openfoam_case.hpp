@@ -49,11 +49,12 @@ struct CaseGeometry {
 };
 
 // Bed section over which the pressure drop is measured: its planes and its void fraction as
-// meshed (cells with their centre between the planes over the container's volume between them).
+// meshed (cells with their centre between the planes over the container's volume between them),
+// from the mesh's cell geometry.
 struct BedSection {
   double z_low = 0.0, z_high = 0.0, void_fraction = 0.0;
 };
-BedSection bed_section(const meshing::PolyMesh& mesh, const CaseGeometry& g, double exclude_d);
+BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d);
 
 // InputError when `case_dir` exists and `overwrite` is false (checked again by write_case;
 // callers check first to refuse before the long stages).

@@ -58,8 +58,7 @@ Eigen::Vector3d vertex_mean(const std::vector<Eigen::Vector3d>& p, const int* fi
 
 }  // namespace
 
-FaceGeometry face_geometry(const PolyMesh& m, const Face& f) {
-  const auto& p = m.points;
+FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& p, const Face& f) {
   if (f.size() == 3)
     return {(p[f[0]] + p[f[1]] + p[f[2]]) / 3.0, 0.5 * (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]])};
   const Eigen::Vector3d mean = vertex_mean(p, f.begin(), f.size());
@@ -80,7 +79,7 @@ FaceGeometry face_geometry(const PolyMesh& m, const Face& f) {
 
 CellGeometry cell_geometry(const PolyMesh& m) {
   std::vector<FaceGeometry> fg(m.faces.size());
-  for (std::size_t f = 0; f < m.faces.size(); ++f) fg[f] = face_geometry(m, m.faces[f]);
+  for (std::size_t f = 0; f < m.faces.size(); ++f) fg[f] = face_geometry(m.points, m.faces[f]);
   std::vector<Eigen::Vector3d> estimate(m.cells, Eigen::Vector3d::Zero());
   std::vector<int> count(m.cells, 0);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {

@@ -71,7 +71,7 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
 struct FaceGeometry {
   Eigen::Vector3d centre, area;
 };
-FaceGeometry face_geometry(const PolyMesh& mesh, const Face& face);
+FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& points, const Face& face);
 
 // Cell centres and volumes (m, m^3; volumes signed) as OpenFOAM computes them
 // (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres;

@@ -49,18 +49,17 @@ double free_path(const Tree& tree, const Eigen::Vector3d& p, const Eigen::Vector
 
 // Every face pyramid of a cell positive, seen from the cell's vertex mean (OpenFOAM's test).
 // Faces are oriented out of the cell; points repeated where a stack collapsed are skipped.
-bool cell_is_valid(const std::vector<Eigen::Vector3d>& x, const std::vector<std::vector<int>>& faces) {
+bool cell_is_valid(const std::vector<Eigen::Vector3d>& x, const std::vector<Face>& faces) {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   int n = 0;
-  for (const auto& f : faces)
+  for (const Face& f : faces)
     for (int v : f) centre += x[v], ++n;
   centre /= n;
-  for (const auto& f : faces) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), area = Eigen::Vector3d::Zero();
+  for (const Face& f : faces) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int v : f) mean += x[v];
     mean /= static_cast<double>(f.size());
-    for (std::size_t k = 0; k < f.size(); ++k) area += (x[f[(k + 1) % f.size()]] - x[f[k]]).cross(mean - x[f[k]]);
-    if (area.dot(mean - centre) <= 0.0) return false;
+    if (face_geometry(x, f).area.dot(mean - centre) <= 0.0) return false;
   }
   return true;
 }
@@ -70,15 +69,14 @@ bool cell_is_valid(const std::vector<Eigen::Vector3d>& x, const std::vector<std:
 // `id(v, k)` is the point of vertex v at level k; a collapsed stack has one point at every level,
 // so faces lose repeated points and faces left with fewer than 3 go.
 template <class Id>
-std::vector<std::vector<int>> layer_cell_faces(const std::array<int, 3>& t, int k, const Id& id) {
+std::vector<Face> layer_cell_faces(const std::array<int, 3>& t, int k, const Id& id) {
   const int a0 = id(t[0], k), b0 = id(t[1], k), c0 = id(t[2], k);
   const int a1 = id(t[0], k + 1), b1 = id(t[1], k + 1), c1 = id(t[2], k + 1);
-  std::vector<std::vector<int>> out;
-  for (std::vector<int> f : std::vector<std::vector<int>>{
-           {a0, b0, c0}, {a1, c1, b1}, {a0, a1, b1, b0}, {b0, b1, c1, c0}, {c0, c1, a1, a0}}) {
-    std::vector<int> g;
-    for (std::size_t i = 0; i < f.size(); ++i)
-      if (f[i] != f[(i + 1) % f.size()]) g.push_back(f[i]);
+  std::vector<Face> out;
+  for (const Face& f : {Face{a0, b0, c0}, Face{a1, c1, b1}, Face{a0, a1, b1, b0}, Face{b0, b1, c1, c0}, Face{c0, c1, a1, a0}}) {
+    Face g;
+    for (int i = 0; i < f.size(); ++i)
+      if (f[i] != f[(i + 1) % f.size()]) g.v[g.n++] = f[i];
     if (g.size() >= 3) out.push_back(g);
   }
   return out;

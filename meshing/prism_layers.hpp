@@ -15,9 +15,9 @@ namespace bedforge::meshing {
 // there is no room the stack thins: it takes at most `gap_fraction` of the gap in front of it
 // and leaves the tetrahedra at least one local surface edge of it (none where that is under
 // half of `thickness_d`: narrow gaps keep their tetrahedra), changes by at most half the
-// distance between neighbouring vertices (so side faces stay upright), and is zero on the edges the particles share with other patches (a bridge's
-// foot on a wall, a sphere cut by the inlet). Next to a stack of no height prisms collapse to
-// pyramids and tetrahedra.
+// distance between neighbouring vertices (so side faces stay upright), and is zero on the
+// edges the particles share with other patches (a bridge's foot on a wall, a sphere cut by the
+// inlet). Next to a stack of no height prisms collapse to pyramids and tetrahedra.
 struct PrismLayerParams {
   int count = 0;              // layers; 0: none
   double thickness_d = 0.02;  // total thickness of a stack with room to grow

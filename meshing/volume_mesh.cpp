@@ -4,6 +4,7 @@
 #include <gmsh.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -153,6 +154,9 @@ int load_surface(const TriangleMesh& s) {
   return volume;
 }
 
+// gmsh's element types of the cells a mesh can hold, with their numbers of points.
+constexpr std::array<std::pair<int, int>, 3> kCellTypes{{{4, 4}, {7, 5}, {6, 6}}};  // tetrahedron, pyramid, prism
+
 // The physical group of that dimension and name, or -1.
 int physical_group(int dim, const std::string& name) {
   gmsh::vectorpair groups;
@@ -204,8 +208,7 @@ void insert_layers(const PrismLayers& layers) {
     coords.insert(coords.end(), {layers.below[i].x(), layers.below[i].y(), layers.below[i].z()});
   }
   gmsh::model::mesh::addNodes(3, volume, new_tags, coords);
-  // gmsh's element types: 4 tetrahedron, 7 pyramid, 6 prism.
-  for (const auto& [points, type] : {std::pair{4, 4}, std::pair{5, 7}, std::pair{6, 6}}) {
+  for (const auto& [type, points] : kCellTypes) {
     std::vector<std::size_t> nodes;
     for (const VolumeCell& c : layers.cells)
       if (c.n == points)
@@ -240,9 +243,8 @@ PolyMesh extract_poly_mesh() {
     index.emplace(node_tags[k], static_cast<int>(k));
     points[k] = {xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
   }
-  // gmsh's element types: 4 tetrahedron, 7 pyramid, 6 prism (prism layers).
   std::vector<VolumeCell> cells;
-  for (const auto& [type, points] : {std::pair{4, 4}, std::pair{7, 5}, std::pair{6, 6}}) {
+  for (const auto& [type, points] : kCellTypes) {
     std::vector<std::size_t> element_tags, element_nodes;
     gmsh::model::mesh::getElementsByType(type, element_tags, element_nodes);
     for (std::size_t e = 0; e < element_tags.size(); ++e) {
@@ -352,6 +354,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     const auto t0 = std::chrono::steady_clock::now();
     progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), boundary.triangles.size()));
     GmshSession session;
+    auto failed = [&](const std::string& why) {
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", why}});
+      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), why);
+    };
     int tetrahedra = 0;
     try {
       gmsh::model::add("bedforge");
@@ -365,12 +371,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       gmsh::model::mesh::generate(3);
       if (layers) insert_layers(*layers);
     } catch (const std::string& e) {  // gmsh's API throws its last error message
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e}});
-      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), e);
+      failed(e);
       continue;
-    } catch (const std::runtime_error& e) {
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", e.what()}});
-      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), e.what());
+    } catch (const std::runtime_error& e) {  // the layers could not be joined
+      failed(e.what());
       continue;
     }
     const double generated_at = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -265,14 +265,16 @@ def write_report(R):
     if big:
         mean = sum(r["time_s"] for r in big) / len(big)
         met = mean < 300.0
+        slowest = max(r["time_s"] for r in big)
+        # A margin inside the timing noise is said, so a pass is not read as a safe one.
+        thin = (f"The slowest seed is only {100 * (1 - slowest / 300.0):.0f} % under 300 s, inside this machine's "
+                "run-to-run timing noise (5-10 %), so a rerun of it can land over. " if 270.0 < slowest < 300.0 else "")
         lines += ["", f"The issue's target for N = 1e5 (a about 40), under 5 minutes, is {'met' if met else 'not met'} "
                   f"on the mean of {len(big)} seeds: {mean:.0f} s ("
                   + ", ".join(f"seed {r['seed']} {r['time_s']:.0f} s" for r in big) + f"; "
                   f"{sum(1 for r in big if r['time_s'] < 300.0)} of {len(big)} under 300 s), "
                   f"{1000 * sum(r['time_s'] for r in big) / sum(r['iterations'] for r in big):.1f} ms per iteration. "
-                  + (f"The slowest seed is only {100 * (1 - slowest / 300.0):.0f} % under 300 s, inside this "
-                     "machine's run-to-run timing noise (5-10 %), so a rerun of it can land over. "
-                     if (slowest := max(r["time_s"] for r in big)) < 300.0 and slowest > 270.0 else "") +
+                  + thin +
                   "The number of iterations varies with rounding, because the settling bed creeps and the stage "
                   "ends at a chaotic moment: compaction ends on the force-residual test (rms net force under 0.2 "
                   "weights), which the agitated bed meets only in a lull after a momentum restart (N = 1e4, seed 1: "
