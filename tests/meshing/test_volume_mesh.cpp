@@ -194,13 +194,18 @@ TEST(VolumeMesh, CellsPerGapPutsThatManyCellsAcrossAGap) {
   Progress quiet("mesh", false);
   // Along the line of centres, from one sphere's surface to the other's.
   const Eigen::Vector3d from(-0.05, 0.0, 0.6), to(0.05, 0.0, 0.6);
-  const VolumeMesh plain = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, {}, {}, {}, quiet);
+  // One thread: on two, HXT's graded mesh changed from run to run and its longest piece reached
+  // 0.33 of the gap, so 1 in 6 runs failed the ratio below (0.481 against 1.5 x 0.333); on one
+  // it stays at 0.17-0.20.
+  VolumeMeshParams mp;
+  mp.threads = 1;
+  const VolumeMesh plain = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, mp, {}, {}, quiet);
   sp.cells_per_gap = 4.0;
-  const VolumeMesh graded = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, {}, {}, {}, quiet);
+  const VolumeMesh graded = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, mp, {}, {}, quiet);
   // With 4 cells per gap no cell holds more than a third of the way across (a quarter asked
   // for, gmsh's sizes within about 1.3 x); without, one cell spans about half of it.
   const double piece_plain = longest_piece_in_a_cell(plain.mesh, from, to);
   const double piece = longest_piece_in_a_cell(graded.mesh, from, to);
   EXPECT_LE(piece, 1.0 / 3.0);
-  EXPECT_GT(piece_plain, 1.5 * piece);
+  EXPECT_GT(piece_plain, 1.5 * piece) << "plain " << piece_plain << ", graded " << piece;
 }
