@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "analysis/intersection_volumes.hpp"
+#include "core/intersection_volumes.hpp"
 
 namespace bedforge::analysis {
 

@@ -4,16 +4,10 @@
 #include <cmath>
 #include <numbers>
 
-#include "analysis/intersection_volumes.hpp"
+#include "core/intersection_volumes.hpp"
 #include "core/parallel.hpp"
 
 namespace bedforge::analysis {
-
-double bed_height(const Bed& bed) {
-  double h = 0.0;
-  for (std::size_t i = 0; i < bed.size(); ++i) h = std::max(h, bed.centres[i].z() + 0.5 * bed.diameters[i]);
-  return h;
-}
 
 double void_fraction(const Bed& bed, double z1, double z2) {
   const auto solid = accumulate_bins(bed.size(), 1, [&](std::size_t i, std::vector<double>& acc) {

@@ -6,9 +6,6 @@
 
 namespace bedforge::analysis {
 
-// Height of the bed: top of its highest sphere (m).
-double bed_height(const Bed& bed);
-
 // Void fraction of the container between heights z1 < z2 (m), from exact sphere-slab volumes.
 // Overlaps between spheres (at most the packer's tolerance) are counted twice; a sphere's
 // part beyond the wall (at most the same tolerance) is counted as inside.

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <future>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -71,6 +72,52 @@ BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g
     if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
   s.void_fraction = fluid / (g.cross_section_area * (s.z_high - s.z_low));
   return s;
+}
+
+CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed) {
+  CaseGeometry g;
+  g.d_ref = sauter_mean(bed.diameters);
+  const Container& c = *bed.container;
+  g.cross_section_area = c.cross_section_area();
+  g.lateral_bounds = c.lateral_bounds();
+  g.aspect_ratio = 4.0 * g.cross_section_area / c.wall_perimeter() / g.d_ref;  // hydraulic diameter over d
+  g.inlet_z = std::numeric_limits<double>::infinity();
+  g.outlet_z = -g.inlet_z;
+  for (const auto& x : mesh.points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
+  g.bed_top = bed_height(bed);
+  return g;
+}
+
+nlohmann::json CaseInfo::to_json() const {
+  return {{"directory", directory.string()},
+          {"parameters", cases::to_json(params)},
+          {"velocity_m_s", velocity_m_s},
+          {"kinematic_viscosity_m2_s", kinematic_viscosity_m2_s},
+          {"cells", cells},
+          {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
+          {"aspect_ratio", aspect_ratio},
+          {"inlet_area_m2", inlet_area_m2},
+          {"d_ref_m", d_ref_m}};
+}
+
+nlohmann::json FlowResult::to_json() const {
+  nlohmann::json mesh = {{"mesher", snappy ? "snappyHexMesh" : "gmsh"}};
+  if (snappy_cells >= 0) mesh["cells"] = snappy_cells;
+  return {{"time_s", time_s},
+          {"solver_peak_memory_mb", solver_peak_memory_mb},
+          {"mesh", mesh},
+          {"iterations", iterations},
+          {"history", history},
+          {"converged", converged},
+          {"final_initial_residual", {{"U", residual_u}, {"p", residual_p}}},
+          {"pressure_gradient_bed_pa_m", pressure_gradient_bed_pa_m},
+          {"pressure_gradient_change_last_tenth", pressure_gradient_change_last_tenth},
+          {"pressure_drop_inlet_outlet_pa", pressure_drop_inlet_outlet_pa},
+          {"flow_rate_m3_s", flow_rate_m3_s},
+          {"flow_rate_relative_error", flow_rate_relative_error},
+          {"eisfeld_schnitzlein_pa_m", eisfeld_schnitzlein_pa_m},
+          {"ratio_to_eisfeld_schnitzlein", ratio_to_eisfeld_schnitzlein},
+          {"void_fraction_section", void_fraction_section}};
 }
 
 namespace {
@@ -179,9 +226,9 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
     throw InputError(fmt::format("{} exists; remove it or pass --overwrite", case_dir.string()));
 }
 
-nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
-                          const CaseGeometry& g, const CaseParams& p, const std::string& note,
-                          const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl) {
+CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh, const CaseGeometry& g,
+                    const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                    const std::string& bed_csv, const std::string& fluid_stl) {
   refuse_existing_case(case_dir, overwrite);
   std::random_device rd;
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
@@ -332,15 +379,7 @@ nlohmann::json write_case(const fs::path& case_dir, bool overwrite, const meshin
     fs::remove_all(tmp, ec);
     throw;
   }
-  return {{"directory", case_dir.string()},
-          {"parameters", to_json(p)},
-          {"velocity_m_s", u},
-          {"kinematic_viscosity_m2_s", nu},
-          {"cells", mesh.cells},
-          {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
-          {"aspect_ratio", g.aspect_ratio},
-          {"inlet_area_m2", g.cross_section_area},
-          {"d_ref_m", g.d_ref}};
+  return {case_dir, p, u, nu, static_cast<long>(mesh.cells), section, g.aspect_ratio, g.cross_section_area, g.d_ref};
 }
 
 namespace {
@@ -408,17 +447,18 @@ Iteration last_iteration(const fs::path& log_path) {
 
 }  // namespace
 
-nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progress& progress) {
+FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  const int np = c["parameters"]["processors"].get<int>();
-  const bool snappy = c["parameters"]["run_mesh"].get<std::string>() == "snappy";
+  const fs::path& case_dir = c.directory;
+  const int np = c.params.processors;
+  const bool snappy = c.params.run_snappy;
   const std::string cmd = fmt::format("'{}/Allrun' -np {}{} > '{}/log.Allrun' 2>&1", case_dir.string(), np,
                                       snappy ? " -snappy" : "", case_dir.string());
   // Allrun in the background; meanwhile the solver's log tells how far it is (log.mpirun while a
   // parallel run lasts). The ETA assumes the residuals keep falling geometrically to their
   // targets, and follows the one furthest from its target.
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
-  const double target_p = c["parameters"]["residual_p"].get<double>(), target_u = c["parameters"]["residual_u"].get<double>();
+  const double target_p = c.params.residual_p, target_u = c.params.residual_u;
   double start_p = 0.0, start_u = 0.0;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     Iteration now = last_iteration(case_dir / "log.simpleFoam");
@@ -446,11 +486,8 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
   if (its.empty()) throw std::runtime_error(fmt::format("{}/log.simpleFoam holds no iteration", case_dir.string()));
   const long iterations = static_cast<long>(its.size());
   const double res_u = its.back().res_u, res_p = its.back().res_p;
-  const double rho = c["parameters"]["density_kg_m3"].get<double>(), u = c["velocity_m_s"].get<double>();
-  const double d = c["d_ref_m"].get<double>(), a = c["aspect_ratio"].get<double>();
-  const double zl = c["section"]["z_low_m"].get<double>(), zh = c["section"]["z_high_m"].get<double>();
-  const double eps = c["section"]["void_fraction_mesh"].get<double>();
-  const double re = c["parameters"]["reynolds"].get<double>();
+  const double rho = c.params.density_kg_m3, u = c.velocity_m_s, d = c.d_ref_m, a = c.aspect_ratio;
+  const double zl = c.section.z_low, zh = c.section.z_high, eps = c.section.void_fraction, re = c.params.reynolds;
   const std::vector<double> bottom = series(case_dir, "pBedBottom"), top = series(case_dir, "pBedTop");
   const std::size_t n = std::min(bottom.size(), top.size());
   auto bed_gradient = [&](std::size_t k) { return rho * (bottom[k] - top[k]) / (zh - zl); };
@@ -460,11 +497,12 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
   const double overall = rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
   const double es = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps, a), eps, rho, u, d);
   const double flow = series(case_dir, "flowRate").back();
-  nlohmann::json mesh = {{"mesher", snappy ? "snappyHexMesh" : "gmsh"}};
+  FlowResult r;
+  r.snappy = snappy;
   if (snappy) {  // the cells snappyHexMesh made, as its checkMesh counted them
     std::ifstream check(case_dir / "log.checkMesh");
     for (std::string line; std::getline(check, line);)
-      if (const auto at = line.find("cells:"); at != std::string::npos) mesh["cells"] = std::atol(line.c_str() + at + 6);
+      if (const auto at = line.find("cells:"); at != std::string::npos) r.snappy_cells = std::atol(line.c_str() + at + 6);
   }
   // Convergence history: the residuals and the bed's pressure gradient against the solver's time.
   nlohmann::json history = nlohmann::json::array();
@@ -474,21 +512,22 @@ nlohmann::json run_case(const fs::path& case_dir, const nlohmann::json& c, Progr
     if (k < n) point["pressure_gradient_bed_pa_m"] = bed_gradient(k);
     history.push_back(std::move(point));
   }
-  return {{"time_s", time},
-          {"solver_peak_memory_mb", children_peak_memory_mb()},
-          {"mesh", mesh},
-          {"iterations", iterations},
-          {"history", thin_history(history)},
-          {"converged", converged},
-          {"final_initial_residual", {{"U", res_u}, {"p", res_p}}},
-          {"pressure_gradient_bed_pa_m", gradient},
-          {"pressure_gradient_change_last_tenth", change},
-          {"pressure_drop_inlet_outlet_pa", overall},
-          {"flow_rate_m3_s", flow},
-          {"flow_rate_relative_error", flow / (u * c["inlet_area_m2"].get<double>()) - 1.0},
-          {"eisfeld_schnitzlein_pa_m", es},
-          {"ratio_to_eisfeld_schnitzlein", gradient / es},
-          {"void_fraction_section", eps}};
+  r.time_s = time;
+  r.solver_peak_memory_mb = children_peak_memory_mb();
+  r.iterations = iterations;
+  r.history = thin_history(history);
+  r.converged = converged;
+  r.residual_u = res_u;
+  r.residual_p = res_p;
+  r.pressure_gradient_bed_pa_m = gradient;
+  r.pressure_gradient_change_last_tenth = change;
+  r.pressure_drop_inlet_outlet_pa = overall;
+  r.flow_rate_m3_s = flow;
+  r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;
+  r.eisfeld_schnitzlein_pa_m = es;
+  r.ratio_to_eisfeld_schnitzlein = gradient / es;
+  r.void_fraction_section = eps;
+  return r;
 }
 
 }  // namespace bedforge::cases

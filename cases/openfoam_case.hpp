@@ -5,8 +5,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/bed.hpp"
 #include "core/progress.hpp"
 #include "core/scene_section.hpp"
+#include "meshing/cell_quality.hpp"
 #include "meshing/poly_mesh.hpp"
 
 namespace bedforge::cases {
@@ -48,6 +50,10 @@ struct CaseGeometry {
   double inlet_z = 0.0, outlet_z = 0.0, bed_top = 0.0;
 };
 
+// The case geometry of a bed (m) and the mesh of its fluid domain: the inlet and outlet are the
+// mesh's lowest and highest points, the rest comes from the bed's container and spheres.
+CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed);
+
 // Bed section over which the pressure drop is measured: its planes and its void fraction as
 // meshed (cells with their centre between the planes over the container's volume between them),
 // from the mesh's cell geometry.
@@ -60,19 +66,53 @@ BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g
 // callers check first to refuse before the long stages).
 void refuse_existing_case(const std::filesystem::path& case_dir, bool overwrite);
 
-// Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
-// an existing case is replaced (only with `overwrite`) once the new one is complete: constant/polyMesh, 0/U, 0/p, transport and turbulence
-// properties, controlDict with pressure and flow function objects, fvSchemes, fvSolution,
-// decomposeParDict, Allrun, Allclean, and the records `bedforge/scene.toml` and
-// `bedforge/bed.csv`. Returns the case's report entry.
-nlohmann::json write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
-                          const CaseGeometry& g, const CaseParams& p, const std::string& note,
-                          const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl);
+// A case as written: what running it and comparing its pressure drop need.
+struct CaseInfo {
+  std::filesystem::path directory;
+  CaseParams params;
+  double velocity_m_s = 0.0;             // superficial inlet velocity
+  double kinematic_viscosity_m2_s = 0.0;
+  long cells = 0;
+  BedSection section;                    // where the pressure drop is measured
+  double aspect_ratio = 0.0;             // D_h / d, for the correlation
+  double inlet_area_m2 = 0.0;
+  double d_ref_m = 0.0;
+  nlohmann::json to_json() const;        // its report.json entry
+};
 
-// Runs `case_dir/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and reads
-// back the solver's convergence and the pressure drop, compared with Eisfeld & Schnitzlein at
-// the section's own void fraction. Shows the solver's iteration on `progress` while it runs.
-// std::runtime_error naming the log when the solver fails.
-nlohmann::json run_case(const std::filesystem::path& case_dir, const nlohmann::json& case_report, Progress& progress);
+// Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
+// an existing case is replaced (only with `overwrite`) once the new one is complete:
+// constant/polyMesh, 0/U, 0/p, transport and turbulence properties, controlDict with pressure
+// and flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, and the
+// records `bedforge/scene.toml` and `bedforge/bed.csv`.
+CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
+                    const CaseGeometry& g, const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                    const std::string& bed_csv, const std::string& fluid_stl);
+
+// The flow solved in a case: the solver's convergence and the bed's pressure gradient.
+struct FlowResult {
+  double time_s = 0.0;                   // wall time of Allrun
+  double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
+  bool snappy = false;                   // solved on snappyHexMesh's mesh instead of gmsh's
+  long snappy_cells = -1;                // its cells as checkMesh counted them (-1: not found)
+  long iterations = 0;
+  bool converged = false;                // SIMPLE's own verdict at the residual targets
+  double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
+  double pressure_gradient_bed_pa_m = 0.0;    // over the bed section
+  double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
+  double pressure_drop_inlet_outlet_pa = 0.0;
+  double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
+  double eisfeld_schnitzlein_pa_m = 0.0;      // the correlation at the section's void fraction
+  double ratio_to_eisfeld_schnitzlein = 0.0;
+  double void_fraction_section = 0.0;
+  nlohmann::json history;                // per iteration: residuals and the bed's gradient against time
+  nlohmann::json to_json() const;        // the case entry's "flow"
+};
+
+// Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
+// reads back the solver's convergence and the pressure drop, compared with Eisfeld &
+// Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
+// while it runs. std::runtime_error naming the log when the solver fails.
+FlowResult run_case(const CaseInfo& c, Progress& progress);
 
 }  // namespace bedforge::cases

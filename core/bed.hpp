@@ -1,6 +1,7 @@
 #pragma once
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -23,6 +24,13 @@ inline double sauter_mean(const std::vector<double>& diameters) {
   double s3 = 0.0, s2 = 0.0;
   for (double d : diameters) s3 += d * d * d, s2 += d * d;
   return s2 > 0.0 ? s3 / s2 : 0.0;
+}
+
+// Height of the bed: the top of its highest sphere (m); 0 for an empty bed.
+inline double bed_height(const Bed& bed) {
+  double h = 0.0;
+  for (std::size_t i = 0; i < bed.size(); ++i) h = std::max(h, bed.centres[i].z() + 0.5 * bed.diameters[i]);
+  return h;
 }
 
 }  // namespace bedforge

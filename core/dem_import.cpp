@@ -81,6 +81,15 @@ BedFileFormat bed_file_format(const std::string& name) {
   throw InputError(fmt::format("bed file format '{}'; allowed: xyzd, lammps-dump (also LIGGGHTS), yade", name));
 }
 
+const char* bed_file_format_name(BedFileFormat format) {
+  switch (format) {
+    case BedFileFormat::lammps_dump: return "lammps-dump";
+    case BedFileFormat::yade: return "yade";
+    case BedFileFormat::xyzd: break;
+  }
+  return "xyzd";
+}
+
 ImportedBed read_lammps_dump(const std::filesystem::path& path, double to_metres) {
   const Lines lines(path);
   const RowReader rows(path);

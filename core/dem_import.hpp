@@ -30,6 +30,7 @@ namespace bedforge {
 // InputError names the file, the line and what was expected.
 enum class BedFileFormat { xyzd, lammps_dump, yade };
 BedFileFormat bed_file_format(const std::string& name);  // "xyzd" | "lammps-dump" | "yade"
+const char* bed_file_format_name(BedFileFormat format);
 ImportedBed read_bed_file(const std::filesystem::path& path, BedFileFormat format, double to_metres,
                           const Eigen::Vector3d& origin_m = Eigen::Vector3d::Zero());
 

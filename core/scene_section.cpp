@@ -53,7 +53,12 @@ std::string join(const std::vector<std::string>& v) {
 
 }  // namespace
 
-SceneSection::SceneSection(const toml::table* table, std::string name) : table_(table), name_(std::move(name)) {}
+SceneSection::SceneSection(const toml::table* table, std::string name, SceneSchema* schema)
+    : table_(table), name_(std::move(name)), schema_(schema) {}
+
+void SceneSection::record(const std::string& key, KeySpec spec) const {
+  if (schema_) schema_->try_emplace(key_path(key), std::move(spec));
+}
 
 bool SceneSection::has(const std::string& key) const { return table_ && table_->contains(key); }
 
@@ -66,11 +71,14 @@ void SceneSection::fail(const std::string& key, const std::string& found, const 
   throw InputError(fmt::format("{}: got {}; allowed: {}", key_path(key), found, allowed));
 }
 
-double SceneSection::number(const std::string& key, double fallback, Range range) {
-  return optional_number(key, range).value_or(fallback);
+double SceneSection::number(const std::string& key, double fallback, Range range, const std::string& fallback_text) {
+  return optional_number(key, range, fallback_text.empty() ? fmt::format("{}", fallback) : fallback_text)
+      .value_or(fallback);
 }
 
-std::optional<double> SceneSection::optional_number(const std::string& key, Range range) {
+std::optional<double> SceneSection::optional_number(const std::string& key, Range range,
+                                                    const std::string& fallback_text) {
+  record(key, {"FLOAT", range.describe(), fallback_text});
   const toml::node* node = get(key);
   if (!node) return std::nullopt;
   auto v = as_number(*node);
@@ -79,10 +87,12 @@ std::optional<double> SceneSection::optional_number(const std::string& key, Rang
   return v;
 }
 
-long long SceneSection::integer(const std::string& key, long long fallback, long long min, long long max) {
+long long SceneSection::integer(const std::string& key, long long fallback, long long min, long long max,
+                                const std::string& fallback_text) {
+  const std::string allowed = fmt::format("an integer in [{}, {}]", min, max);
+  record(key, {"INT", allowed, fallback_text.empty() ? std::to_string(fallback) : fallback_text});
   const toml::node* node = get(key);
   if (!node) return fallback;
-  const std::string allowed = fmt::format("an integer in [{}, {}]", min, max);
   auto i = node->as_integer();
   if (!i) fail(key, show(*node), allowed);
   if (i->get() < min || i->get() > max) fail(key, show(*node), allowed);
@@ -90,6 +100,7 @@ long long SceneSection::integer(const std::string& key, long long fallback, long
 }
 
 bool SceneSection::boolean(const std::string& key, bool fallback) {
+  record(key, {"BOOL", "true or false", fallback ? "true" : "false"});
   const toml::node* node = get(key);
   if (!node) return fallback;
   auto b = node->as_boolean();
@@ -99,6 +110,7 @@ bool SceneSection::boolean(const std::string& key, bool fallback) {
 
 std::string SceneSection::choice(const std::string& key, const std::string& fallback,
                                  const std::vector<std::string>& allowed) {
+  record(key, {"STRING", "one of " + join(allowed), fallback});
   const toml::node* node = get(key);
   if (!node) return fallback;
   auto s = node->as_string();
@@ -109,6 +121,7 @@ std::string SceneSection::choice(const std::string& key, const std::string& fall
 }
 
 std::vector<double> SceneSection::numbers(const std::string& key, Range range) {
+  record(key, {"FLOAT...", "numbers, each " + range.describe(), "none"});
   const toml::node* node = get(key);
   if (!node) return {};
   auto arr = node->as_array();
@@ -125,6 +138,9 @@ std::vector<double> SceneSection::numbers(const std::string& key, Range range) {
 
 std::vector<std::string> SceneSection::strings(const std::string& key, const std::vector<std::string>& fallback,
                                                const std::vector<std::string>& allowed) {
+  std::string fallback_text;
+  for (const auto& f : fallback) fallback_text += (fallback_text.empty() ? "" : " ") + f;
+  record(key, {"STRING...", "any of " + join(allowed), fallback_text});
   const toml::node* node = get(key);
   if (!node) return fallback;
   auto arr = node->as_array();
@@ -144,6 +160,7 @@ std::vector<std::string> SceneSection::strings(const std::string& key, const std
 }
 
 std::optional<std::string> SceneSection::optional_string(const std::string& key) {
+  record(key, {"STRING", "a string", "none"});
   const toml::node* node = get(key);
   if (!node) return std::nullopt;
   auto s = node->as_string();
@@ -151,27 +168,33 @@ std::optional<std::string> SceneSection::optional_string(const std::string& key)
   return s->get();
 }
 
-std::optional<Length> SceneSection::optional_length(const std::string& name, Range range) {
+std::optional<Length> SceneSection::optional_length(const std::string& name, Range range,
+                                                   const std::optional<Length>& fallback) {
   const bool in_m = has(name + "_m"), in_d = has(name + "_d");
   if (in_m && in_d)
     throw InputError(fmt::format("{0}_m and {0}_d are both given; give the length once, in metres (_m) or in "
                                  "particle diameters (_d)",
                                  key_path(name)));
-  auto m = optional_number(name + "_m", range);
-  auto d = optional_number(name + "_d", range);
+  auto fallback_in = [&](Length::Unit unit) {
+    if (!fallback) return std::string("none");
+    return fallback->unit == unit ? fmt::format("{}", fallback->value)
+                                  : fmt::format("none ({}_{} is)", name, unit == Length::Unit::metres ? "d" : "m");
+  };
+  auto m = optional_number(name + "_m", range, fallback_in(Length::Unit::metres));
+  auto d = optional_number(name + "_d", range, fallback_in(Length::Unit::diameters));
   if (m) return Length{*m, Length::Unit::metres};
   if (d) return Length{*d, Length::Unit::diameters};
   return std::nullopt;
 }
 
 Length SceneSection::length(const std::string& name, Length fallback, Range range) {
-  return optional_length(name, range).value_or(fallback);
+  return optional_length(name, range, fallback).value_or(fallback);
 }
 
 SceneSection SceneSection::sub(const std::string& key) {
   const toml::node* node = get(key);
   if (node && !node->is_table()) fail(key, show(*node), "a table");
-  return SceneSection(node ? node->as_table() : nullptr, key_path(key));
+  return SceneSection(node ? node->as_table() : nullptr, key_path(key), schema_);
 }
 
 void SceneSection::finish() const {

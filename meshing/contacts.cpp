@@ -10,8 +10,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "analysis/intersection_volumes.hpp"
-#include "analysis/quadrature.hpp"
+#include "core/intersection_volumes.hpp"
+#include "core/quadrature.hpp"
 #include "core/error.hpp"
 #include "core/neighbour_list.hpp"
 
@@ -506,7 +506,7 @@ class Treater {
     for (int j = 0; j < kAngles; ++j) {
       const double th = 2.0 * kPi * j / kAngles, cs = std::cos(th), sn = std::sin(th);
       lateral += length(rb * cs, rb * sn) * rb * 2.0 * kPi / kAngles;
-      vol += analysis::integrate_pieces({0.0, rb}, [&](double s) { return length(s * cs, s * sn) * s; }) * 2.0 * kPi /
+      vol += integrate_pieces({0.0, rb}, [&](double s) { return length(s * cs, s * sn) * s; }) * 2.0 * kPi /
              kAngles;
     }
     volume_ += vol;
@@ -556,7 +556,7 @@ class Treater {
     add_cut(i, std::move(cut), "union with the " + w.name, beta_max);
     open_hole(i, holes, -w.towards(out_.cuts[i].back().loop[0]));
     const double rho = std::hypot(c.x(), c.y());
-    const double inside = analysis::sphere_cylinder_volume(r, rho, c.z(), w.R, c.z() - r, c.z() + r);
+    const double inside = sphere_cylinder_volume(r, rho, c.z(), w.R, c.z() - r, c.z() + r);
     volume_ -= w.inner ? inside : 4.0 / 3.0 * kPi * r * r * r - inside;
     area_ -= removed_area;
   }

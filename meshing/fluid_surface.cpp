@@ -5,17 +5,21 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <numbers>
 #include <optional>
 #include <tuple>
 
-#include "analysis/void_fraction.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/version.hpp"
+#include "meshing/defect_locations.hpp"
 #include "meshing/contacts.hpp"
 #include "meshing/gap_spacing.hpp"
 #include "meshing/primitives.hpp"
+#include "meshing/vtp_io.hpp"
 #include "meshing/wall_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -128,7 +132,7 @@ std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>&
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
   const double d = sauter_mean(bed.diameters), edge = p.edge_length_d * d;
-  const double top = analysis::bed_height(bed);
+  const double top = bed_height(bed);
   DomainPlanes planes{-p.inlet_length_d * d, top + p.outlet_length_d * d, p.clip};
   if (p.clip) planes.z0 = p.clip_bottom_d * d, planes.z1 = p.clip_top_d * d;
   TreatedBed tb = treat_contacts(bed, p, planes);
@@ -253,7 +257,8 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.report = tb.report;
   out.report["parameters"] = to_json(p);
   out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
-  out.report["fluid_volume_exact_m3"] = domain - tb.solid_volume;
+  out.exact_volume_m3 = domain - tb.solid_volume;
+  out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
   out.report["void_fraction_bed_section_change"] =
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
   out.report["chordal_deviation_d"] = *std::max_element(chordal.begin(), chordal.end()) / d;
@@ -263,6 +268,46 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.report["min_edge_d"] = q.min_edge / d;
   out.report["max_edge_d"] = q.max_edge / d;
   return out;
+}
+
+FluidSurface build_checked_fluid_surface(const Bed& bed, const SurfaceParams& p,
+                                         const std::filesystem::path& bad_triangles_path) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto since = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  FluidSurface fs = build_fluid_surface(bed, p);
+  const double built_at = since();
+  fs.check = check_surface(fs.fluid, p.self_intersection_limit);
+  nlohmann::json& j = fs.report;
+  j["time_build_s"] = built_at;
+  j["time_check_s"] = since() - built_at;
+  j["check"] = fs.check.to_json();
+  j["fluid_volume_mesh_m3"] = fs.check.volume;
+  if (!fs.check.manifold || !fs.check.closed || fs.check.self_intersecting)
+    throw std::runtime_error(fmt::format("the fluid surface is not valid ({}); {} defective edges, first at{} please "
+                                         "report it with the bed",
+                                         fs.check.to_json().dump(), fs.check.defects.size(),
+                                         describe_defects(fs.check)));
+  j["fluid_volume_relative_error"] = (fs.check.volume - fs.exact_volume_m3) / fs.exact_volume_m3;
+  const double min_angle = j["min_angle_deg"].get<double>();
+  if (min_angle < p.min_angle_deg) {
+    // Say where the needles and slivers are: the nearest particle to each, and all of them in a
+    // file for ParaView.
+    const TriangleMesh bad = triangles_below_angle(fs.fluid, p.min_angle_deg);
+    std::vector<Eigen::Vector3d> centroids;
+    for (std::size_t v = 0; v < bad.points.size(); v += 3)
+      centroids.push_back((bad.points[v] + bad.points[v + 1] + bad.points[v + 2]) / 3.0);
+    const DefectLocations where = locate_defects(bed, centroids, "triangles");
+    write_file_atomically(bad_triangles_path, [&](std::ostream& out) {
+      write_vtp(out, bad,
+                "bedforge " + std::string(kVersion) + " surface triangles below surface.min_angle_deg, lengths in m");
+    });
+    throw ConvergenceError(fmt::format(
+        "surface: {} triangles have an angle below surface.min_angle_deg = {} deg (smallest {:.2f} deg), most near {}; "
+        "written to {}. Refine where contacts meet (surface.contact_edge_length_d), widen the gaps ([contacts]), "
+        "move the clip window, or lower surface.min_angle_deg",
+        bad.triangles.size(), p.min_angle_deg, min_angle, where.summary, bad_triangles_path.string()));
+  }
+  return fs;
 }
 
 }  // namespace bedforge::meshing

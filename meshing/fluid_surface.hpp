@@ -1,8 +1,10 @@
 #pragma once
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/bed.hpp"
 #include "core/scene_section.hpp"
+#include "meshing/surface_checks.hpp"
 #include "meshing/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -49,6 +51,8 @@ nlohmann::json to_json(const SurfaceParams& p);
 struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)
   TriangleMesh bed;    // the closed treated particles, normals outward (m)
+  double exact_volume_m3 = 0.0;  // of the treated geometry's fluid domain, what the facets approximate
+  SurfaceCheck check;            // CGAL's verdict on `fluid` (build_checked_fluid_surface only)
   nlohmann::json report;
 };
 
@@ -59,5 +63,14 @@ struct FluidSurface {
 // treated, solid volume and area change, smallest gap) and the surface's accuracy (chordal
 // deviation, exact fluid volume, triangle quality).
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& params);
+
+// The surface stage: build_fluid_surface, then CGAL's check (closed, 2-manifold, no
+// self-intersection below params.self_intersection_limit triangles, the enclosed volume against
+// the exact one, all into the report) and the angle gate. std::runtime_error locating the defects
+// when the surface is not valid (a defect of ours, not of the input); ConvergenceError naming the
+// particles nearest the triangles below params.min_angle_deg, after writing those triangles to
+// `bad_triangles_path` (VTK PolyData).
+FluidSurface build_checked_fluid_surface(const Bed& bed, const SurfaceParams& params,
+                                         const std::filesystem::path& bad_triangles_path);
 
 }  // namespace bedforge::meshing

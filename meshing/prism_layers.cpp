@@ -158,13 +158,8 @@ PrismLayers build_prism_layers(const TriangleMesh& surface, double d_ref, const 
 
   // Room: at most `gap_fraction` of the free path ahead, and the tetrahedra keep at least one
   // local edge of it (a stack may face another one); a stack with room for less than half the
-  // target goes. Measured on a = 5, N = 500, bridges, surface edge 0.2 d, 3 layers of 0.02 d
-  // (2026-11-22): with the fraction alone, 8838 faces past 70 degrees of non-orthogonality
-  // (8309 between tetrahedra in the narrowed gaps; 11 without layers) and simpleFoam did not
-  // converge; keeping one edge, 1087, with stacks on 44 400 of 116 342 particle vertices. On
-  // touching spheres shrunk 1 % (a = 3.2, target 0.02 d), a fraction of 0.3 and a quarter of the
-  // target left cells beside the contacts at 85.6 degrees, failing the gate the mesh without
-  // layers passes; 0.2 and half gave 75.
+  // target goes. Without these rules the tetrahedra in narrowed gaps failed the gate or stopped
+  // the solver (measurements: docs/defaults.md).
   Triangles soup;
   soup.reserve(surface.triangles.size());
   for (const auto& t : surface.triangles)

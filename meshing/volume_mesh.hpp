@@ -51,7 +51,4 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress);
 
-// A volume mesh written by build_volume_mesh, read back (for `bedforge case DIR`).
-PolyMesh read_msh(const std::filesystem::path& msh_path);
-
 }  // namespace bedforge::meshing

@@ -41,7 +41,8 @@ MonteCarloParams read_monte_carlo_params(SceneSection& s) {
   p.initial_void_fraction = s.number("initial_void_fraction", p.initial_void_fraction, Range{0.7, 1.0, false, true});
   p.mixing_height_d = s.optional_number("mixing_height_d", positive);
   p.mixing_cycles = s.integer("mixing_cycles", p.mixing_cycles, 0, 1'000'000'000);
-  if (s.has("shakes")) p.shakes = s.integer("shakes", 0, 0, 1'000'000);
+  const long long shakes = s.integer("shakes", -1, 0, 1'000'000, "10 for equal spheres, 100 for mixtures");
+  if (shakes >= 0) p.shakes = shakes;
   p.shake_amplitude_d = s.number("shake_amplitude_d", p.shake_amplitude_d, Range::non_negative());
   p.shake_dilation = s.number("shake_dilation", p.shake_dilation, Range::closed(0.0, 100.0));
   p.settle_block_cycles = s.integer("settle_block_cycles", p.settle_block_cycles, 1, 1'000'000);
@@ -247,6 +248,10 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
               {"history", thin_history(history)},
               {"max_overlap_d", std::max(0.0, worst) / d_min},
               {"time_s", time}};
+  out.summary = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {} "
+                            "of {} shakes settled, no overlap",
+                            x.size(), container.kind(), cycles, out.info["cycles_per_second"].get<double>(),
+                            out.info["mean_acceptance"].get<double>(), shakes.size() - unsettled, shakes.size());
   return out;
 }
 

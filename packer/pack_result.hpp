@@ -1,5 +1,6 @@
 #pragma once
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "core/bed.hpp"
 
@@ -9,6 +10,7 @@ namespace bedforge::packer {
 struct PackResult {
   Bed bed;              // metres
   nlohmann::json info;  // the packer's report: parameters, effort, time, accuracy, history
+  std::string summary;  // one line: the algorithm, its effort and accuracy
 };
 
 }  // namespace bedforge::packer

@@ -28,7 +28,8 @@ SoftSphereParams read_soft_sphere_params(SceneSection& s) {
   p.mass_centre_samples = static_cast<int>(s.integer("mass_centre_samples", p.mass_centre_samples, 2, 10'000));
   p.mass_centre_tolerance = s.number("mass_centre_tolerance", p.mass_centre_tolerance, positive);
   p.force_tolerance = s.number("force_tolerance", p.force_tolerance, positive);
-  p.final_momentum_bound = s.number("final_momentum_bound", p.final_momentum_bound, Range::non_negative());
+  p.final_momentum_bound = s.number("final_momentum_bound", p.final_momentum_bound, Range::non_negative(),
+                                    "100 at the default tolerance, x 1e-4 d / tolerance below it");
   if (p.final_momentum_bound > 0.0 && p.final_momentum_bound < 1.0)
     throw InputError(fmt::format("{}: final_momentum_bound = {} is not allowed; allowed: 0 (no bound) or >= 1 "
                                  "(Nesterov's t starts at 1)",
@@ -134,6 +135,11 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
               {"force_residual_rms", res_rms},
               {"force_residual_max", res_max},
               {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
+  out.summary = fmt::format("pack (soft-sphere {}): {} spheres, {} iterations, max overlap {:.2g} d (tol {:.2g}), "
+                            "residual {:.2g}",
+                            params.mode == SoftSphereParams::Mode::faithful ? "faithful" : "accelerated", s.size(),
+                            run["iterations"].get<long>(), con.max_pair_overlap / p.d_min, params.overlap_tolerance_d,
+                            res_rms);
   return out;
 }
 

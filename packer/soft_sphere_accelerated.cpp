@@ -174,16 +174,9 @@ nlohmann::json run_accelerated(Spheres& s, const Container& container, const Sof
   }
 
   // Final: stiffen so both overlaps fall below half the tolerance, settle, check. Restarts are
-  // rare here (a handful per run: the global test sums over the whole bed, where some region
-  // is always still going downhill), so unbounded momentum leaves the slow modes undamped and
-  // the force residual rises and falls with a period of thousands of iterations, longer the
-  // larger the bed. A bound on t damps them (beta <= 1 - 1.5 / bound): measured on 2026-11-22,
-  // 100 cut the final stage of a 1e5-sphere bed from 21400 to 7400 iterations and of 1e4 from
-  // 15800 and 11000 to 5600 and 5700, and cost 1e3-2e3 spheres about 1000 (docs/validation.md).
-  // The bound is set for the default tolerance, 1e-4 d. A tighter tolerance stiffens the final
-  // stage in proportion, so gravity moves the spheres that much less per iteration and the
-  // momentum must persist as much longer: at 1e-5 d a bound of 100 doubled the iterations and
-  // 1000 matched the unbounded run. Looser tolerances keep 100 (at 1e-3 d, 10 doubled them).
+  // rare here, so unbounded momentum leaves the slow modes undamped; a bound on t damps them
+  // (beta <= 1 - 1.5 / bound), scaled up for tolerances tighter than the default because a
+  // stiffer stage needs the momentum to persist longer (measurements: docs/defaults.md).
   const double bound = p.given.final_momentum_bound *
                        std::max(1.0, SoftSphereParams{}.overlap_tolerance_d / p.given.overlap_tolerance_d);
   log.begin_stage("final");

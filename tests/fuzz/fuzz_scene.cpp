@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "app/scene.hpp"
+#include "pipeline/scene.hpp"
 #include "core/error.hpp"
 #include "core/scene_section.hpp"
 
@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     // Relative packing.file names resolve into an empty folder: imports fail by name.
-    bedforge::read_scene(bedforge::parse_scene_text(text, "fuzz.toml"), "fuzz.toml",
+    bedforge::pipeline::read_scene(bedforge::parse_scene_text(text, "fuzz.toml"), "fuzz.toml",
                          std::filesystem::temp_directory_path() / "bedforge_fuzz_empty");
   } catch (const bedforge::InputError&) {
   }

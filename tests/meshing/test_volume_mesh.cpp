@@ -1,6 +1,7 @@
 // gmsh volume meshes of small beds: the cells fill exactly the surface they were made from,
 // every patch keeps its triangles, and a mesh failing the gate is located and written out.
 #include "meshing/volume_mesh.hpp"
+#include "meshing/gmsh_model.hpp"
 
 #include <gtest/gtest.h>
 

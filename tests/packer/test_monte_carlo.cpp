@@ -51,7 +51,7 @@ TEST(MonteCarlo, SettledCylinderBedIsValidAndDense) {
   expect_valid(r.bed);
   // Below its rough top (2 d) the settled bed lies between random close packing (0.36) and
   // loose random packing at a = 5 (Zou & Yu, loose: 0.475); it fell from a void fraction of 0.88.
-  const double eps = analysis::void_fraction(r.bed, 0.0, analysis::bed_height(r.bed) - 0.002);
+  const double eps = analysis::void_fraction(r.bed, 0.0, bed_height(r.bed) - 0.002);
   EXPECT_GT(eps, 0.36);
   EXPECT_LT(eps, 0.475);
   for (const auto& s : r.info["shakes"]) EXPECT_TRUE(s["settled"].get<bool>());
@@ -147,7 +147,7 @@ TEST(MonteCarlo, ShakenBinaryMixtureSegregatesLargeOnTop) {
     p.shakes = shakes;
     const auto r = packer::pack_monte_carlo(p, mixture, c, 400, 2, quiet);
     expect_valid(r.bed);
-    return analysis::axial_segregation(r.bed, 0.0012, analysis::bed_height(r.bed));
+    return analysis::axial_segregation(r.bed, 0.0012, bed_height(r.bed));
   };
   const auto fallen = segregation_after(1);  // the first shake's settling is the fall
   const auto shaken = segregation_after(40);

@@ -1,6 +1,6 @@
-#include "analysis/intersection_volumes.hpp"
+#include "core/intersection_volumes.hpp"
 
-#include "analysis/quadrature.hpp"
+#include "core/quadrature.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +8,7 @@
 #include <numbers>
 #include <vector>
 
-namespace bedforge::analysis {
+namespace bedforge {
 
 namespace {
 
@@ -82,4 +82,4 @@ double sphere_halfspace_volume(double r, double xc, double zc, double x_max, dou
   });
 }
 
-}  // namespace bedforge::analysis
+}  // namespace bedforge

@@ -1,4 +1,4 @@
-#include "app/scene.hpp"
+#include "pipeline/scene.hpp"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include "core/bed_io.hpp"
 #include "core/error.hpp"
 
-namespace bedforge {
+namespace bedforge::pipeline {
 
 namespace {
 
@@ -38,11 +38,14 @@ nlohmann::json Scene::to_json() const {
   return nlohmann::json::parse(s.str());
 }
 
-Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir) {
+namespace {
+
+Scene read_scene_into(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir,
+                      SceneSchema* schema) {
   Scene sc;
   sc.table = table;
   sc.source = source;
-  SceneSection root(&table, "");  // top level: keys are named from their section down
+  SceneSection root(&table, "", schema);  // top level: keys are named from their section down
   for (const auto& [k, v] : table) {
     const std::string key(k.str());
     if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
@@ -64,16 +67,16 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   double d_ref = 0.0, d_max = 0.0;
   SceneSection particles = root.sub("particles");
   if (sc.algorithm == "import") {
-    const auto file = packing.optional_string("file");
-    if (!file)
-      throw InputError("packing.file is required when packing.algorithm = \"import\": a bed file (see packing.format)");
-    sc.import.file = std::filesystem::path(*file).is_relative() ? base_dir / *file : std::filesystem::path(*file);
     sc.import.format = bed_file_format(packing.choice("format", "xyzd", {"xyzd", "lammps-dump", "yade"}));
     sc.import.to_metres = unit_to_metres(packing.choice("units", "m", {"m", "cm", "mm", "um"}));
     const std::vector<double> origin = packing.numbers("origin_m", Range{});
     if (!origin.empty() && origin.size() != 3)
       throw InputError(fmt::format("packing.origin_m has {} values; allowed: [x, y, z] in metres", origin.size()));
     if (origin.size() == 3) sc.import.origin_m = {origin[0], origin[1], origin[2]};
+    const auto file = packing.optional_string("file");
+    if (!file)
+      throw InputError("packing.file is required when packing.algorithm = \"import\": a bed file (see packing.format)");
+    sc.import.file = std::filesystem::path(*file).is_relative() ? base_dir / *file : std::filesystem::path(*file);
     sc.import.bed = std::make_shared<const ImportedBed>(
         read_bed_file(sc.import.file, sc.import.format, sc.import.to_metres, sc.import.origin_m));
     const std::vector<double>& diameters = sc.import.bed->bed.diameters;
@@ -81,7 +84,7 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
     d_max = *std::max_element(diameters.begin(), diameters.end());
     sc.count = static_cast<long long>(diameters.size());
   } else {
-    sc.count = particles.integer("count", 0, 1, 100'000'000);
+    sc.count = particles.integer("count", 0, 1, 100'000'000, "none (required)");
     if (!particles.has("count")) throw InputError("particles.count is required: the number of spheres, an integer >= 1");
     sc.sizes = read_size_distribution(particles);
     d_ref = sc.sizes.sauter_mean();
@@ -118,21 +121,43 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   surface.finish();
 
   SceneSection mesh = root.sub("mesh"), case_section = root.sub("case");
-#ifdef BEDFORGE_HAVE_GMSH
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
   sc.mesh = meshing::read_volume_mesh_params(mesh);
 #else
   if (sc.needs_mesh() || table.contains("mesh"))
-    throw InputError("this bedforge was built without gmsh, so it has no volume mesh stage ([mesh], outputs.files "
-                     "\"mesh\" or \"case\", which needs the mesh); install libgmsh-dev and rebuild");
+    throw InputError("this bedforge was built without gmsh or CGAL, so it has no volume mesh stage ([mesh], "
+                     "outputs.files \"mesh\" or \"case\", which needs the mesh); install libgmsh-dev and "
+                     "libcgal-dev and rebuild");
 #endif
-#ifdef BEDFORGE_HAVE_CGAL
   sc.case_params = cases::read_case_params(case_section);
-#else
-  if (table.contains("case")) throw InputError("this bedforge was built without CGAL, so it has no [case] stage");
-#endif
   mesh.finish();
   case_section.finish();
   return sc;
+}
+
+}  // namespace
+
+Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir) {
+  return read_scene_into(table, source, base_dir, nullptr);
+}
+
+SceneSchema scene_schema() {
+  // Scenes that between them take every branch of the readers: each container type, and an
+  // import (which stops at its missing file after its own keys are recorded).
+  SceneSchema schema;
+  const char* scenes[] = {"container = {diameter_d = 5.0}\nparticles = {count = 1}",
+                          "container = {type = \"annulus\", diameter_d = 5.0, inner_diameter_d = 2.0}\n"
+                          "particles = {count = 1}",
+                          "container = {type = \"box\", size_x_d = 5.0, size_y_d = 5.0}\nparticles = {count = 1}",
+                          "packing = {algorithm = \"import\"}"};
+  for (const char* text : scenes) {
+    try {
+      read_scene_into(toml::parse(text), "schema", {}, &schema);
+    } catch (const InputError&) {
+      // the import scene names no file: its keys are recorded by then
+    }
+  }
+  return schema;
 }
 
 Scene read_scene_file(const std::filesystem::path& path) {
@@ -154,10 +179,34 @@ toml::table& table_for_override(toml::table& table, const std::string& dotted, s
   return *t;
 }
 
+void apply_overrides(toml::table& table, const std::vector<Override>& overrides) {
+  auto given = [&](const std::string& key) {
+    return std::any_of(overrides.begin(), overrides.end(), [&](const Override& o) { return o.key == key; });
+  };
+  for (const Override& o : overrides) {
+    std::visit(
+        [&](const auto& v) {
+          using T = std::decay_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, std::vector<double>>) {
+            toml::array a;
+            for (double x : v) a.push_back(x);
+            override_key(table, o.key, std::move(a));
+          } else {
+            override_key(table, o.key, v);
+          }
+        },
+        o.value);
+  }
+  if (given("surface.clip_window_d"))
+    if (auto* s = table["surface"].as_table())
+      for (const char* key : {"inlet_length_d", "outlet_length_d"})
+        if (!given(std::string("surface.") + key)) s->erase(key);
+}
+
 std::string scene_to_toml(const toml::table& table) {
   std::ostringstream s;
   s << table;
   return s.str() + "\n";
 }
 
-}  // namespace bedforge
+}  // namespace bedforge::pipeline

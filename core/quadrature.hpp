@@ -5,7 +5,7 @@
 #include <numbers>
 #include <vector>
 
-namespace bedforge::analysis {
+namespace bedforge {
 
 // n-point Gauss-Legendre nodes and weights on [-1, 1] (Newton on the Legendre recurrence).
 struct GaussLegendre {
@@ -47,4 +47,4 @@ double integrate_pieces(std::vector<double> cuts, F f) {
   return v;
 }
 
-}  // namespace bedforge::analysis
+}  // namespace bedforge

@@ -1,10 +1,11 @@
-#include "app/scene.hpp"
+#include "pipeline/scene.hpp"
 
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
 
 using namespace bedforge;
+using namespace bedforge::pipeline;
 
 namespace {
 

@@ -1,6 +1,6 @@
 #pragma once
 
-namespace bedforge::analysis {
+namespace bedforge {
 
 // Exact volumes of a sphere cut by the shapes the void-fraction profiles use. All lengths in
 // one unit (any); volumes in that unit cubed.
@@ -26,4 +26,4 @@ double sphere_cylinder_volume(double r, double s, double zc, double rho, double 
 // sampling noise of a profile. Profiles next to the flat walls of a box.
 double sphere_halfspace_volume(double r, double xc, double zc, double x_max, double z1, double z2);
 
-}  // namespace bedforge::analysis
+}  // namespace bedforge

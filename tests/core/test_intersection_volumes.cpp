@@ -1,4 +1,4 @@
-#include "analysis/intersection_volumes.hpp"
+#include "core/intersection_volumes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 
 #include "core/random.hpp"
 
-using namespace bedforge::analysis;
+using namespace bedforge;
 constexpr double kPi = std::numbers::pi;
 
 TEST(SphereSlab, WholeHalfAndCap) {

@@ -6,23 +6,24 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "analysis/bed_analysis.hpp"
 #include "core/container.hpp"
 #include "core/dem_import.hpp"
 #include "core/size_distribution.hpp"
+#include "cases/openfoam_case.hpp"
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
-#include "cases/openfoam_case.hpp"
 #include "meshing/fluid_surface.hpp"
 #endif
-#ifdef BEDFORGE_HAVE_GMSH
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
 #include "meshing/volume_mesh.hpp"
 #endif
 
-namespace bedforge {
+namespace bedforge::pipeline {
 
 // A scene: what to build and which outputs to write. Sections: [container], [particles],
 // [packing] (with [packing.soft_sphere] and [packing.monte_carlo]), [analysis], [contacts],
@@ -56,11 +57,11 @@ struct Scene {
   analysis::AnalysisParams analysis;
 #ifdef BEDFORGE_HAVE_CGAL
   meshing::SurfaceParams surface;  // [contacts] and [surface]
-  cases::CaseParams case_params;   // [case]
 #endif
-#ifdef BEDFORGE_HAVE_GMSH
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
   meshing::VolumeMeshParams mesh;  // [mesh]
 #endif
+  cases::CaseParams case_params;   // [case]
   // [outputs] files: "positions" (bed.csv), "vtp" (bed.vtp), "analysis" (profiles, contacts),
   // "stl" (the fluid-domain surface and the bed solid; needs a build with CGAL), "mesh" (the
   // gmsh volume mesh fluid.msh; needs gmsh), "case" (the OpenFOAM case in case/; runs the
@@ -79,6 +80,10 @@ struct Scene {
 Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir = {});
 Scene read_scene_file(const std::filesystem::path& path);
 
+// Every key a scene can hold, with its type, range and default, as the section readers ask for
+// them (for the command line's help).
+SceneSchema scene_schema();
+
 // The table that holds `dotted.key` (created if missing); `leaf` receives the last part. For a
 // length key (ending in _m or _d) the key in the other unit is removed, so an override wins.
 toml::table& table_for_override(toml::table& table, const std::string& dotted_key, std::string& leaf);
@@ -90,7 +95,16 @@ void override_key(toml::table& table, const std::string& dotted_key, T value) {
   table_for_override(table, dotted_key, leaf).insert_or_assign(leaf, std::move(value));
 }
 
+// A scene key set from the command line.
+struct Override {
+  std::string key;  // dotted, e.g. "container.diameter_d"
+  std::variant<bool, long long, double, std::string, std::vector<double>> value;
+};
+// Applies `overrides` in order. A clip window given without empty-section lengths replaces the
+// lengths the table gives (a window and empty sections exclude each other).
+void apply_overrides(toml::table& table, const std::vector<Override>& overrides);
+
 // The scene as TOML text, to store next to its outputs.
 std::string scene_to_toml(const toml::table& table);
 
-}  // namespace bedforge
+}  // namespace bedforge::pipeline

@@ -1,0 +1,29 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "cases/openfoam_case.hpp"
+#include "core/bed.hpp"
+#include "core/bed_io.hpp"
+#include "meshing/poly_mesh.hpp"
+#include "pipeline/console.hpp"
+
+namespace bedforge::pipeline {
+
+// The OpenFOAM case of a bed, and its flow when it was run.
+struct CaseStage {
+  cases::CaseInfo info;
+  std::optional<cases::FlowResult> flow;  // with params.run
+  nlohmann::json report;                  // stages.case, with "flow" and "summary"
+};
+
+// Writes the case for `mesh` (the fluid domain of `bed`, m) into `case_dir` (replacing one only
+// with `overwrite`), recording `scene_toml`, the bed and `fluid_stl` (the snappyHexMesh route's
+// surface; empty without it), and runs it when params.run.
+CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CaseParams& params,
+                     const Provenance& provenance, const std::string& scene_toml, const std::string& fluid_stl,
+                     const std::filesystem::path& case_dir, bool overwrite, const Console& console);
+
+}  // namespace bedforge::pipeline

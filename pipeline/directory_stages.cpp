@@ -1,0 +1,134 @@
+#include "pipeline/directory_stages.hpp"
+
+#include <fmt/format.h>
+
+#include <limits>
+#include <string>
+
+#include "core/atomic_file.hpp"
+#include "core/bed_io.hpp"
+#include "core/error.hpp"
+#include "core/report.hpp"
+#include "core/version.hpp"
+#include "pipeline/analysis_stage.hpp"
+#include "pipeline/output_files.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
+#include "meshing/stl_io.hpp"
+#include "meshing/surface_checks.hpp"
+#include "pipeline/surface_stage.hpp"
+#endif
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+#include "pipeline/mesh_stage.hpp"
+#endif
+#ifdef BEDFORGE_HAVE_GMSH
+#include "meshing/gmsh_model.hpp"
+#include "pipeline/case_stage.hpp"
+#endif
+
+namespace bedforge::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// What a stage run on its own starts from: the bed, the scene as run with the overrides, and
+// the report the earlier stages left.
+struct Directory {
+  Bed bed;
+  toml::table scene;
+  Report report;
+};
+
+Directory open_directory(const fs::path& dir, const std::vector<Override>& overrides) {
+  Directory d;
+  d.bed = read_bed_text(dir / "bed.csv", 1.0).bed;
+  if (!d.bed.container)
+    throw InputError(fmt::format("{}: the header names no container; write the bed with `bedforge import`",
+                                 (dir / "bed.csv").string()));
+  if (fs::exists(dir / "scene.toml"))
+    d.scene = parse_scene_text(read_file(dir / "scene.toml"), (dir / "scene.toml").string());
+  apply_overrides(d.scene, overrides);
+  d.report = Report::load_or_new(dir);
+  return d;
+}
+
+// A section's parameters by its reader, every key checked.
+template <class Reader>
+auto read_section(toml::table& scene, const char* name, Reader reader) {
+  SceneSection section(scene[name].as_table(), name);
+  auto params = reader(section);
+  section.finish();
+  return params;
+}
+
+}  // namespace
+
+void analyse_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
+  Directory d = open_directory(dir, overrides);
+  const analysis::AnalysisParams params = read_section(d.scene, "analysis", analysis::read_analysis_params);
+  AnalysisStage a = analysis_stage(d.bed, params, console);
+  OutputFiles files;
+  for (auto& [name, csv] : a.csv_files) files.add(name, std::move(csv));
+  d.report.set_stage("analysis", std::move(a.report));
+  files.write(dir);
+  d.report.save(dir);
+}
+
+#ifdef BEDFORGE_HAVE_CGAL
+void surface_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
+  Directory d = open_directory(dir, overrides);
+  SceneSection contacts(d.scene["contacts"].as_table(), "contacts"), surf(d.scene["surface"].as_table(), "surface");
+  const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
+  contacts.finish();
+  surf.finish();
+  SurfaceStage s = surface_stage(d.bed, params, dir / "bad_triangles.vtp", console);
+  OutputFiles files;
+  add_surface_files(s.surface, files);
+  d.report.set_stage("surface", std::move(s.report));
+  files.write(dir);
+  d.report.save(dir);
+}
+#endif
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
+  Directory d = open_directory(dir, overrides);
+  const meshing::VolumeMeshParams params = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
+  const fs::path stl = dir / "fluid.stl";
+  const meshing::TriangleMesh surface = meshing::read_stl_ascii_by_patch(read_file(stl), stl.string());
+  // A surface edited or made elsewhere: gmsh needs it closed, so say where it is not.
+  const meshing::SurfaceCheck check = meshing::check_surface(surface, 0);
+  if (!check.closed || !check.manifold)
+    throw InputError(fmt::format("{}: the surface is not closed ({} defective edges, first at{}); a volume needs a "
+                                 "closed surface: rebuild it with `bedforge surface`",
+                                 stl.string(), check.defects.size(), meshing::describe_defects(check)));
+  // The exact volume is the surface stage's record; a surface made elsewhere has none.
+  const nlohmann::json& stages = d.report.data().value("stages", nlohmann::json::object());
+  const double exact = stages.contains("surface")
+                           ? stages["surface"].value("fluid_volume_exact_m3", std::numeric_limits<double>::quiet_NaN())
+                           : std::numeric_limits<double>::quiet_NaN();
+  OutputFiles files;
+  const fs::path msh = dir / ".fluid.partial.msh";  // gmsh picks the format by extension
+  files.add_made("fluid.msh", msh);
+  MeshStage m = mesh_stage(surface, exact, d.bed, params, msh, dir / "bad_cells.vtk", console);
+  d.report.set_stage("mesh", std::move(m.report));
+  files.write(dir);
+  d.report.save(dir);
+}
+#endif
+
+#ifdef BEDFORGE_HAVE_GMSH
+void case_directory(const fs::path& dir, const std::vector<Override>& overrides, bool overwrite, const Console& console) {
+  Directory d = open_directory(dir, overrides);
+  const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
+  const meshing::PolyMesh mesh = meshing::read_msh(dir / "fluid.msh");
+  const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
+  const CaseStage c = case_stage(mesh, d.bed, params, prov, scene_to_toml(d.scene),
+                                 params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir / "case", overwrite,
+                                 console);
+  d.report.set_stage("case", c.report);
+  d.report.save(dir);
+}
+#endif
+
+}  // namespace bedforge::pipeline

@@ -1,0 +1,121 @@
+#include "pipeline/run_scene.hpp"
+
+#include <fmt/format.h>
+
+#include <memory>
+#include <string>
+
+#include "core/atomic_file.hpp"
+#include "core/bed_io.hpp"
+#include "core/report.hpp"
+#include "core/version.hpp"
+#include "pipeline/analysis_stage.hpp"
+#include "pipeline/output_files.hpp"
+#include "pipeline/pack_stage.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
+#include "pipeline/surface_stage.hpp"
+#endif
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+#include "meshing/gmsh_model.hpp"
+#include "pipeline/case_stage.hpp"
+#include "pipeline/mesh_stage.hpp"
+#endif
+
+namespace bedforge::pipeline {
+
+namespace fs = std::filesystem;
+
+void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, const Console& console) {
+  const nlohmann::json previous =
+      opt.force || !fs::exists(dir / "report.json") ? nlohmann::json() : Report::load_or_new(dir).data();
+  const StageKeys keys = stage_keys(scene);
+  const RunPlan plan = plan_run(opt.wants, keys, previous, [&dir](const std::string& f) { return fs::exists(dir / f); });
+  if (plan.case_.build) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages
+
+  // Results of other stages in DIR may belong to another bed: the report starts afresh.
+  Report report;
+  report.set_provenance(kVersion, scene.to_json(), scene.seed);
+  auto record = [&report](const char* name, nlohmann::json entry, const std::string& key) {
+    entry["cache_key"] = key;
+    report.set_stage(name, std::move(entry));
+  };
+  auto reuse = [&](const char* name, const StagePlan& s, const std::string& what) {
+    if (s.reused.is_null()) return;
+    console.line(fmt::format("{}: reused {}", name, what));
+    report.set_stage(name, s.reused);
+  };
+
+  Bed bed;
+  if (plan.pack.build) {
+    PackStage pack = pack_stage(scene, console);
+    bed = std::move(pack.bed);
+    record("pack", std::move(pack.report), keys.pack);
+  } else {
+    if (plan.load_bed) {  // bed.csv keeps 17 digits: the bed read back is the bed packed
+      bed = read_bed_text(dir / "bed.csv", 1.0).bed;
+      bed.container = scene.container;
+    }
+    reuse("pack", plan.pack,
+          fmt::format("the bed in {} (container, particles and packing unchanged; --force redoes it)", dir.string()));
+  }
+
+  OutputFiles files;
+  const Provenance prov{kVersion, scene.seed, scene.to_json()};
+  if (plan.write_bed_csv) files.add("bed.csv", bed_to_csv(bed, prov));
+  if (plan.write_bed_vtp) files.add("bed.vtp", bed_to_vtp(bed, prov));
+  files.add("scene.toml", "# scene as run by bedforge " + std::string(kVersion) + "\n" + scene_to_toml(scene.table));
+
+  if (plan.analysis.build) {
+    AnalysisStage a = analysis_stage(bed, scene.analysis, console);
+    for (auto& [name, csv] : a.csv_files) files.add(name, std::move(csv));
+    record("analysis", std::move(a.report), keys.analysis);
+  } else {
+    reuse("analysis", plan.analysis, fmt::format("the analysis in {} (bed and [analysis] unchanged)", dir.string()));
+  }
+
+#ifdef BEDFORGE_HAVE_CGAL
+  std::shared_ptr<const meshing::FluidSurface> surface;
+  if (plan.surface.build) {
+    SurfaceStage s = surface_stage(bed, scene.surface, dir / "bad_triangles.vtp", console);
+    if (opt.wants.stl) add_surface_files(s.surface, files);
+    surface = std::move(s.surface);
+    record("surface", std::move(s.report), keys.surface);
+  } else {
+    reuse("surface", plan.surface,
+          opt.wants.stl ? fmt::format("the surface in {} (bed, [contacts] and [surface] unchanged)", dir.string())
+                        : std::string("the surface's record (bed, [contacts] and [surface] unchanged; its mesh is "
+                                      "reused)"));
+  }
+#endif
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  std::shared_ptr<const meshing::PolyMesh> mesh;
+  if (plan.mesh.build) {
+    const fs::path msh = opt.wants.mesh ? dir / ".fluid.partial.msh" /* gmsh picks the format by extension */ : fs::path();
+    if (opt.wants.mesh) files.add_made("fluid.msh", msh);
+    MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.mesh, msh, dir / "bad_cells.vtk", console);
+    mesh = std::shared_ptr<const meshing::PolyMesh>(m.volume, &m.volume->mesh);
+    record("mesh", std::move(m.report), keys.mesh);
+  } else {
+    if (plan.load_mesh) mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
+    reuse("mesh", plan.mesh,
+          opt.wants.mesh ? fmt::format("{} (surface and [mesh] unchanged)", (dir / "fluid.msh").string())
+                         : std::string("the mesh's record (surface and [mesh] unchanged; its case is reused)"));
+  }
+  surface.reset();  // the case needs the volume mesh only
+#endif
+  files.write(dir);
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (plan.case_.build) {
+    const CaseStage c = case_stage(*mesh, bed, scene.case_params, prov, read_file(dir / "scene.toml"),
+                                   scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(),
+                                   dir / "case", opt.overwrite, console);
+    record("case", c.report, keys.case_);
+  } else {
+    reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));
+  }
+#endif
+  report.save(dir);
+}
+
+}  // namespace bedforge::pipeline

@@ -1,0 +1,124 @@
+// A scene run through the pipeline library, no command line: what an unchanged rerun, a changed
+// section and files deleted by hand make it do.
+#include "pipeline/run_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "core/error.hpp"
+#include "support/temp_dir.hpp"
+
+namespace fs = std::filesystem;
+using namespace bedforge;
+using namespace bedforge::pipeline;
+
+namespace {
+
+// 12 spheres in a = 3 with a coarse surface: every stage, in seconds. `extra` adds sections.
+Scene small_scene(const std::string& outputs, const std::string& extra = "") {
+  const std::string text = "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n"
+                           "[surface]\nedge_length_d = 0.1\n[mesh]\nthreads = 1\n[outputs]\nfiles = [" +
+                           outputs + "]\n" + extra;
+  return read_scene(parse_scene_text(text, "small.toml"), "small.toml");
+}
+
+// What a run printed and which stages it built, from the report's "reused" marks.
+struct RunOutcome {
+  std::string printed;
+  nlohmann::json stages;
+  bool built(const std::string& stage) const { return stages.contains(stage) && !stages[stage].value("reused", false); }
+};
+
+RunOutcome run(const Scene& scene, const fs::path& dir, bool overwrite = false) {
+  const Console quiet_progress{false, false};
+  testing::internal::CaptureStdout();
+  try {
+    run_scene(scene, dir, {run_wants(scene), overwrite, false}, quiet_progress);
+  } catch (...) {
+    testing::internal::GetCapturedStdout();
+    throw;
+  }
+  RunOutcome r{testing::internal::GetCapturedStdout(), nullptr};
+  std::ifstream report(dir / "report.json");
+  r.stages = nlohmann::json::parse(report)["stages"];
+  return r;
+}
+
+fs::file_time_type written(const fs::path& p) { return fs::last_write_time(p); }
+
+}  // namespace
+
+TEST(RunScene, ACaseOnlySceneRerunUnchangedDoesNoWork) {
+  // The defect a new user met: outputs naming "case" but not "mesh", run twice.
+  const fs::path dir = test_support::fresh_dir("case_only");
+  const Scene scene = small_scene("\"case\"");
+  const RunOutcome first = run(scene, dir);
+  for (const char* stage : {"pack", "surface", "mesh", "case"}) EXPECT_TRUE(first.built(stage)) << stage;
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+  const auto points = written(dir / "case/constant/polyMesh/points");
+
+  const RunOutcome again = run(scene, dir);  // no --overwrite needed
+  for (const char* stage : {"pack", "surface", "mesh", "case"}) {
+    EXPECT_FALSE(again.built(stage)) << stage;
+    EXPECT_NE(again.printed.find(std::string(stage) + ": reused"), std::string::npos) << again.printed;
+  }
+  EXPECT_EQ(again.printed.find("cells"), std::string::npos) << "a stage ran: " << again.printed;
+  EXPECT_EQ(written(dir / "case/constant/polyMesh/points"), points);
+  EXPECT_EQ(again.stages["case"]["cache_key"], first.stages["case"]["cache_key"]);
+}
+
+TEST(RunScene, OnlyTheCaseChangedMakesTheCaseAgainOnTheSameBed) {
+  const fs::path dir = test_support::fresh_dir("case_changed");
+  const RunOutcome first = run(small_scene("\"positions\", \"mesh\", \"case\""), dir);
+  const std::string bed = first.stages["pack"]["cache_key"];
+  const auto msh = written(dir / "fluid.msh");
+  const Scene faster = small_scene("\"positions\", \"mesh\", \"case\"", "[case]\nreynolds = 10\n");
+  // The case in DIR was made with other settings: replaced only when asked, refused before any work.
+  EXPECT_THROW(run(faster, dir), InputError);
+  const RunOutcome second = run(faster, dir, true);
+  EXPECT_TRUE(second.built("case"));
+  EXPECT_FALSE(second.built("mesh") || second.built("surface") || second.built("pack"));
+  EXPECT_EQ(written(dir / "fluid.msh"), msh);
+  EXPECT_EQ(second.stages["pack"]["cache_key"], bed);
+  EXPECT_EQ(second.stages["case"]["parameters"]["reynolds"], 10.0);
+}
+
+TEST(RunScene, OnlyTheMeshChangedMeshesAgainWithoutPacking) {
+  const fs::path dir = test_support::fresh_dir("mesh_changed");
+  const RunOutcome first = run(small_scene("\"positions\", \"mesh\""), dir);
+  const Scene coarser = small_scene("\"positions\", \"mesh\"", "[mesh.gate]\nmax_skewness = 5\n");
+  const RunOutcome second = run(coarser, dir);
+  EXPECT_TRUE(second.built("mesh") && second.built("surface"));  // a mesh is made from the surface in memory
+  EXPECT_FALSE(second.built("pack"));
+  EXPECT_NE(second.stages["mesh"]["cache_key"], first.stages["mesh"]["cache_key"]);
+  EXPECT_EQ(second.stages["mesh"]["parameters"]["gate"]["max_skewness"], 5.0);
+}
+
+TEST(RunScene, FilesDeletedByHandAreMadeAgain) {
+  const fs::path dir = test_support::fresh_dir("deleted");
+  const Scene scene = small_scene("\"positions\", \"vtp\", \"analysis\", \"mesh\", \"case\"");
+  run(scene, dir);
+  const std::string vtp = [&] {
+    std::ifstream in(dir / "bed.vtp");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }();
+  fs::remove(dir / "bed.vtp");
+  fs::remove(dir / "radial_profile.csv");
+  fs::remove_all(dir / "case");
+  const RunOutcome again = run(scene, dir);
+  EXPECT_FALSE(again.built("pack") || again.built("surface") || again.built("mesh"));
+  EXPECT_TRUE(again.built("analysis") && again.built("case"));
+  EXPECT_TRUE(fs::exists(dir / "radial_profile.csv") && fs::exists(dir / "case/Allrun"));
+  std::ifstream in(dir / "bed.vtp");
+  std::stringstream s;
+  s << in.rdbuf();
+  EXPECT_EQ(s.str(), vtp);  // the same bed, read back from bed.csv
+}
