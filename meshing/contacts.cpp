@@ -14,6 +14,7 @@
 #include "core/quadrature.hpp"
 #include "core/error.hpp"
 #include "core/neighbour_list.hpp"
+#include "meshing/clip_planes.hpp"
 
 namespace bedforge::meshing {
 
@@ -96,32 +97,19 @@ std::vector<Wall> walls_of(const Container& c) {
                                c.kind()));
 }
 
-// A contact of a bed of n spheres as one number: spheres i < j, or sphere i and wall w as
-// j = n + w; and back.
-long long contact_key(std::size_t i, std::size_t j, std::size_t n) { return static_cast<long long>(i) * (n + 8) + j; }
-std::pair<std::size_t, std::size_t> contact_of(long long k, std::size_t n) {
-  return {static_cast<std::size_t>(k) / (n + 8), static_cast<std::size_t>(k) % (n + 8)};
-}
-
-// What a treated contact occupies in z (m), by contact key: a clip plane must keep clear of it.
-using Extents = std::unordered_map<long long, std::pair<double, double>>;
-
-// Contacts a clip plane cuts through, opened instead of treated (see treat_contacts): their
-// spheres shrink by contacts.shrink_factor and the contacts are left as gaps.
-struct Opening {
-  std::vector<char> spheres;              // per sphere
-  std::unordered_set<long long> contacts;  // by contact_key
+// How one treatment of the bed stands to the clip planes.
+struct ClipContext {
+  bool record_extents = false;                 // a survey of the whole bed: record each treated contact's z extent
+  const ContactExtents* surveyed = nullptr;    // the window: the survey's extents, to leave out contacts beyond the planes
+  const ClipOpening* opening = nullptr;        // the window: contacts opened at the planes instead of treated
 };
 
-class Treater {
+// Treats the contacts of a bed once: resizes the spheres, cuts them where they meet each other,
+// a wall or a clip plane, adds the bridges, caps and unions, and measures what is left.
+class ContactTreatment {
  public:
-  // `survey`: the extents of the contacts treated without clip planes, to leave out those
-  // beyond the planes (null without clipping). `measure`: record this run's extents.
-  // `opening`: contacts to open at the clip planes (null: none).
-  Treater(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, const Extents* survey, bool measure,
-          const Opening* opening = nullptr)
-      : bed_(bed), p_(p), planes_(planes), survey_(survey), measure_(measure), opening_(opening),
-        walls_(walls_of(*bed.container)) {
+  ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip = {})
+      : bed_(bed), p_(p), planes_(planes), clip_(clip), walls_(walls_of(*bed.container)) {
     d_ = sauter_mean(bed.diameters);
     edge_c_ = p.contact_edge_length_d * d_;
     scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
@@ -136,7 +124,7 @@ class Treater {
     out_.planes = planes;
     cut_angle_.resize(n);
     for (std::size_t i = 0; i < n; ++i)
-      out_.radius[i] = (opening && opening->spheres[i] ? p.shrink_factor : scale_) * 0.5 * bed.diameters[i];
+      out_.radius[i] = (clip.opening && clip.opening->spheres[i] ? p.shrink_factor : scale_) * 0.5 * bed.diameters[i];
     if (p.treatment == SurfaceParams::Treatment::enlarge) grow_to_join();
     for (std::size_t i = 0; i < n; ++i) {
       const double z = bed.centres[i].z();
@@ -155,8 +143,8 @@ class Treater {
     // Skin: the treatment's tolerance, what a shrink opens and an enlarge closes, and the join
     // gap: every contact of the bed is seen, and every gap the smallest-gap report must cover.
     const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
-    const double join = p_.treatment == T::enlarge ? p_.enlarge_join_gap_d * d_ : 0.0;
-    const double resized = std::max(std::abs(1.0 - scale_), opening_ ? 1.0 - p_.shrink_factor : 0.0);
+    const double join = p_.treatment == Treatment::enlarge ? p_.enlarge_join_gap_d * d_ : 0.0;
+    const double resized = std::max(std::abs(1.0 - scale_), clip_.opening ? 1.0 - p_.shrink_factor : 0.0);
     NeighbourList nl(std::max(tolerance, 0.0) + resized * d_max + join + 1e-3 * d_);
     nl.build(bed_.centres, out_.radius, *bed_.container);
     const double wall_pad = 0.6 * p_.edge_length_d * d_;  // the wall mesh keeps its holes this clear of its ends
@@ -192,15 +180,15 @@ class Treater {
         {"smallest_gap_d", {{"particle_particle", min_pair_gap_ / d_}, {"particle_wall", min_wall_gap_ / d_}}},
         {"smallest_fluid_wedge_angle_deg", angle(min_wedge_)},
         {"solid_volume_exact_m3", volume_}};
-    if (opening_)
+    if (clip_.opening)
       out_.report["opened_at_clip_planes"] = {{"particle_particle", opened_pp_}, {"particle_wall", opened_pw_}};
     return std::move(out_);
   }
 
-  const Extents& extents() const { return extents_; }
+  const ContactExtents& extents() const { return extents_; }
 
  private:
-  using T = SurfaceParams::Treatment;
+  using Treatment = SurfaceParams::Treatment;
 
   // Enlarging leaves the pairs that were just out of its reach a sliver of a gap (1e-6 d at
   // N = 1e4), which no volume mesh resolves. So a sphere left nearer than
@@ -252,11 +240,11 @@ class Treater {
   static constexpr int kJoinRounds = 20;
 
   // Gap below which a contact is treated (pairs and walls share the tolerance of their treatment).
-  double treat_below(T t) const {
+  double treat_below(Treatment t) const {
     switch (t) {
-      case T::bridge: return p_.bridge_gap_d * d_;
-      case T::cap: return p_.cap_gap_d * d_;
-      case T::enlarge: return 0.0;
+      case Treatment::bridge: return p_.bridge_gap_d * d_;
+      case Treatment::cap: return p_.cap_gap_d * d_;
+      case Treatment::enlarge: return 0.0;
       default: return -std::numeric_limits<double>::infinity();
     }
   }
@@ -291,39 +279,39 @@ class Treater {
   };
   Marks mark(std::size_t i, std::size_t j) const {
     Marks m{out_.cuts[i].size(), out_.cuts[j].size(), out_.parts.size(), {}};
-    if (measure_)
+    if (clip_.record_extents)
       for (const auto& h : out_.wall_holes) m.holes.push_back(h.size());
     return m;
   }
   // The z extent of what the contact (i, j) added since `m` (the cut caps included), widened by `pad`.
   void record(long long k, const Marks& m, std::size_t i, std::size_t j, double pad) {
-    if (!measure_) return;
+    if (!clip_.record_extents) return;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     auto take = [&](const Eigen::Vector3d& q) { lo = std::min(lo, q.z()), hi = std::max(hi, q.z()); };
     for (auto [s, from] : {std::pair{i, m.cuts_i}, std::pair{j, m.cuts_j}}) {
       const Eigen::Vector3d& c = bed_.centres[s];
       const double r = out_.radius[s];
-      for (std::size_t k2 = from; k2 < out_.cuts[s].size(); ++k2) {
-        const SphereCut& cut = out_.cuts[s][k2];
+      for (std::size_t c_new = from; c_new < out_.cuts[s].size(); ++c_new) {
+        const SphereCut& cut = out_.cuts[s][c_new];
         for (const auto& q : cut.loop) take(q);
         take(c + r * cut.axis);
         for (const Eigen::Vector3d& pole : {Eigen::Vector3d(c + r * Eigen::Vector3d::UnitZ()), Eigen::Vector3d(c - r * Eigen::Vector3d::UnitZ())})
           if (cut.removed(pole)) take(pole);
       }
     }
-    for (std::size_t k2 = m.parts; k2 < out_.parts.size(); ++k2)
-      for (const auto& q : out_.parts[k2].points) take(q);
+    for (std::size_t part = m.parts; part < out_.parts.size(); ++part)
+      for (const auto& q : out_.parts[part].points) take(q);
     for (std::size_t w = 0; w < m.holes.size(); ++w)
-      for (std::size_t k2 = m.holes[w]; k2 < out_.wall_holes[w].size(); ++k2)
-        for (const auto& q : out_.wall_holes[w][k2].loop) take(q);
+      for (std::size_t hole = m.holes[w]; hole < out_.wall_holes[w].size(); ++hole)
+        for (const auto& q : out_.wall_holes[w][hole].loop) take(q);
     if (lo <= hi) extents_[k] = {lo - pad, hi + pad};
   }
   // With clip planes: true when the contact (as surveyed) lies wholly beyond them, so is left
   // out; InputError when it crosses one (the planes were placed clear of every contact).
   bool beyond_planes(long long k, const std::string& who) const {
-    if (!survey_) return false;
-    const auto it = survey_->find(k);
-    if (it == survey_->end()) return false;
+    if (!clip_.surveyed) return false;
+    const auto it = clip_.surveyed->find(k);
+    if (it == clip_.surveyed->end()) return false;
     const auto [lo, hi] = it->second;
     if (hi <= planes_.z0 || lo >= planes_.z1) return true;
     if (lo < planes_.z0 || hi > planes_.z1)
@@ -335,7 +323,7 @@ class Treater {
   // left as it is (nothing to do when a sphere of it is left out); returns false for any other
   // contact. InputError when shrinking did not open it (an overlap deeper than the shrink).
   bool open(long long k, const std::string& who, double gap, bool kept, const Wall* wall) {
-    if (!opening_ || !opening_->contacts.count(k)) return false;
+    if (!clip_.opening || !clip_.opening->contacts.count(k)) return false;
     if (!kept) return true;
     if (!(gap > 0.0))
       throw InputError(fmt::format("{} meet at a clip plane, so they are shrunk by contacts.shrink_factor = {} "
@@ -367,6 +355,9 @@ class Treater {
     return f;
   }
 
+  // Spheres i and j: a contact closer than the treatment's gap is capped, joined or bridged
+  // (cut_i, cut_j: the distances from each centre to its cut plane along the line of centres);
+  // any other is left as the gap it is.
   void pair(std::size_t i, std::size_t j, const NeighbourList& nl) {
     const Eigen::Vector3d &ci = bed_.centres[i], &cj = bed_.centres[j];
     const double ri = out_.radius[i], rj = out_.radius[j], dist = (cj - ci).norm(), gap = dist - ri - rj;
@@ -375,16 +366,16 @@ class Treater {
     const bool treated = gap < treat_below(p_.treatment);
     if ((treated && beyond_planes(key(i, j), who)) || !out_.kept[i] || !out_.kept[j]) return;
     if (!treated) {
-      if (p_.treatment == T::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
+      if (p_.treatment == Treatment::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
       return gap_left(gap, nullptr, who);
     }
     const Eigen::Vector3d a = (cj - ci) / dist;
     ++treated_pp_;
-    if (p_.treatment == T::cap) {
-      const double g = p_.cap_gap_d * d_, mid = 0.5 * (dist + ri - rj), hi = mid - 0.5 * g, hj = dist - mid - 0.5 * g;
-      if (hi <= 0.1 * ri || hj <= 0.1 * rj)
+    if (p_.treatment == Treatment::cap) {
+      const double g = p_.cap_gap_d * d_, mid = 0.5 * (dist + ri - rj), cut_i = mid - 0.5 * g, cut_j = dist - mid - 0.5 * g;
+      if (cut_i <= 0.1 * ri || cut_j <= 0.1 * rj)
         throw InputError(fmt::format("{} overlap too deeply to be capped (centre distance {:.3g} d)", who, dist / d_));
-      for (auto [k, h, axis] : {std::tuple{i, hi, a}, std::tuple{j, hj, Eigen::Vector3d(-a)}}) {
+      for (auto [k, h, axis] : {std::tuple{i, cut_i, a}, std::tuple{j, cut_j, Eigen::Vector3d(-a)}}) {
         const double r = out_.radius[k], rho = std::sqrt(r * r - h * h);
         const Frame f = plane_cut(k, axis, h, rho, ring_points(rho, edge_c_), fmt::format("cap towards sphere {}", k == i ? j : i));
         out_.parts.push_back(ring_mesh(f, 0.0, rho, edge_c_, true, "particles"));
@@ -393,78 +384,78 @@ class Treater {
       ++caps_;
       return gap_left(g, nullptr, who);
     }
-    const double rb = 0.5 * p_.bridge_diameter_d * d_;
+    const double bridge_radius = 0.5 * p_.bridge_diameter_d * d_;
     const double rho_union = gap < 0.0 ? std::sqrt(std::max(0.0, ri * ri - std::pow((dist * dist + ri * ri - rj * rj) / (2.0 * dist), 2))) : 0.0;
-    if (p_.treatment == T::enlarge || rho_union >= 0.5 * rb) {
+    if (p_.treatment == Treatment::enlarge || rho_union >= 0.5 * bridge_radius) {
       // Union along the circle where the spheres meet (the radical plane).
-      const double hi = (dist * dist + ri * ri - rj * rj) / (2.0 * dist), hj = dist - hi;
-      if (hi <= 0.0 || hj <= 0.0)
+      const double cut_i = (dist * dist + ri * ri - rj * rj) / (2.0 * dist), cut_j = dist - cut_i;
+      if (cut_i <= 0.0 || cut_j <= 0.0)
         throw InputError(fmt::format("{} overlap so deeply that one centre lies inside the other sphere", who));
-      const double rho = std::sqrt(std::max(0.0, ri * ri - hi * hi));
+      const double rho = std::sqrt(std::max(0.0, ri * ri - cut_i * cut_i));
       const int n = ring_points(rho, edge_c_);
-      const Frame f = plane_cut(i, a, hi, rho, n, fmt::format("union with sphere {}", j));
+      const Frame f = plane_cut(i, a, cut_i, rho, n, fmt::format("union with sphere {}", j));
       SphereCut cut;
       cut.loop = out_.cuts[i].back().loop;  // the same vertices on both spheres
       cut.spacing = out_.cuts[i].back().spacing;
       cut.axis = -a;
-      cut.removed = [ci, a, hi](const Eigen::Vector3d& q) { return (q - ci).dot(a) < hi; };
-      add_cut(j, std::move(cut), fmt::format("union with sphere {}", i), std::acos(std::clamp(hj / rj, -1.0, 1.0)));
-      volume_ -= cap_volume(rj, rj - hj);
-      area_ -= cap_area(rj, rj - hj);
+      cut.removed = [ci, a, cut_i](const Eigen::Vector3d& q) { return (q - ci).dot(a) < cut_i; };
+      add_cut(j, std::move(cut), fmt::format("union with sphere {}", i), std::acos(std::clamp(cut_j / rj, -1.0, 1.0)));
+      volume_ -= cap_volume(rj, rj - cut_j);
+      area_ -= cap_area(rj, rj - cut_j);
       const Eigen::Vector3d q = f.to_world(Eigen::Vector3d(rho, 0.0, 0.0));
       wedge(kPi - std::acos(std::clamp(((q - ci) / ri).dot((q - cj) / rj), -1.0, 1.0)));
       ++unions_;
       return;
     }
-    if (rb >= 0.9 * std::min(ri, rj))
+    if (bridge_radius >= 0.9 * std::min(ri, rj))
       throw InputError(fmt::format("contacts.bridge_diameter_d = {}: a bridge as wide as the smaller of {} (diameter "
                                    "{:.3g} d); allowed: below 0.9 x the smallest sphere diameter",
                                    p_.bridge_diameter_d, who, 2.0 * std::min(ri, rj) / d_));
-    const double hi = std::sqrt(ri * ri - rb * rb), hj = std::sqrt(rj * rj - rb * rb), L = dist - hi - hj;
+    const double cut_i = std::sqrt(ri * ri - bridge_radius * bridge_radius), cut_j = std::sqrt(rj * rj - bridge_radius * bridge_radius), L = dist - cut_i - cut_j;
     if (!(L > 0.0)) throw InputError(fmt::format("{}: no room for a bridge between them", who));
-    const Eigen::Vector3d from = ci + hi * a, to = ci + (hi + L) * a;
+    const Eigen::Vector3d from = ci + cut_i * a, to = ci + (cut_i + L) * a;
     for (std::size_t s : {i, j})
       for (int k : nl.of(s))
         if (static_cast<std::size_t>(k) != i && static_cast<std::size_t>(k) != j &&
-            segment_distance(bed_.centres[k], from, to) < out_.radius[k] + rb)
+            segment_distance(bed_.centres[k], from, to) < out_.radius[k] + bridge_radius)
           throw InputError(fmt::format("the bridge between {} would cross sphere {}; allowed: a narrower "
                                        "contacts.bridge_diameter_d or another treatment",
                                        who, k));
-    const int n = ring_points(rb, edge_c_);
-    const Frame f = plane_cut(i, a, hi, rb, n, fmt::format("bridge to sphere {}", j));
+    const int n = ring_points(bridge_radius, edge_c_);
+    const Frame f = plane_cut(i, a, cut_i, bridge_radius, n, fmt::format("bridge to sphere {}", j));
     const GeneratorLength length = [L](double, double) { return L; };
     SphereCut cut;
-    cut.loop = tube_end_loop(f, rb, n, length, edge_c_);
-    cut.spacing = 2.0 * kPi * rb / n;
+    cut.loop = tube_end_loop(f, bridge_radius, n, length, edge_c_);
+    cut.spacing = 2.0 * kPi * bridge_radius / n;
     cut.axis = -a;
-    const Eigen::Vector3d cjj = cj;
-    cut.removed = [cjj, a, hj](const Eigen::Vector3d& q) { return (q - cjj).dot(-a) > hj; };
-    add_cut(j, std::move(cut), fmt::format("bridge to sphere {}", i), std::acos(std::clamp(hj / rj, -1.0, 1.0)));
-    volume_ += kPi * rb * rb * L - cap_volume(rj, rj - hj);
-    area_ += 2.0 * kPi * rb * L - cap_area(rj, rj - hj);
-    out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
-    wedge(0.5 * kPi + std::asin(rb / std::max(ri, rj)));
+    cut.removed = [centre_j = cj, a, cut_j](const Eigen::Vector3d& q) { return (q - centre_j).dot(-a) > cut_j; };
+    add_cut(j, std::move(cut), fmt::format("bridge to sphere {}", i), std::acos(std::clamp(cut_j / rj, -1.0, 1.0)));
+    volume_ += kPi * bridge_radius * bridge_radius * L - cap_volume(rj, rj - cut_j);
+    area_ += 2.0 * kPi * bridge_radius * L - cap_area(rj, rj - cut_j);
+    out_.parts.push_back(tube_mesh(f, bridge_radius, n, length, edge_c_, true, "particles"));
+    wedge(0.5 * kPi + std::asin(bridge_radius / std::max(ri, rj)));
     ++bridges_;
     gap_left(L, nullptr, who);
   }
 
+  // Sphere i and wall w, as pair() with the wall's own treatment.
   void wall(std::size_t i, const Wall& w, const NeighbourList& nl) {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i], gap = w.gap(c, r);
     const std::string who = fmt::format("sphere {} and the {}", i, w.name);
     if (open(key(i, bed_.size() + w.index), who, gap, out_.kept[i], &w)) return;
-    const T t = p_.wall_treatment;
+    const Treatment t = p_.wall_treatment;
     const bool treated = gap < treat_below(t);
     if ((treated && beyond_planes(key(i, bed_.size() + w.index), who)) || !out_.kept[i]) return;
     if (!treated) {
-      if (t == T::shrink && w.gap(c, r / scale_) <= kContact * d_) ++treated_pw_;
+      if (t == Treatment::shrink && w.gap(c, r / scale_) <= kContact * d_) ++treated_pw_;
       return gap_left(gap, &w, who);
     }
     ++treated_pw_;
     const Eigen::Vector3d a = w.towards(c);
     const double to_wall = w.reach(c);  // centre to wall along a
     auto& holes = out_.wall_holes[w.index];
-    if (t == T::cap) {
+    if (t == Treatment::cap) {
       const double g = p_.cap_gap_d * d_, h = to_wall - g;
       if (h <= 0.1 * r) throw InputError(fmt::format("{} overlap too deeply to be capped", who));
       const double rho_c = std::sqrt(r * r - h * h);
@@ -476,42 +467,42 @@ class Treater {
       ++caps_;
       return gap_left(left, &w, who);
     }
-    const double rb = 0.5 * p_.bridge_diameter_d * d_;
-    if (t == T::enlarge || (gap < 0.0 && std::sqrt(-gap * (2.0 * r + gap)) >= 0.5 * rb)) return wall_union(i, w, a);
-    if (rb >= 0.9 * r)
+    const double bridge_radius = 0.5 * p_.bridge_diameter_d * d_;
+    if (t == Treatment::enlarge || (gap < 0.0 && std::sqrt(-gap * (2.0 * r + gap)) >= 0.5 * bridge_radius)) return wall_union(i, w, a);
+    if (bridge_radius >= 0.9 * r)
       throw InputError(fmt::format("contacts.bridge_diameter_d = {}: a bridge as wide as sphere {} (diameter {:.3g} d); "
                                    "allowed: below 0.9 x the smallest sphere diameter",
                                    p_.bridge_diameter_d, i, 2.0 * r / d_));
-    const double h = std::sqrt(r * r - rb * rb);
-    const int n = ring_points(rb, edge_c_);
-    const Frame f = plane_cut(i, a, h, rb, n, "bridge to the " + w.name);
+    const double h = std::sqrt(r * r - bridge_radius * bridge_radius);
+    const int n = ring_points(bridge_radius, edge_c_);
+    const Frame f = plane_cut(i, a, h, bridge_radius, n, "bridge to the " + w.name);
     const GeneratorLength length = [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
     double shortest = std::numeric_limits<double>::infinity();
     for (int j = 0; j < 64; ++j) {
-      const double l = length(rb * std::cos(2 * kPi * j / 64), rb * std::sin(2 * kPi * j / 64));
+      const double l = length(bridge_radius * std::cos(2 * kPi * j / 64), bridge_radius * std::sin(2 * kPi * j / 64));
       shortest = std::min(shortest, std::isnan(l) ? -1.0 : l);
     }
     if (!(shortest > 0.0))
       throw InputError(fmt::format("{}: no room for a bridge (the sphere crosses the wall or the bridge misses it)", who));
     const Eigen::Vector3d from = f.origin, to = f.origin + length(0.0, 0.0) * a;
     for (int k : nl.of(i))
-      if (segment_distance(bed_.centres[k], from, to) < out_.radius[k] + rb)
+      if (segment_distance(bed_.centres[k], from, to) < out_.radius[k] + bridge_radius)
         throw InputError(fmt::format("the bridge between {} would cross sphere {}", who, k));
-    holes.push_back({tube_end_loop(f, rb, n, length, edge_c_), 2.0 * kPi * rb / n, static_cast<int>(i)});
-    out_.parts.push_back(tube_mesh(f, rb, n, length, edge_c_, true, "particles"));
+    holes.push_back({tube_end_loop(f, bridge_radius, n, length, edge_c_), 2.0 * kPi * bridge_radius / n, static_cast<int>(i)});
+    out_.parts.push_back(tube_mesh(f, bridge_radius, n, length, edge_c_, true, "particles"));
     // Volume and lateral area of the bridge: polar quadrature over its cross-section (smooth
     // integrand: Gauss-Legendre in radius, trapezoid in angle, both spectrally accurate).
     constexpr int kAngles = 128;
     double vol = 0.0, lateral = 0.0;
     for (int j = 0; j < kAngles; ++j) {
       const double th = 2.0 * kPi * j / kAngles, cs = std::cos(th), sn = std::sin(th);
-      lateral += length(rb * cs, rb * sn) * rb * 2.0 * kPi / kAngles;
-      vol += integrate_pieces({0.0, rb}, [&](double s) { return length(s * cs, s * sn) * s; }) * 2.0 * kPi /
+      lateral += length(bridge_radius * cs, bridge_radius * sn) * bridge_radius * 2.0 * kPi / kAngles;
+      vol += integrate_pieces({0.0, bridge_radius}, [&](double s) { return length(s * cs, s * sn) * s; }) * 2.0 * kPi /
              kAngles;
     }
     volume_ += vol;
     area_ += lateral;
-    wedge(0.5 * kPi + std::asin(rb / r));
+    wedge(0.5 * kPi + std::asin(bridge_radius / r));
     ++bridges_;
     gap_left(shortest, &w, who);
   }
@@ -626,11 +617,9 @@ class Treater {
   const Bed& bed_;
   const SurfaceParams& p_;
   DomainPlanes planes_;
-  const Extents* survey_;
-  bool measure_;
-  const Opening* opening_;
+  ClipContext clip_;
   std::vector<Wall> walls_;
-  Extents extents_;
+  ContactExtents extents_;
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
   TreatedBed out_;
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
@@ -643,105 +632,21 @@ class Treater {
   std::vector<std::vector<double>> cut_angle_;  // per sphere and cut, see add_cut
 };
 
-// The height within `shift` of `asked` nearest to it that lies `wanted` clear of every
-// obstacle (a z interval); failing that, the clearest one.
-struct ClipHeight {
-  double z, clearance;
-};
-ClipHeight clip_height(double asked, double shift, double wanted, const std::vector<std::pair<double, double>>& obstacles) {
-  std::vector<std::pair<double, double>> near;
-  for (const auto& o : obstacles)
-    if (o.second > asked - shift - wanted && o.first < asked + shift + wanted) near.push_back(o);
-  auto clearance = [&](double z) {
-    double c = std::numeric_limits<double>::infinity();
-    for (const auto& [lo, hi] : near) c = std::min(c, z < lo ? lo - z : z > hi ? z - hi : -std::min(z - lo, hi - z));
-    return c;
-  };
-  // Candidates: the asked height, the ends of the range, the midpoints between obstacle ends,
-  // and the points `wanted` away from each end (the nearest clear heights).
-  std::vector<double> ends{asked - shift, asked + shift}, candidates{asked, asked - shift, asked + shift};
-  for (const auto& [lo, hi] : near) ends.push_back(lo), ends.push_back(hi);
-  std::sort(ends.begin(), ends.end());
-  for (std::size_t k = 0; k + 1 < ends.size(); ++k) candidates.push_back(0.5 * (ends[k] + ends[k + 1]));
-  for (double e : ends) candidates.push_back(e - 1.001 * wanted), candidates.push_back(e + 1.001 * wanted);
-  ClipHeight best{asked, -std::numeric_limits<double>::infinity()}, nearest{asked, -1.0};
-  bool found = false;
-  for (double z : candidates) {
-    if (std::abs(z - asked) > shift) continue;
-    const double c = clearance(z);
-    if (c > best.clearance) best = {z, c};
-    if (c >= wanted && (!found || std::abs(z - asked) < std::abs(nearest.z - asked))) nearest = {z, c}, found = true;
-  }
-  return found ? nearest : best;
-}
-
 }  // namespace
 
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes) {
   if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
-  if (!planes.clip) return Treater(bed, p, planes, nullptr, false).run();
+  if (!planes.clip) return ContactTreatment(bed, p, planes).run();
   // Survey the whole bed's contacts, place the clip planes clear of them and of every sphere's
   // top and bottom, then treat the window.
-  const std::size_t n = bed.size();
   const double inf = std::numeric_limits<double>::infinity();
-  Treater survey(bed, p, {-inf, inf, false}, nullptr, true);
+  ContactTreatment survey(bed, p, {-inf, inf, false}, {.record_extents = true});
   const TreatedBed whole = survey.run();
-  const double d = sauter_mean(bed.diameters), d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
-  const double clearance = p.clip_clearance_d * d;
-  std::vector<std::pair<double, double>> sphere_ends;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double z = bed.centres[i].z(), r = whole.radius[i];
-    for (double e : {z - r, z + r}) sphere_ends.push_back({e, e});
-  }
-  auto everything = sphere_ends;
-  for (const auto& [k, range] : survey.extents()) everything.push_back(range);
-  // A packed bed has bridges or caps at every height, so a plane often finds no height clear of
-  // them. Such a plane then keeps clear of the spheres' tops and bottoms only (at either radius)
-  // and the contacts near it are opened: both spheres shrink by contacts.shrink_factor, as in
-  // the shrink treatment, and the contact is left as a gap. Not with enlarge, whose grown
-  // neighbours a shrunk sphere would still overlap.
-  const bool can_open = p.treatment != SurfaceParams::Treatment::enlarge &&
-                        p.wall_treatment != SurfaceParams::Treatment::enlarge;
-  auto with_shrunk = sphere_ends;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double z = bed.centres[i].z(), r = 0.5 * p.shrink_factor * bed.diameters[i];
-    for (double e : {z - r, z + r}) with_shrunk.push_back({e, e});
-  }
-  const double moved = (1.0 - p.shrink_factor) * d_max;  // how far a contact's geometry moves when opened
-  Opening opening;
-  opening.spheres.assign(n, 0);
-  const DomainPlanes asked = planes;
-  nlohmann::json clip_report;
-  for (auto [z, name] : {std::pair<double*, const char*>{&planes.z0, "inlet"}, {&planes.z1, "outlet"}}) {
-    ClipHeight h = clip_height(*z, p.clip_shift_d * d, clearance, everything);
-    const bool opens = !(h.clearance >= clearance) && can_open;
-    if (opens) h = clip_height(*z, p.clip_shift_d * d, clearance, with_shrunk);
-    if (!(h.clearance >= clearance))
-      throw InputError(fmt::format(
-          "surface.clip_window_d: the {} clip plane at {:.4g} d finds no height within surface.clip_shift_d = {} d "
-          "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom{} (at best {:.3g} d, at "
-          "{:.4g} d); allowed: a larger clip_shift_d or a smaller clip_clearance_d",
-          name, *z / d, p.clip_shift_d, p.clip_clearance_d, can_open ? "" : " and every enlarged contact",
-          h.clearance / d, h.z / d));
-    *z = h.z;
-    long opened = 0;
-    if (opens)
-      for (const auto& [k, range] : survey.extents()) {
-        if (!(range.first < h.z + clearance + moved && range.second > h.z - clearance - moved)) continue;
-        opening.contacts.insert(k);
-        const auto [i, j] = contact_of(k, n);
-        opening.spheres[i] = 1;
-        if (j < n) opening.spheres[j] = 1;
-        ++opened;
-      }
-    clip_report[name] = {{"asked_d", (name[0] == 'i' ? asked.z0 : asked.z1) / d}, {"used_d", h.z / d},
-                         {"clearance_d", h.clearance / d}, {"contacts_opened", opened}};
-  }
-  if (!(planes.z1 > planes.z0))
-    throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
-  const Opening* opened = opening.contacts.empty() ? nullptr : &opening;
-  TreatedBed out = Treater(bed, p, planes, &survey.extents(), false, opened).run();
-  out.report["clip"] = clip_report;
+  const ClipPlacement placed = place_clip_planes(bed, p, planes, whole.radius, survey.extents());
+  const ClipOpening* opening = placed.opening.contacts.empty() ? nullptr : &placed.opening;
+  TreatedBed out =
+      ContactTreatment(bed, p, placed.planes, {.surveyed = &survey.extents(), .opening = opening}).run();
+  out.report["clip"] = placed.report;
   return out;
 }
 
