@@ -44,6 +44,17 @@ CaseParams read_case_params(SceneSection& s) {
   if (p.run_snappy && !p.snappy)
     throw InputError("case.run_mesh = \"snappy\" without case.snappy = true: there is no snappyHexMesh set-up to "
                      "run; allowed: run_mesh = \"gmsh\", or snappy = true");
+  SceneSection convergence = s.sub("convergence");
+  p.convergence.levels = static_cast<int>(convergence.integer("levels", 0, 0, 6));
+  p.convergence.ratio = convergence.number("ratio", p.convergence.ratio, Range::closed(1.1, 2.0));
+  convergence.finish();
+  if (p.convergence.levels == 1 || p.convergence.levels == 2)
+    throw InputError(fmt::format("case.convergence.levels = {}: an order and an extrapolation need three meshes; "
+                                 "allowed: 0 (no study) or 3 to 6",
+                                 p.convergence.levels));
+  if (p.convergence.levels > 0 && (!p.run || p.run_snappy))
+    throw InputError("case.convergence.levels > 0 needs the flow solved on gmsh's meshes; allowed: case.run = true "
+                     "with case.run_mesh = \"gmsh\"");
   return p;
 }
 
@@ -55,7 +66,8 @@ nlohmann::json to_json(const CaseParams& p) {
           {"format", p.binary ? "binary" : "ascii"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
-          {"run", p.run},                   {"run_mesh", p.run_snappy ? "snappy" : "gmsh"}};
+          {"run", p.run},                   {"run_mesh", p.run_snappy ? "snappy" : "gmsh"},
+          {"convergence", {{"levels", p.convergence.levels}, {"ratio", p.convergence.ratio}}}};
 }
 
 BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d) {
@@ -97,7 +109,8 @@ nlohmann::json CaseInfo::to_json() const {
           {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
           {"aspect_ratio", aspect_ratio},
           {"inlet_area_m2", inlet_area_m2},
-          {"d_ref_m", d_ref_m}};
+          {"d_ref_m", d_ref_m},
+          {"fluid_volume_m3", fluid_volume_m3}};
 }
 
 nlohmann::json FlowResult::to_json() const {
@@ -379,7 +392,10 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     fs::remove_all(tmp, ec);
     throw;
   }
-  return {case_dir, p, u, nu, static_cast<long>(mesh.cells), section, g.aspect_ratio, g.cross_section_area, g.d_ref};
+  double fluid_volume = 0.0;
+  for (double v : geometry.volumes) fluid_volume += v;
+  return {case_dir, p, u, nu, static_cast<long>(mesh.cells), section, g.aspect_ratio, g.cross_section_area, g.d_ref,
+          fluid_volume};
 }
 
 namespace {

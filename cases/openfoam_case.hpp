@@ -34,6 +34,12 @@ struct CaseParams {
   double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
   bool run_snappy = false;              // run_mesh = "snappy": the run meshes with snappyHexMesh first (needs snappy)
+  // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
+  // drop's discretisation error (Richardson extrapolation and the grid convergence index).
+  struct Convergence {
+    int levels = 0;        // meshes in all, the scene's own the finest; 0: no study, else 3-6
+    double ratio = 1.3;    // cell size ratio between successive levels (surface and volume together)
+  } convergence;
 };
 CaseParams read_case_params(SceneSection& s);
 nlohmann::json to_json(const CaseParams& p);
@@ -77,6 +83,7 @@ struct CaseInfo {
   double aspect_ratio = 0.0;             // D_h / d, for the correlation
   double inlet_area_m2 = 0.0;
   double d_ref_m = 0.0;
+  double fluid_volume_m3 = 0.0;          // of the mesh's cells
   nlohmann::json to_json() const;        // its report.json entry
 };
 

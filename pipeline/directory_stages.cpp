@@ -18,6 +18,7 @@
 #include "pipeline/surface_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+#include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
@@ -121,12 +122,22 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
 void case_directory(const fs::path& dir, const std::vector<Override>& overrides, bool overwrite, const Console& console) {
   Directory d = open_directory(dir, overrides);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
+#ifndef BEDFORGE_HAVE_VOLUME_MESH
+  if (params.convergence.levels > 0)
+    throw InputError("case.convergence needs the surface and mesh stages, which this bedforge was built without");
+#endif
   const meshing::PolyMesh mesh = meshing::read_msh(dir / "fluid.msh");
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
   const CaseStage c = case_stage(mesh, d.bed, params, prov, scene_to_toml(d.scene),
                                  params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir / "case", overwrite,
                                  console);
-  d.report.set_stage("case", c.report);
+  nlohmann::json entry = c.report;
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // The coarser levels need the whole scene: their surface and mesh settings, scaled.
+  if (params.convergence.levels > 0)
+    add_convergence_study(read_scene(d.scene, (dir / "scene.toml").string(), dir), d.bed, c, dir, console, entry);
+#endif
+  d.report.set_stage("case", std::move(entry));
   d.report.save(dir);
 }
 #endif

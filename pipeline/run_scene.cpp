@@ -18,6 +18,7 @@
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 #include "meshing/gmsh_model.hpp"
 #include "pipeline/case_stage.hpp"
+#include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
 #endif
 
@@ -110,7 +111,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     const CaseStage c = case_stage(*mesh, bed, scene.case_params, prov, read_file(dir / "scene.toml"),
                                    scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(),
                                    dir / "case", opt.overwrite, console);
-    record("case", c.report, keys.case_);
+    nlohmann::json entry = c.report;
+    if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, dir, console, entry);
+    record("case", std::move(entry), keys.case_);
   } else {
     reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));
   }

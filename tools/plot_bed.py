@@ -7,7 +7,11 @@ DIR holds what `bedforge run` or `bedforge analyse` wrote: the wall profiles (ra
 wall_profile_*.csv, with their centre distributions and line-intersection versions),
 axial_profile.csv and report.json. Writes a PNG per wall profile,
 DIR/axial_profile.png and DIR/convergence.png: the convergence history of every iterative stage
-the report holds (packer, mesh optimiser, flow solve), error against elapsed time.
+the report holds (packer, mesh optimiser, flow solve), error against elapsed time; and, when the
+case ran a mesh-convergence study ([case.convergence]), DIR/mesh_convergence.png: dp/L against
+cell size on each level, the Richardson extrapolation with the grid convergence index of the
+finest mesh, and Eisfeld & Schnitzlein's correlation with the +-20 % scatter of its data
+(docs/reference.md).
 """
 import json
 import os
@@ -54,6 +58,40 @@ def main(d):
         ax.set_xlabel("void fraction"), ax.set_ylabel("height z/d"), ax.grid(alpha=0.3)
         fig.tight_layout(), fig.savefig(os.path.join(d, "axial_profile.png"), dpi=110), plt.close(fig)
     plot_convergence(report, os.path.join(d, "convergence.png"))
+    case = report.get("stages", {}).get("case", {})
+    if "convergence" in case:
+        plot_mesh_convergence(case, os.path.join(d, "mesh_convergence.png"))
+
+
+def plot_mesh_convergence(case, path):
+    """dp/L against cell size h = (V/N)^(1/3) over d on every level that gave a value; the
+    extrapolation to h = 0 with the finest level's GCI as its band, when the study concluded one;
+    the correlation at the finest mesh's section void fraction with its data's scatter."""
+    study, d = case["convergence"], case["d_ref_m"]
+    ok = [lv for lv in study["levels"] if "failure" not in lv]
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    h = [lv["cell_size_m"] / d for lv in ok]
+    ax.plot(h, [lv["pressure_gradient_bed_pa_m"] for lv in ok], "ko-", label="levels (1 = the scene's mesh)")
+    for lv in ok:
+        ax.annotate(str(lv["level"]), (lv["cell_size_m"] / d, lv["pressure_gradient_bed_pa_m"]), fontsize=8,
+                    textcoords="offset points", xytext=(4, 4))
+    g = study.get("grid_convergence", {})
+    if g.get("extrapolated") is not None:
+        fine = ok[0]["pressure_gradient_bed_pa_m"]
+        band = g["gci_fine"] * abs(fine)
+        ax.errorbar([0.0], [g["extrapolated"]], fmt="rs", label=f"extrapolated, order {g['apparent_order']:.2f}")
+        ax.errorbar([h[0]], [fine], yerr=[[band], [band]], fmt="none", ecolor="r", capsize=4,
+                    label=f"GCI of the finest mesh {100 * g['gci_fine']:.1f} %")
+    flow = case.get("flow", {})
+    if "eisfeld_schnitzlein_pa_m" in flow:
+        es = flow["eisfeld_schnitzlein_pa_m"]
+        ax.axhspan(0.8 * es, 1.2 * es, color="g", alpha=0.12)
+        ax.axhline(es, color="g", lw=1,
+                   label=f"Eisfeld & Schnitzlein +-20 % at eps {flow['void_fraction_section']:.3f}")
+    ax.set_xlim(left=-0.02 * max(h + [0.1]))
+    ax.set_xlabel("cell size (V/N)^(1/3) / d"), ax.set_ylabel("dp/L (Pa/m)"), ax.grid(alpha=0.3)
+    ax.set_title(study["conclusion"][:110], fontsize=7), ax.legend(fontsize=7)
+    fig.tight_layout(), fig.savefig(path, dpi=110), plt.close(fig)
 
 
 def plot_convergence(report, path):

@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
+#include "analysis/grid_convergence.hpp"
 #include "core/error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -20,13 +22,18 @@ using namespace bedforge::pipeline;
 
 namespace {
 
-// 12 spheres in a = 3 with a coarse surface: every stage, in seconds. `extra` adds sections.
-Scene small_scene(const std::string& outputs, const std::string& extra = "") {
-  const std::string text = "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n"
-                           "[surface]\nedge_length_d = 0.1\n[mesh]\nthreads = 1\n[outputs]\nfiles = [" +
-                           outputs + "]\n" + extra;
+// 12 spheres in a = 3 with a coarse surface: every stage, in seconds. `extra` adds sections;
+// `surface` replaces the surface and contact settings.
+Scene small_scene(const std::string& outputs, const std::string& extra = "",
+                  const std::string& surface = "[surface]\nedge_length_d = 0.1\n") {
+  const std::string text = "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n" + surface +
+                           "[mesh]\nthreads = 1\n[outputs]\nfiles = [" + outputs + "]\n" + extra;
   return read_scene(parse_scene_text(text, "small.toml"), "small.toml");
 }
+
+// For flow studies: gaps of 6 % of a diameter at contacts (3 % at the wall) leave room for
+// coarse wall facets (0.2 d and coarser), so each solve takes seconds.
+const std::string kOpenSurface = "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.2\n";
 
 // What a run printed and which stages it built, from the report's "reused" marks.
 struct RunOutcome {
@@ -121,4 +128,70 @@ TEST(RunScene, FilesDeletedByHandAreMadeAgain) {
   std::stringstream s;
   s << in.rdbuf();
   EXPECT_EQ(s.str(), vtp);  // the same bed, read back from bed.csv
+}
+
+// [case.convergence]: the scene's mesh and two coarser ones, each solved; the verdict is the
+// grid-convergence procedure's on the levels' own numbers.
+TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
+  const fs::path dir = test_support::fresh_dir("convergence");
+  const Scene scene =
+      small_scene("\"case\"", "[case]\nrun = true\n[case.convergence]\nlevels = 3\nratio = 1.4\n", kOpenSurface);
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& study = r.stages["case"]["convergence"];
+  ASSERT_EQ(study["levels"].size(), 3u) << study.dump();
+  for (int k = 0; k < 3; ++k) {
+    const auto& level = study["levels"][k];
+    ASSERT_FALSE(level.contains("failure")) << level.dump();
+    EXPECT_EQ(level["level"], k + 1);
+    EXPECT_NEAR(level["scale"].get<double>(), std::pow(1.4, k), 1e-12);
+  }
+  EXPECT_EQ(study["levels"][0]["cells"], r.stages["case"]["cells"]);  // the scene's own mesh is the finest
+  EXPECT_EQ(study["levels"][0]["pressure_gradient_bed_pa_m"], r.stages["case"]["flow"]["pressure_gradient_bed_pa_m"]);
+  for (int k = 1; k < 3; ++k) {
+    // Coarser lengths, fewer cells; the procedure takes each level's own cell size, since the
+    // surface's rules (points per sphere, per loop) keep the fall from being ratio^3 exactly.
+    EXPECT_LT(study["levels"][k]["cells"].get<long>(), study["levels"][k - 1]["cells"].get<long>()) << k;
+    EXPECT_GT(study["levels"][k]["cell_size_m"].get<double>(), study["levels"][k - 1]["cell_size_m"].get<double>());
+  }
+  ASSERT_TRUE(study["complete"].get<bool>()) << study.dump();
+  std::vector<bedforge::analysis::GridLevel> levels;
+  for (const auto& l : study["levels"])
+    levels.push_back({l["cell_size_m"].get<double>(), l["pressure_gradient_bed_pa_m"].get<double>()});
+  EXPECT_EQ(study["grid_convergence"], bedforge::analysis::grid_convergence(levels).to_json());
+  EXPECT_NE(r.stages["case"]["summary"].get<std::string>().find("convergence: levels 1-3"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "convergence/level_3/Allrun"));
+  // Rerun unchanged: the study is part of the case, reused with it.
+  const RunOutcome again = run(scene, dir);
+  EXPECT_FALSE(again.built("case"));
+  EXPECT_EQ(again.stages["case"]["convergence"], study);
+}
+
+// A study whose levels all fail (here the solver is stopped after 2 iterations) says so, level by
+// level, and concludes nothing.
+TEST(RunScene, AConvergenceStudyReportsTheLevelsThatFailed) {
+  const fs::path dir = test_support::fresh_dir("convergence_failed");
+  const Scene scene = small_scene(
+      "\"case\"", "[case]\nrun = true\niterations = 2\n[case.convergence]\nlevels = 3\nratio = 1.4\n", kOpenSurface);
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& study = r.stages["case"]["convergence"];
+  EXPECT_FALSE(study["complete"].get<bool>());
+  EXPECT_FALSE(study.contains("grid_convergence"));
+  for (const auto& level : study["levels"])
+    EXPECT_NE(level.value("failure", "").find("did not converge"), std::string::npos) << level.dump();
+  EXPECT_NE(study["conclusion"].get<std::string>().find("no three successive levels"), std::string::npos);
+}
+
+TEST(RunScene, AConvergenceRequestThatCannotWorkIsRefusedByKey) {
+  auto refused = [](const std::string& extra, const std::string& key) {
+    try {
+      small_scene("\"case\"", extra);
+      ADD_FAILURE() << "accepted: " << extra;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  refused("[case]\nrun = true\n[case.convergence]\nlevels = 2\n", "case.convergence.levels");
+  refused("[case]\nrun = true\n[case.convergence]\nlevels = 3\nratio = 1.05\n", "case.convergence.ratio");
+  refused("[case.convergence]\nlevels = 3\n", "case.run = true");
+  refused("[case]\nrun = true\n[case.convergence]\nlevels = 3\nrefine = 2\n", "case.convergence.refine");
 }

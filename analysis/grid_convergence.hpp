@@ -1,0 +1,45 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace bedforge::analysis {
+
+// One mesh of a grid-convergence study: its representative cell size h = (V / N)^(1/3) (m, V
+// the domain's volume, N its cells) and the quantity phi computed on it (e.g. dp/L, Pa/m).
+struct GridLevel {
+  double cell_size = 0.0;
+  double value = 0.0;
+};
+
+// The verdict of Celik et al. (2008, J. Fluids Eng. 130, 078001) on three meshes, the
+// Richardson extrapolation and the grid convergence index of Roache (1994).
+struct GridConvergence {
+  enum class Verdict {
+    monotone,     // s > 0 and a positive order: p, phi_ext and the GCI apply
+    oscillatory,  // e32 and e21 of opposite signs: no extrapolation
+    divergent,    // |e32 / e21| <= ln r32 / ln r21 (1 for equal ratios): no positive order
+    unresolved,   // e21 = 0 or e32 = 0 to round-off: nothing to extrapolate from
+  };
+  Verdict verdict = Verdict::unresolved;
+  double r21 = 0.0, r32 = 0.0;      // refinement ratios h2/h1, h3/h2
+  double order = 0.0;               // apparent order p (NaN unless monotone)
+  double extrapolated = 0.0;        // phi_ext (NaN unless monotone)
+  double relative_error_fine = 0.0; // e_a21 = |(phi1 - phi2) / phi1|
+  double extrapolated_error_fine = 0.0;  // e_ext21 = |(phi_ext - phi1) / phi_ext|
+  double gci_fine = 0.0;            // GCI_21 = 1.25 e_a21 / (r21^p - 1), relative
+  double gci_medium = 0.0;          // GCI_32, for the asymptotic-range check
+  double asymptotic_ratio = 0.0;    // GCI_32 / (r21^p GCI_21): near 1 in the asymptotic range
+  std::string explanation;          // one sentence a report can show
+  nlohmann::json to_json() const;
+};
+
+const char* verdict_name(GridConvergence::Verdict v);
+
+// Applies the procedure to `levels` ordered fine (1), medium (2), coarse (3): the apparent order
+// by fixed-point iteration on p = |ln|e32/e21| + q(p)| / ln r21, q(p) = ln((r21^p - s)/(r32^p - s)).
+// std::invalid_argument unless there are exactly three levels, each coarser than the one before
+// (cell sizes strictly increasing) and all values finite.
+GridConvergence grid_convergence(const std::vector<GridLevel>& levels);
+
+}  // namespace bedforge::analysis

@@ -1,0 +1,122 @@
+#include "pipeline/convergence_study.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <exception>
+
+#include "core/bed_io.hpp"
+#include "core/stage_meter.hpp"
+#include "core/version.hpp"
+#include "pipeline/case_stage.hpp"
+#include "pipeline/mesh_stage.hpp"
+#include "pipeline/surface_stage.hpp"
+
+namespace bedforge::pipeline {
+
+namespace fs = std::filesystem;
+
+nlohmann::json ConvergenceStudy::to_json() const {
+  nlohmann::json out = {{"complete", complete}, {"conclusion", conclusion}, {"levels", nlohmann::json::array()}};
+  for (const StudyLevel& l : levels) {
+    nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}};
+    if (l.failure.empty()) {
+      j.update({{"cells", l.cells},
+                {"cell_size_m", l.cell_size_m},
+                {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
+                {"converged", l.converged}});
+    } else {
+      j["failure"] = l.failure;
+    }
+    out["levels"].push_back(std::move(j));
+  }
+  if (complete) out["grid_convergence"] = convergence.to_json();
+  return out;
+}
+
+StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s) {
+  StudyLevel l;
+  l.level = level;
+  l.scale = scale;
+  l.cells = solved.info.cells;
+  l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3 / static_cast<double>(l.cells));
+  l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
+  l.converged = solved.flow->converged;
+  if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
+  l.time_s = time_s;
+  return l;
+}
+
+namespace {
+
+// Level k of the study: the scene's mesh lengths scaled by `scale`, solved in `case_dir`.
+StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double scale, const fs::path& case_dir,
+                       const Console& console) {
+  const StageMeter meter;
+  StudyLevel l;
+  l.level = k;
+  l.scale = scale;
+  meshing::SurfaceParams surface = scene.surface;
+  surface.edge_length_d *= scale;
+  surface.contact_edge_length_d *= scale;
+  meshing::VolumeMeshParams mesh = scene.mesh;
+  mesh.max_size_d *= scale;
+  try {
+    const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
+    const MeshStage m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, mesh, {},
+                                   case_dir.parent_path() / "bad_cells.vtk", console);
+    const Provenance prov{kVersion, scene.seed, scene.to_json()};
+    const CaseStage c = case_stage(m.volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
+                                   case_dir, true, console);
+    l = study_level(c, k, scale, 0.0);
+  } catch (const std::exception& e) {
+    l.failure = e.what();
+  }
+  l.time_s = meter.seconds();
+  return l;
+}
+
+}  // namespace
+
+ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const fs::path& dir,
+                                   const Console& console) {
+  const cases::CaseParams::Convergence& p = scene.case_params.convergence;
+  ConvergenceStudy study;
+  study.levels.push_back(finest);
+  for (int k = 2; k <= p.levels; ++k) {
+    const double scale = std::pow(p.ratio, k - 1);
+    console.line(fmt::format("convergence: level {} of {}, mesh lengths x {:.3g}", k, p.levels, scale));
+    study.levels.push_back(solve_level(scene, bed, k, scale, dir / fmt::format("level_{}", k), console));
+  }
+  // The finest three levels in a row that gave a value.
+  for (std::size_t first = 0; first + 2 < study.levels.size(); ++first) {
+    const StudyLevel* three[] = {&study.levels[first], &study.levels[first + 1], &study.levels[first + 2]};
+    if (!three[0]->failure.empty() || !three[1]->failure.empty() || !three[2]->failure.empty()) continue;
+    study.convergence = analysis::grid_convergence({{three[0]->cell_size_m, three[0]->pressure_gradient_pa_m},
+                                                    {three[1]->cell_size_m, three[1]->pressure_gradient_pa_m},
+                                                    {three[2]->cell_size_m, three[2]->pressure_gradient_pa_m}});
+    study.complete = true;
+    study.conclusion = fmt::format("levels {}-{}: {}", three[0]->level, three[2]->level, study.convergence.explanation);
+    if (first > 0) study.conclusion += fmt::format(" (level {} failed, so this is not the scene's own mesh)", first);
+    break;
+  }
+  if (!study.complete) {
+    std::string failed;
+    for (const StudyLevel& l : study.levels)
+      if (!l.failure.empty()) failed += fmt::format("{}level {}: {}", failed.empty() ? "" : "; ", l.level, l.failure);
+    study.conclusion = "no three successive levels gave a pressure drop, so no error estimate: " + failed;
+  }
+  return study;
+}
+
+void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const fs::path& dir,
+                           const Console& console, nlohmann::json& case_entry) {
+  const StudyLevel finest = study_level(solved, 1, 1.0, case_entry["time_s"].get<double>());
+  const ConvergenceStudy study = convergence_study(scene, bed, finest, dir / "convergence", console);
+  case_entry["convergence"] = study.to_json();
+  const std::string line = "convergence: " + study.conclusion;
+  case_entry["summary"] = case_entry["summary"].get<std::string>() + "; " + line;
+  console.line(line);
+}
+
+}  // namespace bedforge::pipeline

@@ -1,0 +1,56 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "analysis/grid_convergence.hpp"
+#include "cases/openfoam_case.hpp"
+#include "core/bed.hpp"
+#include "pipeline/case_stage.hpp"
+#include "pipeline/console.hpp"
+#include "pipeline/scene.hpp"
+
+namespace bedforge::pipeline {
+
+// One mesh of a convergence study and the flow on it.
+struct StudyLevel {
+  int level = 0;              // 1 the finest (the scene's own mesh), then coarser
+  double scale = 1.0;         // its lengths over the scene's: ratio^(level - 1)
+  long cells = 0;
+  double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
+  double pressure_gradient_pa_m = 0.0;
+  bool converged = false;     // the solver's own verdict
+  double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one;
+                              // the flow alone of the finest (its surface and mesh may be reused)
+  std::string failure;        // why the level gave no value (empty when it did)
+};
+
+// The pressure drop's discretisation error from the flow solved on the scene's mesh and on
+// coarser ones: the levels and the verdict on the finest three that gave a value.
+struct ConvergenceStudy {
+  std::vector<StudyLevel> levels;
+  bool complete = false;                 // three usable finest levels in a row
+  analysis::GridConvergence convergence; // when complete
+  std::string conclusion;                // what the study could and could not conclude
+  nlohmann::json to_json() const;
+};
+
+// Level `level` (lengths x `scale`) from its solved case.
+StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s);
+
+// The study of [case.convergence] on `bed` (m): `finest` is the scene's own level, already
+// solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's
+// surface.edge_length_d, surface.contact_edge_length_d and mesh.max_size_d by ratio^(k - 1),
+// builds its surface and mesh in memory and solves its case in `dir`/level_k. A level that
+// fails (a gate, the solver) is reported with its reason, and the others go on.
+ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest,
+                                   const std::filesystem::path& dir, const Console& console);
+
+// Runs the study of [case.convergence] after the scene's case `solved`, into `dir`/convergence,
+// and adds it to the case's report entry (its "convergence" and a summary that ends with the
+// study's conclusion, which is printed).
+void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const std::filesystem::path& dir,
+                           const Console& console, nlohmann::json& case_entry);
+
+}  // namespace bedforge::pipeline

@@ -1,0 +1,65 @@
+// Richardson extrapolation and the grid convergence index (Celik et al. 2008) on values made
+// from an exact power law phi(h) = phi_0 + C h^p, where the procedure must give p and phi_0 back,
+// and on sequences it must refuse to extrapolate.
+#include "analysis/grid_convergence.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+using namespace bedforge::analysis;
+
+namespace {
+
+std::vector<GridLevel> power_law(double phi0, double c, double p, double h1, double r21, double r32) {
+  const double h2 = h1 * r21, h3 = h2 * r32;
+  auto phi = [&](double h) { return phi0 + c * std::pow(h, p); };
+  return {{h1, phi(h1)}, {h2, phi(h2)}, {h3, phi(h3)}};
+}
+
+}  // namespace
+
+TEST(GridConvergence, AnExactPowerLawGivesItsOrderAndLimitBack) {
+  for (double p : {1.0, 2.0, 2.7})
+    for (auto [r21, r32] : {std::pair{1.5, 1.5}, std::pair{1.3, 1.7}, std::pair{2.0, 1.31}})
+      for (double c : {3.0, -3.0}) {
+        const auto levels = power_law(16.0, c, p, 0.1, r21, r32);
+        const GridConvergence g = grid_convergence(levels);
+        ASSERT_EQ(g.verdict, GridConvergence::Verdict::monotone) << p << " " << r21 << " " << r32;
+        EXPECT_NEAR(g.order, p, 1e-9) << r21 << " " << r32;
+        EXPECT_NEAR(g.extrapolated, 16.0, 1e-9);
+        EXPECT_NEAR(g.r21, r21, 1e-12);
+        // The definitions, term by term.
+        const double ea = std::abs((levels[1].value - levels[0].value) / levels[0].value);
+        EXPECT_NEAR(g.relative_error_fine, ea, 1e-15);
+        EXPECT_NEAR(g.gci_fine, 1.25 * ea / (std::pow(r21, p) - 1.0), 1e-12);
+        EXPECT_NEAR(g.extrapolated_error_fine, std::abs(c) * std::pow(0.1, p) / 16.0, 1e-9);
+        // In the asymptotic range by construction: GCI_32 / (r21^p GCI_21) = phi1 / phi2.
+        EXPECT_NEAR(g.asymptotic_ratio, levels[0].value / levels[1].value, 1e-9);
+        // The GCI is a band, 1.25 times the estimated error: it holds the exact value.
+        EXPECT_GE(g.gci_fine * std::abs(levels[0].value), std::abs(levels[0].value - 16.0) * (1 - 1e-9));
+      }
+}
+
+TEST(GridConvergence, OscillatingOrGrowingDifferencesAreNotExtrapolated) {
+  const GridConvergence osc = grid_convergence({{0.1, 1.00}, {0.13, 1.10}, {0.17, 1.05}});
+  EXPECT_EQ(osc.verdict, GridConvergence::Verdict::oscillatory);
+  EXPECT_TRUE(std::isnan(osc.order) && std::isnan(osc.extrapolated) && std::isnan(osc.gci_fine));
+  EXPECT_NE(osc.explanation.find("oscillates"), std::string::npos);
+  const GridConvergence div = grid_convergence({{0.1, 1.00}, {0.13, 1.20}, {0.17, 1.25}});
+  EXPECT_EQ(div.verdict, GridConvergence::Verdict::divergent);
+  EXPECT_TRUE(std::isnan(div.extrapolated));
+  const GridConvergence flat = grid_convergence({{0.1, 2.0}, {0.13, 2.0}, {0.17, 2.5}});
+  EXPECT_EQ(flat.verdict, GridConvergence::Verdict::unresolved);
+  // Reported as null, not as a number.
+  EXPECT_TRUE(osc.to_json()["extrapolated"].is_null());
+  EXPECT_EQ(osc.to_json()["verdict"], "oscillatory");
+}
+
+TEST(GridConvergence, RefusesWhatIsNotThreeMeshesFromFineToCoarse) {
+  EXPECT_THROW(grid_convergence({{0.1, 1.0}, {0.2, 1.1}}), std::invalid_argument);
+  EXPECT_THROW(grid_convergence({{0.1, 1.0}, {0.1, 1.1}, {0.2, 1.2}}), std::invalid_argument);
+  EXPECT_THROW(grid_convergence({{0.2, 1.0}, {0.15, 1.1}, {0.1, 1.2}}), std::invalid_argument);
+  EXPECT_THROW(grid_convergence({{0.1, NAN}, {0.15, 1.1}, {0.2, 1.2}}), std::invalid_argument);
+}
