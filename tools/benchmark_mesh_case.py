@@ -23,6 +23,10 @@ snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 pro
         the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
         case, with the time and peak memory of every stage.
+study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedforge run` with
+        [case.convergence] (--levels meshes, --ratio between them): each level's cells, dp/L and
+        time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
+        run's wall time from scene to that result. The section records the commit and date.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -43,7 +47,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -175,6 +179,22 @@ def scale(tmp):
     return row
 
 
+def study(tmp, edge, levels, ratio, a=5, n=500, treatment="bridge"):
+    """One run of the scene with a mesh-convergence study; its levels and verdict."""
+    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}")
+    text = scene(a, n, treatment, edge, True) + f"[case.convergence]\nlevels = {levels}\nratio = {ratio}\n"
+    open(path + ".toml", "w").write(text)
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    rep = json.load(open(os.path.join(path, "report.json")))
+    case = rep["stages"]["case"]
+    commit = subprocess.run(["git", "-C", os.path.dirname(DOCS), "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    return {"commit": commit, "date": time.strftime("%Y-%m-%d"), "a": a, "n": n, "treatment": treatment,
+            "edge_d": edge, "ratio": ratio, "wall_s": wall, "peak_mb": peak_mb(rep),
+            "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
+            "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"]}
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -268,6 +288,31 @@ def write(results):
                   f"gmsh's tetrahedra {gen:.0f} s and the optimiser pass with the quality checks "
                   f"{st['mesh'] - gen:.0f} s; the surface {st['surface'] / r['wall_s']:.0%}, the packer "
                   f"{st['pack'] / r['wall_s']:.1%}.", ""]
+    if "study" in results:
+        r = results["study"]
+        st = r["study"]
+        lines += [f"## a = {r['a']}, N = {r['n']}, {r['treatment']}: mesh-convergence study ([case.convergence])", "",
+                  f"Made at commit {r['commit']} on {r['date']}: one `bedforge run` whose finest mesh has a surface "
+                  f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
+                  f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
+                  "| level | lengths x | cells | h / d | dp/L (Pa/m) | / E&S (finest's eps) | time (s) |",
+                  "|---|---|---|---|---|---|---|"]
+        for lv in st["levels"]:
+            if "failure" in lv:
+                lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
+                continue
+            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | "
+                         f"{lv['pressure_gradient_bed_pa_m']:.4g} | {lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | "
+                         f"{lv['time_s']:.0f} |")
+        lines += ["", f"Verdict: {st['conclusion']}."]
+        g = st.get("grid_convergence", {})
+        if g.get("extrapolated") is not None:
+            lines += [f"Extrapolated dp/L {g['extrapolated']:.4g} Pa/m = {g['extrapolated'] / r['es_pa_m']:.3f} x "
+                      f"Eisfeld & Schnitzlein at the finest mesh's section void fraction {r['eps_section']:.4f}; "
+                      f"apparent order {g['apparent_order']:.2f}; GCI of the finest mesh {100 * g['gci_fine']:.1f} % "
+                      f"(target: at most 5 %); asymptotic-range ratio GCI_32 / (r^p GCI_21) "
+                      f"{g['asymptotic_ratio']:.3f} (1 in the asymptotic range)."]
+        lines += [""]
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -305,6 +350,8 @@ def main():
     ap.add_argument("--edges", type=float, nargs="+", default=[0.2, 0.15, 0.1])
     ap.add_argument("--gap-cells", type=float, nargs="+", default=[2, 3])
     ap.add_argument("--layer-thickness", type=float, nargs="+", default=[0.02, 0.05])
+    ap.add_argument("--levels", type=int, default=3, help="study: meshes in all")
+    ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -323,6 +370,9 @@ def main():
             write(results)
         if "scale" in args.only:
             results["scale"] = scale(tmp)
+            write(results)
+        if "study" in args.only:
+            results["study"] = study(tmp, min(args.edges), args.levels, args.ratio)
             write(results)
 
 
