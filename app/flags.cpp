@@ -125,13 +125,9 @@ std::string joined(const std::vector<const char*>& keys) {
   return out;
 }
 
-// The type a row's values take, as help shows it: FLOAT, INT, STRING, or FLOAT FLOAT for a pair.
-std::string type_name(const Flag& f, const KeySpec& spec) {
-  if (!spec.type.ends_with("...")) return spec.type;
-  const std::string one = spec.type.substr(0, spec.type.size() - 3);
-  std::string all = one;
-  for (int k = 1; k < f.values; ++k) all += " " + one;
-  return all;
+// The type of a row's values as help shows it; CLI11 adds "x N" for a row of N values.
+std::string type_name(const KeySpec& spec) {
+  return spec.type.ends_with("...") ? spec.type.substr(0, spec.type.size() - 3) : spec.type;
 }
 
 // The generated help of a row: what it is, its range, the keys it sets, its default.
@@ -164,7 +160,7 @@ void SceneFlags::add_to(CLI::App& app, Command command) {
     if (spec.type == "BOOL") {
       app.add_flag_callback(f.name, [this, row] { given_[row] = {"true"}; }, help(f, spec));
     } else {
-      app.add_option(f.name, given_[row], help(f, spec))->expected(f.values)->type_name(type_name(f, spec));
+      app.add_option(f.name, given_[row], help(f, spec))->expected(f.values)->type_name(type_name(spec));
     }
   }
 }

@@ -139,9 +139,10 @@ std::unique_ptr<Container> read_container(SceneSection& s, double d_ref_m, doubl
     }
   }
   if (2.0 * c->max_radius() < d_max_m * (1.0 - 1e-12))
-    throw InputError(fmt::format("{}: the largest particle ({} m, {:.4g} d) does not fit in the {} ({}); allowed: "
-                                 "a {} of at least that width{}",
-                                 fit_key, d_max_m, d_max_m / d_ref_m, type, c->to_json().dump(),
+    throw InputError(fmt::format("{}: the largest particle ({:.4g} m, {:.4g} d) does not fit in the {} (it holds "
+                                 "spheres up to {:.4g} m, {:.4g} d); allowed: a {} of at least that width{}",
+                                 fit_key, d_max_m, d_max_m / d_ref_m, type, 2.0 * c->max_radius(),
+                                 2.0 * c->max_radius() / d_ref_m,
                                  type == "annulus" ? "gap" : type == "box" ? "side" : "diameter",
                                  c->periodicity().any() ? " (3 diameters for a periodic side)" : ""));
   return c;

@@ -1,12 +1,14 @@
 #include "pipeline/run_scene.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <memory>
 #include <string>
 
 #include "core/atomic_file.hpp"
 #include "core/bed_io.hpp"
+#include "core/error.hpp"
 #include "core/report.hpp"
 #include "core/version.hpp"
 #include "pipeline/analysis_stage.hpp"
@@ -26,7 +28,26 @@ namespace bedforge::pipeline {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The output directory must be one, or a path that can become one: said before any work.
+void check_output_directory(const fs::path& dir) {
+  if (fs::exists(dir) && !fs::is_directory(dir))
+    throw InputError(fmt::format("output directory {}: it exists and is not a directory; allowed: a directory, or a "
+                                 "path where one can be made",
+                                 dir.string()));
+  fs::path existing = fs::absolute(dir);
+  while (!fs::exists(existing)) existing = existing.parent_path();
+  if (!fs::is_directory(existing) || ::access(existing.c_str(), W_OK) != 0)
+    throw InputError(fmt::format("output directory {}: {} is not a directory this user can write in; allowed: a "
+                                 "writable place",
+                                 dir.string(), existing.string()));
+}
+
+}  // namespace
+
 void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, const Console& console) {
+  check_output_directory(dir);
   const nlohmann::json previous =
       opt.force || !fs::exists(dir / "report.json") ? nlohmann::json() : Report::load_or_new(dir).data();
   const StageKeys keys = stage_keys(scene);

@@ -255,6 +255,21 @@ TEST(CommandLine, BadInputIsRejectedByName) {
   expect_rejected("run " + scene("syntax.toml", "[container\n").string(), "syntax.toml:1");
 }
 
+// Checked before any work: an output path that is a file, and a message without raw records.
+TEST(CommandLine, AnOutputThatIsAFileIsRefusedBeforePacking) {
+  const fs::path file = fresh_dir("file_output");
+  std::ofstream(file) << "not a directory\n";
+  const Result r = bedforge("pack --aspect-ratio 4 --count 2000 -o " + file.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("is not a directory"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("pack ("), std::string::npos) << "packed first: " << r.output;
+  EXPECT_EQ(read(file), "not a directory\n");
+  const Result narrow = bedforge("pack --aspect-ratio 0.9 --count 10 -o " + fresh_dir("narrow").string());
+  EXPECT_EQ(narrow.status, 2);
+  EXPECT_NE(narrow.output.find("it holds spheres up to 0.0009 m, 0.9 d"), std::string::npos) << narrow.output;
+  EXPECT_EQ(narrow.output.find('{'), std::string::npos) << "a raw record in the message: " << narrow.output;
+}
+
 TEST(CommandLine, DivergenceIsReportedWithStatusThree) {
   const fs::path out = fresh_dir("cap");
   const Result r = bedforge("pack --aspect-ratio 5 --count 200 --max-iterations 100 -o " + out.string());

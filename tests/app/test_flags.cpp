@@ -41,7 +41,7 @@ TEST(Flags, HelpStatesRangeKeyAndDefaultFromTheSceneReaders) {
       << pack;
   EXPECT_NE(pack.find("sets particles.count); default none (required)"), std::string::npos) << pack;
   const std::string surface = help_of(Command::surface);
-  EXPECT_NE(surface.find("FLOAT FLOAT"), std::string::npos) << surface;  // the clip window's pair
+  EXPECT_NE(surface.find("--clip-window-d FLOAT x 2"), std::string::npos) << surface;  // the window's pair
   EXPECT_NE(surface.find("sets contacts.treatment); default shrink"), std::string::npos) << surface;
 }
 
