@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "analysis/pressure_drop.hpp"
+#include "analysis/void_fraction.hpp"
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -106,7 +107,11 @@ nlohmann::json CaseInfo::to_json() const {
           {"velocity_m_s", velocity_m_s},
           {"kinematic_viscosity_m2_s", kinematic_viscosity_m2_s},
           {"cells", cells},
-          {"section", {{"z_low_m", section.z_low}, {"z_high_m", section.z_high}, {"void_fraction_mesh", section.void_fraction}}},
+          {"section",
+           {{"z_low_m", section.z_low},
+            {"z_high_m", section.z_high},
+            {"void_fraction_mesh", section.void_fraction},
+            {"void_fraction_bed", section.void_fraction_bed}}},
           {"aspect_ratio", aspect_ratio},
           {"inlet_area_m2", inlet_area_m2},
           {"d_ref_m", d_ref_m},
@@ -130,7 +135,10 @@ nlohmann::json FlowResult::to_json() const {
           {"flow_rate_relative_error", flow_rate_relative_error},
           {"eisfeld_schnitzlein_pa_m", eisfeld_schnitzlein_pa_m},
           {"ratio_to_eisfeld_schnitzlein", ratio_to_eisfeld_schnitzlein},
-          {"void_fraction_section", void_fraction_section}};
+          {"void_fraction_section", void_fraction_section},
+          {"eisfeld_schnitzlein_bed_pa_m", eisfeld_schnitzlein_bed_pa_m},
+          {"ratio_to_eisfeld_schnitzlein_bed", ratio_to_eisfeld_schnitzlein_bed},
+          {"void_fraction_section_bed", void_fraction_section_bed}};
 }
 
 namespace {
@@ -240,7 +248,7 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
 }
 
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh, const CaseGeometry& g,
-                    const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                    const Bed& bed, const CaseParams& p, const std::string& note, const std::string& scene_toml,
                     const std::string& bed_csv, const std::string& fluid_stl) {
   refuse_existing_case(case_dir, overwrite);
   std::random_device rd;
@@ -248,7 +256,8 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
   const meshing::CellGeometry geometry = meshing::cell_geometry(mesh);
-  const BedSection section = bed_section(geometry, g, p.section_exclude_d);
+  BedSection section = bed_section(geometry, g, p.section_exclude_d);
+  section.void_fraction_bed = analysis::void_fraction(bed, section.z_low, section.z_high);
   try {
     write_poly_mesh(tmp / "constant/polyMesh", mesh, p.binary, note);
     const std::string fmt_word = p.binary ? "binary" : "ascii";
@@ -543,6 +552,11 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.eisfeld_schnitzlein_pa_m = es;
   r.ratio_to_eisfeld_schnitzlein = gradient / es;
   r.void_fraction_section = eps;
+  const double eps_bed = c.section.void_fraction_bed;
+  r.eisfeld_schnitzlein_bed_pa_m =
+      analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps_bed, a), eps_bed, rho, u, d);
+  r.ratio_to_eisfeld_schnitzlein_bed = gradient / r.eisfeld_schnitzlein_bed_pa_m;
+  r.void_fraction_section_bed = eps_bed;
   return r;
 }
 

@@ -64,7 +64,9 @@ CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed);
 // meshed (cells with their centre between the planes over the container's volume between them),
 // from the mesh's cell geometry.
 struct BedSection {
-  double z_low = 0.0, z_high = 0.0, void_fraction = 0.0;
+  double z_low = 0.0, z_high = 0.0;
+  double void_fraction = 0.0;      // as meshed: the treated contacts and the facets included
+  double void_fraction_bed = 0.0;  // of the spheres as packed, exact (set by write_case)
 };
 BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d);
 
@@ -93,8 +95,8 @@ struct CaseInfo {
 // and flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, and the
 // records `bedforge/scene.toml` and `bedforge/bed.csv`.
 CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
-                    const CaseGeometry& g, const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const std::string& fluid_stl);
+                    const CaseGeometry& g, const Bed& bed, const CaseParams& p, const std::string& note,
+                    const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl);
 
 // The flow solved in a case: the solver's convergence and the bed's pressure gradient.
 struct FlowResult {
@@ -109,9 +111,14 @@ struct FlowResult {
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
-  double eisfeld_schnitzlein_pa_m = 0.0;      // the correlation at the section's void fraction
+  double eisfeld_schnitzlein_pa_m = 0.0;      // the correlation at the section's meshed void fraction
   double ratio_to_eisfeld_schnitzlein = 0.0;
   double void_fraction_section = 0.0;
+  // The same at the section's exact void fraction of the spheres as packed: the bed the
+  // correlation describes, whatever the contact treatment and the facets did to it.
+  double eisfeld_schnitzlein_bed_pa_m = 0.0;
+  double ratio_to_eisfeld_schnitzlein_bed = 0.0;
+  double void_fraction_section_bed = 0.0;
   nlohmann::json history;                // per iteration: residuals and the bed's gradient against time
   nlohmann::json to_json() const;        // the case entry's "flow"
 };

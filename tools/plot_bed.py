@@ -10,7 +10,8 @@ DIR/axial_profile.png and DIR/convergence.png: the convergence history of every 
 the report holds (packer, mesh optimiser, flow solve), error against elapsed time; and, when the
 case ran a mesh-convergence study ([case.convergence]), DIR/mesh_convergence.png: dp/L against
 cell size on each level, the Richardson extrapolation with the grid convergence index of the
-finest mesh, and Eisfeld & Schnitzlein's correlation with the +-20 % scatter of its data
+finest mesh, and Eisfeld & Schnitzlein's correlation at the bed's exact void fraction of the
+section with the +-20 % scatter of its data
 (docs/reference.md).
 """
 import json
@@ -66,7 +67,7 @@ def main(d):
 def plot_mesh_convergence(case, path):
     """dp/L against cell size h = (V/N)^(1/3) over d on every level that gave a value; the
     extrapolation to h = 0 with the finest level's GCI as its band, when the study concluded one;
-    the correlation at the finest mesh's section void fraction with its data's scatter."""
+    the correlation at the bed's exact section void fraction with its data's scatter."""
     study, d = case["convergence"], case["d_ref_m"]
     ok = [lv for lv in study["levels"] if "failure" not in lv]
     fig, ax = plt.subplots(figsize=(6, 4.5))
@@ -83,11 +84,11 @@ def plot_mesh_convergence(case, path):
         ax.errorbar([h[0]], [fine], yerr=[[band], [band]], fmt="none", ecolor="r", capsize=4,
                     label=f"GCI of the finest mesh {100 * g['gci_fine']:.1f} %")
     flow = case.get("flow", {})
-    if "eisfeld_schnitzlein_pa_m" in flow:
-        es = flow["eisfeld_schnitzlein_pa_m"]
+    if "eisfeld_schnitzlein_bed_pa_m" in flow:
+        es = flow["eisfeld_schnitzlein_bed_pa_m"]
         ax.axhspan(0.8 * es, 1.2 * es, color="g", alpha=0.12)
         ax.axhline(es, color="g", lw=1,
-                   label=f"Eisfeld & Schnitzlein +-20 % at eps {flow['void_fraction_section']:.3f}")
+                   label=f"Eisfeld & Schnitzlein +-20 % at the bed's eps {flow['void_fraction_section_bed']:.3f}")
     ax.set_xlim(left=-0.02 * max(h + [0.1]))
     ax.set_xlabel("cell size (V/N)^(1/3) / d"), ax.set_ylabel("dp/L (Pa/m)"), ax.grid(alpha=0.3)
     ax.set_title(study["conclusion"][:110], fontsize=7), ax.legend(fontsize=7)
