@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "analysis/void_fraction.hpp"
 #include "packer/soft_sphere.hpp"
 
@@ -38,10 +40,11 @@ TEST(BedAnalysis, RadialProfileHasTheWallFeatures) {
   const double thin = analysis::radial_void_fraction(bed, cyl.radius(), 0.0, 0.002, 2.0, 14.0).void_fraction.front();
   EXPECT_GT(thin, 0.99);
   EXPECT_LT(j["wall_bin"].get<double>(), thin);  // the 0.05 d bin holds more of those caps
-  // [A] first minimum at z ~ 0.5 d, value about 0.20-0.26 (wider band for one bed of 1200).
+  // [A] first minimum at z ~ 0.5 d, measured minima about 0.20-0.26 (docs/reference.md). This
+  // bed's seeds 1-6 gave 0.208-0.227 (2026-11-24), inside that band with 0.008 to spare.
   EXPECT_NEAR(j["first_minimum_at_d"].get<double>(), 0.5, 0.06);
-  EXPECT_GT(j["first_minimum"].get<double>(), 0.12);
-  EXPECT_LT(j["first_minimum"].get<double>(), 0.32);
+  EXPECT_GT(j["first_minimum"].get<double>(), 0.20);
+  EXPECT_LT(j["first_minimum"].get<double>(), 0.26);
 }
 
 TEST(BedAnalysis, ProfileDampsToTheBulkAndCentresPeakAtHalfADiameter) {
@@ -71,5 +74,12 @@ TEST(BedAnalysis, VoidFractionAndCoordinationAreThoseOfARandomDenseBed) {
   // [A] frictionless jammed spheres: about 6 contacts away from walls, rattlers set apart.
   EXPECT_NEAR(j["coordination"]["bulk_mean_without_rattlers"].get<double>(), 6.0, 0.6);
   EXPECT_LT(j["overlaps"]["max_pair_overlap_d"].get<double>(), 1e-4);
-  EXPECT_GT(j["wall_contacts"]["spheres_touching_lateral_wall"].get<int>(), 100);
+  // The wall contacts against a count made here from the centres alone: a sphere touches the
+  // wall when its centre is within the contact tolerance of R - d/2 (1e-4 d by default).
+  const Bed& bed = bed_at_7_99();
+  const double R = dynamic_cast<const Cylinder&>(*bed.container).radius();
+  int touching = 0;
+  for (const auto& c : bed.centres) touching += R - 0.5 - std::hypot(c.x(), c.y()) <= 1e-4;
+  EXPECT_GT(touching, 300);  // seeds 1-6 of this bed: 436-454 (2026-11-24)
+  EXPECT_EQ(j["wall_contacts"]["spheres_touching_lateral_wall"].get<int>(), touching);
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -93,6 +94,7 @@ TEST(CommandLine, RunFollowsTheScenesOutputs) {
 }
 
 TEST(CommandLine, EveryShippedSceneRuns) {
+  std::set<std::string> with_a_case;  // each has a test in tests/cases/test_openfoam_case.cpp
   for (const auto& e : fs::recursive_directory_iterator(fs::path(BEDFORGE_SOURCE_DIR) / "scenes")) {
     if (e.path().extension() != ".toml") continue;
 #ifndef BEDFORGE_HAVE_CGAL
@@ -103,7 +105,10 @@ TEST(CommandLine, EveryShippedSceneRuns) {
     {
       std::stringstream text;
       text << std::ifstream(e.path()).rdbuf();
-      if (text.str().find("\"case\"]") != std::string::npos) continue;  // scenes making a case have their own tests
+      if (text.str().find("\"case\"]") != std::string::npos) {
+        with_a_case.insert(e.path().filename().string());
+        continue;
+      }
     }
     const fs::path out = fresh_dir("scene_" + e.path().stem().string());
     // The Monte Carlo schedule cut short (the validation tool runs it in full); the options only
@@ -113,6 +118,10 @@ TEST(CommandLine, EveryShippedSceneRuns) {
     EXPECT_EQ(r.status, 0) << e.path() << ": " << r.output;
     EXPECT_TRUE(fs::exists(out / "report.json")) << e.path();
   }
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // A new example that makes a case needs a test of its own there.
+  EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml"}));
+#endif
 }
 
 TEST(CommandLine, ImportedBedIsAnalysed) {
@@ -258,7 +267,9 @@ TEST(CommandLine, BadInputIsRejectedByName) {
 // Checked before any work: an output path that is a file, and a message without raw records.
 TEST(CommandLine, AnOutputThatIsAFileIsRefusedBeforePacking) {
   const fs::path file = fresh_dir("file_output");
+  fs::create_directories(file.parent_path());
   std::ofstream(file) << "not a directory\n";
+  ASSERT_TRUE(fs::is_regular_file(file));
   const Result r = bedforge("pack --aspect-ratio 4 --count 2000 -o " + file.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("is not a directory"), std::string::npos) << r.output;

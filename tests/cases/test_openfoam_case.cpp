@@ -2,6 +2,7 @@
 // `openfoam`; these tests are skipped when its programs are not on PATH).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -221,10 +222,17 @@ TEST(OpenFoamCase, AWalledBoxGivesACaseCheckMeshPasses) {
   const auto cs = nlohmann::json::parse(read(dir / "report.json"))["stages"]["case"];
   EXPECT_NEAR(cs["inlet_area_m2"].get<double>(), 12.0 * d * d, 1e-12);
   EXPECT_NEAR(cs["aspect_ratio"].get<double>(), 24.0 / 7.0, 1e-9);
-  // The bed section's void fraction is a fraction of the box's cross-section.
-  const double eps = cs["section"]["void_fraction_mesh"].get<double>();
-  EXPECT_GT(eps, 0.3);
-  EXPECT_LT(eps, 1.0);
+  // The section's meshed void fraction against the exact one of the packed spheres: shrinking
+  // by 0.99 and the inscribed facets (every vertex on the sphere, so each facetted sphere holds
+  // the ball of its radius less the chordal deviation) only take solid away, at most down to
+  // 0.99^3 (1 - deviation / r)^3 of it. Cells are counted by their centre, an error of about a
+  // cell's height over the section's (0.1 d / 2 d), hence the margin of 0.01 either way.
+  const double eps_bed = cs["section"]["void_fraction_bed"].get<double>();
+  const double eps_mesh = cs["section"]["void_fraction_mesh"].get<double>();
+  const double deviation = nlohmann::json::parse(read(dir / "report.json"))["stages"]["surface"]["chordal_deviation_d"];
+  const double kept = std::pow(0.99, 3) * std::pow(1.0 - deviation / 0.495, 3);
+  EXPECT_GT(eps_mesh, eps_bed - 0.01);
+  EXPECT_LT(eps_mesh, 1.0 - (1.0 - eps_bed) * kept + 0.01) << eps_bed << " " << kept;
 }
 
 TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -201,4 +202,27 @@ TEST(RunScene, AConvergenceRequestThatCannotWorkIsRefusedByKey) {
   refused("[case]\nrun = true\n[case.convergence]\nlevels = 3\nratio = 1.05\n", "case.convergence.ratio");
   refused("[case.convergence]\nlevels = 3\n", "case.run = true");
   refused("[case]\nrun = true\n[case.convergence]\nlevels = 3\nrefine = 2\n", "case.convergence.refine");
+}
+
+// The shipped box example (the other scenes that make a case have tests in
+// tests/cases/test_openfoam_case.cpp): meshed and written by the pipeline, checked by OpenFOAM's
+// checkMesh; its solve is left to the benchmark.
+TEST(RunScene, TheBoxExampleGivesACaseCheckMeshPasses) {
+  const fs::path file = fs::path(BEDFORGE_SOURCE_DIR) / "scenes/examples/box_bed_flow.toml";
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  toml::table table = parse_scene_text(text.str(), file.string());
+  apply_overrides(table, {{"case.run", false}});
+  const Scene scene = read_scene(table, file.string(), file.parent_path());
+  const fs::path dir = test_support::fresh_dir("box_example");
+  run_scene(scene, dir, {run_wants(scene), false, false}, {false, true});
+  const std::string log = (dir / "checkMesh.log").string();
+  const std::string command = "cd '" + (dir / "case").string() +
+                              "' && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} checkMesh > '" + log + "' 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+  std::ifstream check(log);
+  std::stringstream out;
+  out << check.rdbuf();
+  EXPECT_NE(out.str().find("Mesh OK."), std::string::npos) << out.str();
 }
