@@ -71,29 +71,34 @@ int run_command_line(int argc, char** argv) {
   imp->add_option("-o,--output", dir, "output directory (created if missing)")->required();
   flags.add_to(*imp, Command::import);
 
-  CLI::App* analyse = app.add_subcommand("analyse", "analyse DIR/bed.csv: profiles, contacts; adds to DIR/report.json");
+  // A stage run on a directory an earlier stage wrote: DIR and the options of that stage.
+  auto on_directory = [&](const char* name, const char* what, const char* holding, Command command) {
+    CLI::App* sub = app.add_subcommand(name, what);
+    sub->add_option("dir", dir, holding)->required();
+    flags.add_to(*sub, command);
+    return sub;
+  };
+  CLI::App* analyse = on_directory("analyse", "analyse DIR/bed.csv: profiles, contacts; adds to DIR/report.json",
+                                   "directory holding bed.csv (as written by pack or import)", Command::analyse);
   analyse->alias("analyze");
-  analyse->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
-  flags.add_to(*analyse, Command::analyse);
-
 #ifdef BEDFORGE_HAVE_CGAL
-  CLI::App* surface = app.add_subcommand("surface", "treat contacts and build the fluid-domain surface of DIR/bed.csv: "
-                                                    "writes fluid.stl (a named solid per patch), fluid_PATCH.stl, bed.stl, fluid.vtp");
-  surface->add_option("dir", dir, "directory holding bed.csv (as written by pack or import)")->required();
-  flags.add_to(*surface, Command::surface);
+  CLI::App* surface = on_directory("surface",
+                                   "treat contacts and build the fluid-domain surface of DIR/bed.csv: writes fluid.stl "
+                                   "(a named solid per patch), fluid_PATCH.stl, bed.stl, fluid.vtp",
+                                   "directory holding bed.csv (as written by pack or import)", Command::surface);
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
-  CLI::App* mesh = app.add_subcommand("mesh", "mesh the fluid domain of DIR/fluid.stl with gmsh, held to the quality "
-                                              "gate: writes DIR/fluid.msh (bad_cells.vtk when the gate fails)");
-  mesh->add_option("dir", dir, "directory holding fluid.stl and bed.csv (as written by surface)")->required();
-  flags.add_to(*mesh, Command::mesh);
+  CLI::App* mesh = on_directory("mesh",
+                                "mesh the fluid domain of DIR/fluid.stl with gmsh, held to the quality gate: writes "
+                                "DIR/fluid.msh (bad_cells.vtk when the gate fails)",
+                                "directory holding fluid.stl and bed.csv (as written by surface)", Command::mesh);
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
-  CLI::App* case_cmd = app.add_subcommand("case", "write the OpenFOAM case DIR/case from DIR/fluid.msh (simpleFoam, "
-                                                  "laminar); run it with DIR/case/Allrun [-np N]");
-  case_cmd->add_option("dir", dir, "directory holding fluid.msh (as written by mesh)")->required();
+  CLI::App* case_cmd = on_directory("case",
+                                    "write the OpenFOAM case DIR/case from DIR/fluid.msh (simpleFoam, laminar); run it "
+                                    "with DIR/case/Allrun [-np N]",
+                                    "directory holding fluid.msh (as written by mesh)", Command::case_);
   case_cmd->add_flag("--overwrite", overwrite, "replace DIR/case when it exists");
-  flags.add_to(*case_cmd, Command::case_);
 #endif
 
   try {
