@@ -15,8 +15,6 @@ class Report {
   void set_provenance(const std::string& version, const nlohmann::json& scene, unsigned long long seed);
   // `stage` must hold "summary" (one line) and "time_s".
   void set_stage(const std::string& name, nlohmann::json stage);
-  // Records the key stage `name` was made with (see stage_key), so a later run can reuse it.
-  void set_cache_key(const std::string& name, const std::string& key) { data_["stages"][name]["cache_key"] = key; }
   const nlohmann::json& data() const { return data_; }
   // Writes DIR/report.json and DIR/summary.txt (the version, the seed and each stage's line).
   void save(const std::filesystem::path& dir) const;

@@ -97,7 +97,7 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
                                                     {three[2]->cell_size_m, three[2]->pressure_gradient_pa_m}});
     study.complete = true;
     study.conclusion = fmt::format("levels {}-{}: {}", three[0]->level, three[2]->level, study.convergence.explanation);
-    if (first > 0) study.conclusion += fmt::format(" (level {} failed, so this is not the scene's own mesh)", first);
+    if (first > 0) study.conclusion += " (a finer level failed, so the finest here is not the scene's own mesh)";
     break;
   }
   if (!study.complete) {

@@ -300,13 +300,16 @@ def write(results):
                   "| level | lengths x | cells | h / d | dp/L (Pa/m) | / E&S at the bed's eps | "
                   "/ E&S at the finest mesh's eps | time (s) |",
                   "|---|---|---|---|---|---|---|---|"]
+        def bed_ratio(dp):  # runs before the bed's eps was recorded (before a877da4) have none
+            return f"{dp / r['es_bed_pa_m']:.3f}" if "es_bed_pa_m" in r else "not recorded"
+
         for lv in st["levels"]:
             if "failure" in lv:
                 lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | {lv['time_s']:.0f} |")
                 continue
             lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | "
                          f"{lv['pressure_gradient_bed_pa_m']:.4g} | "
-                         f"{lv['pressure_gradient_bed_pa_m'] / r.get('es_bed_pa_m', float('nan')):.3f} | "
+                         f"{bed_ratio(lv['pressure_gradient_bed_pa_m'])} | "
                          f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")
         lines += ["", f"Verdict: {st['conclusion']}."]
         g = st.get("grid_convergence", {})
