@@ -98,4 +98,17 @@ GridConvergence grid_convergence(const std::vector<GridLevel>& levels) {
   return g;
 }
 
+double observed_order(const std::vector<GridLevel>& levels, double exact) {
+  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (const GridLevel& l : levels) {
+    const double e = std::abs(l.value / exact - 1.0);
+    if (!(e > 0.0) || !(l.cell_size > 0.0)) continue;
+    const double x = std::log(l.cell_size), y = std::log(e);
+    n += 1.0, sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double det = n * sxx - sx * sx;
+  if (n < 2.0 || !(det > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (n * sxy - sx * sy) / det;
+}
+
 }  // namespace bedforge::analysis

@@ -42,4 +42,9 @@ const char* verdict_name(GridConvergence::Verdict v);
 // (cell sizes strictly increasing) and all values finite.
 GridConvergence grid_convergence(const std::vector<GridLevel>& levels);
 
+// Verification against a known answer: the order p of the error |phi / exact - 1| ~ C h^p, by
+// least squares on ln error against ln h over `levels` (any order, two or more with distinct
+// sizes). NaN when fewer than two levels have a nonzero error.
+double observed_order(const std::vector<GridLevel>& levels, double exact);
+
 }  // namespace bedforge::analysis

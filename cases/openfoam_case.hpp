@@ -2,6 +2,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -28,6 +29,11 @@ struct CaseParams {
   // graph partitioning, for OpenFOAM builds that have it (Debian's v1912 ships only a stub).
   std::string decomposition = "hierarchical";
   bool binary = true;                   // polyMesh and fields in binary, else ASCII
+  // cells = "polyhedra": Allrun first replaces gmsh's tetrahedra by their dual polyhedra
+  // (OpenFOAM's polyDualMesh), on which the solved pressure drop converges to the exact one;
+  // "tetrahedra" solves on gmsh's cells, whose pressure drop settles about 16 % high in an empty
+  // tube however fine (docs/mesh_case_benchmark.md, verification).
+  bool polyhedra = true;
   bool snappy = false;                  // also write the snappyHexMesh set-up (Allrun -snappy)
   double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
   int snappy_level = 2;                 // refinement levels at particles and walls
@@ -53,7 +59,8 @@ struct CaseGeometry {
   double aspect_ratio = 0.0;
   double cross_section_area = 0.0;
   Eigen::Vector4d lateral_bounds = Eigen::Vector4d::Zero();  // xmin, ymin, xmax, ymax of the cross-section
-  double inlet_z = 0.0, outlet_z = 0.0, bed_top = 0.0;
+  double inlet_z = 0.0, outlet_z = 0.0;
+  double bed_bottom = 0.0, bed_top = 0.0;  // the floor and the top sphere; an empty container's inlet and outlet
 };
 
 // The case geometry of a bed (m) and the mesh of its fluid domain: the inlet and outlet are the
@@ -86,6 +93,9 @@ struct CaseInfo {
   double inlet_area_m2 = 0.0;
   double d_ref_m = 0.0;
   double fluid_volume_m3 = 0.0;          // of the mesh's cells
+  // An empty container's known answer, the fully developed laminar gradient (Pa/m): the route's
+  // verification. Unset for a bed, which is compared with Eisfeld & Schnitzlein instead.
+  std::optional<double> exact_pressure_gradient_pa_m;
   nlohmann::json to_json() const;        // its report.json entry
 };
 
@@ -102,8 +112,9 @@ CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const
 struct FlowResult {
   double time_s = 0.0;                   // wall time of Allrun
   double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
+  std::string mesher;                    // what made the cells solved on: "gmsh tetrahedra", "gmsh polyhedral dual", "snappyHexMesh"
   bool snappy = false;                   // solved on snappyHexMesh's mesh instead of gmsh's
-  long snappy_cells = -1;                // its cells as checkMesh counted them (-1: not found)
+  long solved_cells = -1;                // the cells solved on, as Allrun's checkMesh counted them (-1: no checkMesh ran)
   long iterations = 0;
   bool converged = false;                // SIMPLE's own verdict at the residual targets
   double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
@@ -111,6 +122,10 @@ struct FlowResult {
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
+  // An empty container (no correlation applies): the exact gradient and the relative error
+  // dp/L / exact - 1. For a bed, unset and the correlation's fields below are filled.
+  std::optional<double> exact_pa_m;
+  double relative_error_to_exact = 0.0;
   double eisfeld_schnitzlein_pa_m = 0.0;      // the correlation at the section's meshed void fraction
   double ratio_to_eisfeld_schnitzlein = 0.0;
   double void_fraction_section = 0.0;

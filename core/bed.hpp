@@ -15,6 +15,10 @@ struct Bed {
   std::vector<Eigen::Vector3d> centres;        // m, N
   std::vector<double> diameters;               // m, N
   std::shared_ptr<const Container> container;  // lengths in m
+  // An empty bed (the container alone, a run whose flow has an exact answer) has no spheres to
+  // take its reference diameter from: it keeps the scene's particle diameter (m), the unit of
+  // the scene's _d lengths. Unused when the bed has spheres.
+  double empty_reference_diameter = 0.0;
 
   std::size_t size() const { return centres.size(); }
 };
@@ -24,6 +28,16 @@ inline double sauter_mean(const std::vector<double>& diameters) {
   double s3 = 0.0, s2 = 0.0;
   for (double d : diameters) s3 += d * d * d, s2 += d * d;
   return s2 > 0.0 ? s3 / s2 : 0.0;
+}
+
+// The bed's reference diameter (m): the Sauter mean of its spheres, or an empty bed's own.
+inline double reference_diameter(const Bed& bed) {
+  return bed.size() > 0 ? sauter_mean(bed.diameters) : bed.empty_reference_diameter;
+}
+
+// The largest sphere's diameter (m); an empty bed's reference diameter.
+inline double largest_diameter(const Bed& bed) {
+  return bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) : bed.empty_reference_diameter;
 }
 
 // Height of the bed: the top of its highest sphere (m); 0 for an empty bed.

@@ -49,7 +49,8 @@ ClipHeight clip_height(double asked, double shift, double wanted, const std::vec
 ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes planes,
                                 const std::vector<double>& radius, const ContactExtents& extents) {
   const std::size_t n = bed.size();
-  const double d = sauter_mean(bed.diameters), d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
+  const double d = reference_diameter(bed);
+  const double d_max = largest_diameter(bed);
   const double clearance = p.clip_clearance_d * d;
   std::vector<std::pair<double, double>> sphere_ends;
   for (std::size_t i = 0; i < n; ++i) {

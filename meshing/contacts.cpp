@@ -110,7 +110,7 @@ class ContactTreatment {
  public:
   ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip = {})
       : bed_(bed), p_(p), planes_(planes), clip_(clip), walls_(walls_of(*bed.container)) {
-    d_ = sauter_mean(bed.diameters);
+    d_ = reference_diameter(bed);
     edge_c_ = p.contact_edge_length_d * d_;
     scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
              : p.treatment == SurfaceParams::Treatment::enlarge ? p.enlarge_factor
@@ -142,7 +142,7 @@ class ContactTreatment {
     const double tolerance = treat_below(p_.treatment);
     // Skin: the treatment's tolerance, what a shrink opens and an enlarge closes, and the join
     // gap: every contact of the bed is seen, and every gap the smallest-gap report must cover.
-    const double d_max = *std::max_element(bed_.diameters.begin(), bed_.diameters.end());
+    const double d_max = largest_diameter(bed_);
     const double join = p_.treatment == Treatment::enlarge ? p_.enlarge_join_gap_d * d_ : 0.0;
     const double resized = std::max(std::abs(1.0 - scale_), clip_.opening ? 1.0 - p_.shrink_factor : 0.0);
     NeighbourList nl(std::max(tolerance, 0.0) + resized * d_max + join + 1e-3 * d_);
@@ -635,7 +635,6 @@ class ContactTreatment {
 }  // namespace
 
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes) {
-  if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
   if (!planes.clip) return ContactTreatment(bed, p, planes).run();
   // Survey the whole bed's contacts, place the clip planes clear of them and of every sphere's
   // top and bottom, then treat the window.

@@ -130,8 +130,7 @@ std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>&
 }  // namespace
 
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
-  if (bed.size() == 0) throw InputError("the bed has no spheres to build a surface around");
-  const double d = sauter_mean(bed.diameters), edge = p.edge_length_d * d;
+  const double d = reference_diameter(bed), edge = p.edge_length_d * d;
   const double top = bed_height(bed);
   DomainPlanes planes{-p.inlet_length_d * d, top + p.outlet_length_d * d, p.clip};
   if (p.clip) planes.z0 = p.clip_bottom_d * d, planes.z1 = p.clip_top_d * d;
@@ -252,7 +251,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.bed.weld();
 
   const double domain = c.cross_section_area() * (z1 - z0);
-  const double section = p.clip ? z1 - z0 : top;  // the bed's own height, or the window's
+  const double section = p.clip || n == 0 ? z1 - z0 : top;  // the bed's own height, or the window's (or the empty tube's)
   const MeshQuality q = mesh_quality(f);
   out.report = tb.report;
   out.report["parameters"] = to_json(p);
@@ -261,7 +260,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
   out.report["void_fraction_bed_section_change"] =
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
-  out.report["chordal_deviation_d"] = *std::max_element(chordal.begin(), chordal.end()) / d;
+  out.report["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
   out.report["wall_sagitta_d"] = wall_sag / d;
   out.report["triangles"] = f.triangles.size();
   out.report["min_angle_deg"] = q.min_angle_deg;

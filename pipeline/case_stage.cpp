@@ -13,19 +13,23 @@ CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases:
   out.info = cases::write_case(case_dir, overwrite, mesh, cases::case_geometry(mesh, bed), bed, p, note, scene_toml,
                                bed_to_csv(bed, prov), fluid_stl);
   out.report = out.info.to_json();
-  std::string line = fmt::format("case: {} cells in {}, Re_p {}, u {:.3g} m/s, bed section eps {:.4f} (meshed {:.4f})",
-                                 mesh.cells, case_dir.string(), p.reynolds, out.info.velocity_m_s,
-                                 out.info.section.void_fraction_bed, out.info.section.void_fraction);
+  std::string line = fmt::format("case: {} cells in {}, Re_p {}, u {:.3g} m/s", mesh.cells, case_dir.string(),
+                                 p.reynolds, out.info.velocity_m_s);
+  if (bed.size() > 0)
+    line += fmt::format(", bed section eps {:.4f} (meshed {:.4f})", out.info.section.void_fraction_bed,
+                        out.info.section.void_fraction);
   if (p.run) {
     Progress progress("case", console.progress);
     const cases::FlowResult& flow = out.flow.emplace(cases::run_case(out.info, progress));
     out.report["flow"] = flow.to_json();
-    if (p.run_snappy) line += fmt::format("; snappyHexMesh made {} cells", std::max(flow.snappy_cells, 0L));
-    line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = {:.3f} x "
-                        "Eisfeld & Schnitzlein at the bed's eps ({:.3f} x at the meshed eps)",
+    if (flow.solved_cells != out.info.cells) line += fmt::format("; solved on {} cells ({})", flow.solved_cells, flow.mesher);
+    line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = ",
                         flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
-                        flow.residual_p, flow.pressure_gradient_bed_pa_m, flow.ratio_to_eisfeld_schnitzlein_bed,
-                        flow.ratio_to_eisfeld_schnitzlein);
+                        flow.residual_p, flow.pressure_gradient_bed_pa_m);
+    line += flow.exact_pa_m ? fmt::format("exact laminar flow {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m,
+                                          100.0 * flow.relative_error_to_exact)
+                            : fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps ({:.3f} x at the meshed eps)",
+                                          flow.ratio_to_eisfeld_schnitzlein_bed, flow.ratio_to_eisfeld_schnitzlein);
   }
   finish_stage(out.report, meter, line, console);
   return out;

@@ -25,12 +25,19 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"cell_size_m", l.cell_size_m},
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged}});
+      if (exact_pa_m) j["relative_error_to_exact"] = l.pressure_gradient_pa_m / *exact_pa_m - 1.0;
     } else {
       j["failure"] = l.failure;
     }
     out["levels"].push_back(std::move(j));
   }
   if (complete) out["grid_convergence"] = convergence.to_json();
+  if (exact_pa_m) {
+    out["exact_pa_m"] = *exact_pa_m;
+    out["order_from_exact"] = std::isfinite(order_from_exact) ? nlohmann::json(order_from_exact) : nullptr;
+    if (complete && std::isfinite(convergence.extrapolated))
+      out["extrapolated_error_to_exact"] = convergence.extrapolated / *exact_pa_m - 1.0;
+  }
   return out;
 }
 
@@ -38,10 +45,11 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   StudyLevel l;
   l.level = level;
   l.scale = scale;
-  l.cells = solved.info.cells;
+  l.cells = solved.flow->solved_cells >= 0 ? solved.flow->solved_cells : solved.info.cells;  // the cells solved on
   l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3 / static_cast<double>(l.cells));
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
+  l.exact_pa_m = solved.flow->exact_pa_m;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
   l.time_s = time_s;
   return l;
@@ -105,6 +113,21 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
     for (const StudyLevel& l : study.levels)
       if (!l.failure.empty()) failed += fmt::format("{}level {}: {}", failed.empty() ? "" : "; ", l.level, l.failure);
     study.conclusion = "no three successive levels gave a pressure drop, so no error estimate: " + failed;
+  }
+  if (finest.exact_pa_m) {
+    const double exact = *finest.exact_pa_m;
+    std::vector<analysis::GridLevel> solved;
+    for (const StudyLevel& l : study.levels)
+      if (l.failure.empty()) solved.push_back({l.cell_size_m, l.pressure_gradient_pa_m});
+    study.exact_pa_m = exact;
+    study.order_from_exact = analysis::observed_order(solved, exact);
+    study.conclusion += fmt::format("; against the exact {:.5g} Pa/m", exact);
+    if (!solved.empty())
+      study.conclusion += fmt::format(": finest solved level {:+.3f} %, order {:.2f} from the exact errors",
+                                      100.0 * (solved.front().value / exact - 1.0), study.order_from_exact);
+    if (study.complete && std::isfinite(study.convergence.extrapolated))
+      study.conclusion += fmt::format(", extrapolated {:+.3f} %",
+                                      100.0 * (study.convergence.extrapolated / exact - 1.0));
   }
   return study;
 }

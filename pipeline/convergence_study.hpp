@@ -1,6 +1,7 @@
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,13 +18,14 @@ namespace bedforge::pipeline {
 struct StudyLevel {
   int level = 0;              // 1 the finest (the scene's own mesh), then coarser
   double scale = 1.0;         // its lengths over the scene's: ratio^(level - 1)
-  long cells = 0;
+  long cells = 0;             // the cells the flow was solved on (the polyhedral dual's, by default)
   double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
   double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one;
                               // the flow alone of the finest (its surface and mesh may be reused)
   std::string failure;        // why the level gave no value (empty when it did)
+  std::optional<double> exact_pa_m;  // an empty container's known answer (the case's)
 };
 
 // The pressure drop's discretisation error from the flow solved on the scene's mesh and on
@@ -33,6 +35,10 @@ struct ConvergenceStudy {
   bool complete = false;                 // three usable finest levels in a row
   analysis::GridConvergence convergence; // when complete
   std::string conclusion;                // what the study could and could not conclude
+  // An empty container's exact gradient (Pa/m): each level's error against it and the order of
+  // those errors, the verification of the whole route.
+  std::optional<double> exact_pa_m;
+  double order_from_exact = 0.0;         // observed_order over the levels that gave a value
   nlohmann::json to_json() const;
 };
 

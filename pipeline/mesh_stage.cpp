@@ -11,7 +11,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   std::filesystem::create_directories(bad_cells_path.parent_path());
   Progress progress("mesh", console.progress);
   auto vm = std::make_shared<meshing::VolumeMesh>(
-      meshing::build_volume_mesh(surface, bed, sauter_mean(bed.diameters), p, msh_path, bad_cells_path, progress));
+      meshing::build_volume_mesh(surface, bed, reference_diameter(bed), p, msh_path, bad_cells_path, progress));
   progress.finish();
   MeshStage out{vm, std::move(vm->report)};
   nlohmann::json& j = out.report;

@@ -60,6 +60,11 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
     line = fmt::format("import: {} spheres from {}, max overlap {:.2g} d (wall {:.2g} d)", out.bed.size(),
                        scene.import.file.string(), overlaps["max_pair_overlap_d"].get<double>(),
                        overlaps["max_wall_overlap_d"].get<double>());
+  } else if (scene.count == 0) {
+    out.bed.container = scene.container;
+    out.bed.empty_reference_diameter = scene.sizes.sauter_mean();
+    out.report = {{"algorithm", "none: particles.count = 0, the empty container"}};
+    line = "pack: no spheres (particles.count = 0): the empty container";
   } else {
     Progress progress("pack", console.progress);
     packer::PackResult r =
@@ -72,10 +77,12 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
   }
   out.report["spheres"] = out.bed.size();
   out.report["container_m"] = out.bed.container->to_json();
-  out.report["void_fraction"] = analysis::void_fraction_summary(out.bed, scene.analysis);
-  const auto& vf = out.report["void_fraction"];
-  line += fmt::format(", eps {:.4f} (central {})", vf["whole_bed"].get<double>(),
-                      vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()));
+  if (out.bed.size() > 0) {
+    out.report["void_fraction"] = analysis::void_fraction_summary(out.bed, scene.analysis);
+    const auto& vf = out.report["void_fraction"];
+    line += fmt::format(", eps {:.4f} (central {})", vf["whole_bed"].get<double>(),
+                        vf["central_slab"].is_null() ? std::string("n/a") : fmt::format("{:.4f}", vf["central_slab"].get<double>()));
+  }
   finish_stage(out.report, meter, line, console);
   return out;
 }

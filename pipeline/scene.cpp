@@ -84,8 +84,10 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
     d_max = *std::max_element(diameters.begin(), diameters.end());
     sc.count = static_cast<long long>(diameters.size());
   } else {
-    sc.count = particles.integer("count", 0, 1, 100'000'000, "none (required)");
-    if (!particles.has("count")) throw InputError("particles.count is required: the number of spheres, an integer >= 1");
+    sc.count = particles.integer("count", 0, 0, 100'000'000, "none (required)");
+    if (!particles.has("count"))
+      throw InputError("particles.count is required: the number of spheres, an integer >= 0 (0: the empty container, "
+                       "whose laminar flow has an exact answer)");
     sc.sizes = read_size_distribution(particles);
     d_ref = sc.sizes.sauter_mean();
     d_max = sc.sizes.largest();
@@ -108,6 +110,9 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection outputs = root.sub("outputs");
   sc.outputs = outputs.strings("files", kDefaultOutputs, kOutputs);
   outputs.finish();
+  if (sc.count == 0 && sc.wants("analysis"))
+    throw InputError("outputs.files has \"analysis\", but particles.count = 0 (the empty container) has no spheres to "
+                     "analyse; allowed: \"positions\", \"vtp\", \"stl\", \"mesh\", \"case\"");
 
   SceneSection contacts = root.sub("contacts"), surface = root.sub("surface");
 #ifdef BEDFORGE_HAVE_CGAL

@@ -27,6 +27,12 @@ study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedfor
         [case.convergence] (--levels meshes, --ratio between them): each level's cells, dp/L and
         time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
         run's wall time from scene to that result. The section records the commit and date.
+verification: the empty tube of scenes/examples/empty_tube_verification.toml (D = 2 d, 12 d long,
+        particles.count = 0), whose exact dp/L is Hagen-Poiseuille's, through the same route on
+        tetrahedra and on their polyhedral dual (case.cells): one `bedforge run` each with
+        [case.convergence] (--verify-levels meshes from a finest surface edge --verify-edge d,
+        ratio --verify-ratio); each level's error against the exact value, the order of those
+        errors, and the GCI the study would quote without the exact value.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -47,7 +53,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -187,14 +193,51 @@ def study(tmp, edge, levels, ratio, a=5, n=500, treatment="bridge"):
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     case = rep["stages"]["case"]
-    commit = subprocess.run(["git", "-C", os.path.dirname(DOCS), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    return {"commit": commit, "date": time.strftime("%Y-%m-%d"), "a": a, "n": n, "treatment": treatment,
+    return {**commit_and_date(), "a": a, "n": n, "treatment": treatment,
             "edge_d": edge, "ratio": ratio, "wall_s": wall, "peak_mb": peak_mb(rep),
             "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
             "eps_section_bed": case["flow"]["void_fraction_section_bed"]}
+
+
+def commit_and_date():
+    commit = subprocess.run(["git", "-C", os.path.dirname(DOCS), "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    return {"commit": commit, "date": time.strftime("%Y-%m-%d")}
+
+
+def verification(tmp, edge, levels, ratio):
+    """The empty tube on tetrahedra and on their dual: each a run with a convergence study."""
+    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": ratio, "runs": {}}
+    for cells in ("polyhedra", "tetrahedra"):
+        path = os.path.join(tmp, f"tube_{cells}")
+        open(path + ".toml", "w").write(f"""[container]
+type = "cylinder"
+diameter_d = 2.0
+[particles]
+count = 0
+diameter_m = 0.003
+[surface]
+inlet_length_d = 0.0
+outlet_length_d = 12.0
+edge_length_d = {edge}
+[mesh]
+algorithm = "hxt"
+[case]
+reynolds = 1.0
+section_exclude_d = 3.0
+processors = 2
+run = true
+cells = "{cells}"
+convergence = {{levels = {levels}, ratio = {ratio}}}
+[outputs]
+files = ["case"]
+""")
+        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+        case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
+        out["runs"][cells] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+    return out
 
 
 def write(results):
@@ -320,7 +363,47 @@ def write(results):
                       f"(target: at most 5 %); asymptotic-range ratio GCI_32 / (r^p GCI_21) "
                       f"{g['asymptotic_ratio']:.3f} (1 in the asymptotic range)."]
         lines += [""]
+    if "verification" in results:
+        v = results["verification"]
+        lines += ["## Verification: the empty tube against Hagen-Poiseuille, tetrahedra and their polyhedral dual", "",
+                  f"Made at commit {v['commit']} on {v['date']}: the empty tube (D = 2 d, 12 d long, section 3 d clear "
+                  f"of either end, Re_p = 1) through the same route as a bed, on {v['levels']} meshes from a surface "
+                  f"edge of {v['edge_d']} d, ratio {v['ratio']}; `case.cells` the only difference. Error = dp/L / "
+                  "exact - 1; the order is a least-squares fit of ln |error| against ln h over all levels.", "",
+                  "| cells | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
+                  "|---|---|---|---|---|---|---|"]
+        for cells, run in v["runs"].items():
+            for lv in run["study"]["levels"]:
+                if "failure" in lv:
+                    lines.append(f"| {cells} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
+                    continue
+                lines.append(f"| {cells} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
+                             f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
+                             f"{lv['time_s']:.1f} |")
+        lines.append("")
+        for cells, run in v["runs"].items():
+            st = run["study"]
+            order = st.get("order_from_exact")
+            lines.append(f"- {cells}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
+                         f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
+                         f"the study's own verdict on the finest three: {st['conclusion']}.")
+        lines += ["", "![error against cell size](verification_tube.png)", ""]
+        plot_verification(v)
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
+
+
+def plot_verification(v):
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for cells, run in v["runs"].items():
+        ok = [lv for lv in run["study"]["levels"] if "failure" not in lv]
+        h = [lv["cell_size_m"] / run["d_m"] for lv in ok]
+        ax.loglog(h, [abs(lv["relative_error_to_exact"]) for lv in ok], "o-", label=cells)
+    ax.set_xlabel("cell size h / d, (V / N)^(1/3) of the cells solved on")
+    ax.set_ylabel("|dp/L / Hagen-Poiseuille - 1|")
+    ax.set_title("empty tube D = 2 d, Re_p = 1")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "verification_tube.png"), dpi=120)
 
 
 def plot(results):
@@ -359,6 +442,9 @@ def main():
     ap.add_argument("--layer-thickness", type=float, nargs="+", default=[0.02, 0.05])
     ap.add_argument("--levels", type=int, default=3, help="study: meshes in all")
     ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
+    ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
+    ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
+    ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -380,6 +466,9 @@ def main():
             write(results)
         if "study" in args.only:
             results["study"] = study(tmp, min(args.edges), args.levels, args.ratio)
+            write(results)
+        if "verification" in args.only:
+            results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)
             write(results)
 
 

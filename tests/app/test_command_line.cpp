@@ -94,7 +94,7 @@ TEST(CommandLine, RunFollowsTheScenesOutputs) {
 }
 
 TEST(CommandLine, EveryShippedSceneRuns) {
-  std::set<std::string> with_a_case;  // each has a test in tests/cases/test_openfoam_case.cpp
+  std::set<std::string> with_a_case;  // each has a test in tests/cases or tests/pipeline
   for (const auto& e : fs::recursive_directory_iterator(fs::path(BEDFORGE_SOURCE_DIR) / "scenes")) {
     if (e.path().extension() != ".toml") continue;
 #ifndef BEDFORGE_HAVE_CGAL
@@ -120,7 +120,8 @@ TEST(CommandLine, EveryShippedSceneRuns) {
   }
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // A new example that makes a case needs a test of its own there.
-  EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml"}));
+  EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml",
+                                                "empty_tube_verification.toml"}));
 #endif
 }
 

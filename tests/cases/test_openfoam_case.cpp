@@ -261,10 +261,16 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   EXPECT_GT(flow["solver_peak_memory_mb"].get<double>(), 0.0);
   // Mass conservation: what leaves is what the inlet velocity brings.
   EXPECT_LT(std::abs(flow["flow_rate_relative_error"].get<double>()), 1e-3);
-  // Eisfeld & Schnitzlein at the section's void fraction: particle-resolved CFD commonly
-  // lands within +-20 % of it, the correlation's own scatter (correlations.md, grade C).
-  const double ratio = flow["ratio_to_eisfeld_schnitzlein"].get<double>();
-  EXPECT_GT(ratio, 0.8) << flow.dump();
+  // Solved on the polyhedral dual (the default), not on gmsh's tetrahedra.
+  EXPECT_EQ(flow["mesh"]["mesher"], "gmsh polyhedral dual");
+  EXPECT_LT(flow["mesh"]["cells"].get<long>(), c["cells"].get<long>());
+  // Eisfeld & Schnitzlein at the section's exact void fraction: the correlation's own scatter
+  // is +-20 % (correlations.md, grade C), and this 0.1 d mesh is not converged: on this bed the
+  // dual's dp/L at 0.1 d was 0.65 of what its 0.1, 0.07, 0.05 d sequence extrapolates to
+  // (13.7 against about 21 Pa/m, issue 24). Hence 0.8 x 0.65 below and 1.2 above. (The
+  // tetrahedra's 0.8-1.2 at the meshed void fraction held only through their +16 % bias.)
+  const double ratio = flow["ratio_to_eisfeld_schnitzlein_bed"].get<double>();
+  EXPECT_GT(ratio, 0.8 * 0.65) << flow.dump();
   EXPECT_LT(ratio, 1.2) << flow.dump();
 }
 

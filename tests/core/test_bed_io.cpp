@@ -48,6 +48,27 @@ TEST(BedIo, CsvRoundTripIsBitExactAndKeepsProvenance) {
   EXPECT_EQ(back.header["scene"]["particles"]["count"], 2);
 }
 
+// An empty container (particles.count = 0) keeps the scene's particle diameter, the unit of its
+// _d lengths, through its bed.csv; a file of no rows without that header is still refused.
+TEST(BedIo, AnEmptyBedKeepsItsReferenceDiameter) {
+  Bed bed;
+  bed.container = std::make_shared<Cylinder>(0.003);
+  bed.empty_reference_diameter = 0.0029999999999999996;
+  EXPECT_EQ(reference_diameter(bed), bed.empty_reference_diameter);
+  EXPECT_EQ(largest_diameter(bed), bed.empty_reference_diameter);
+  const fs::path p = temp_dir() / "empty_bed.csv";
+  write_file_atomically(p, bed_to_csv(bed, {"9.9.9", 1ULL, nullptr}));
+  const ImportedBed back = read_bed_text(p, 1.0);
+  EXPECT_EQ(back.bed.size(), 0u);
+  EXPECT_EQ(reference_diameter(back.bed), bed.empty_reference_diameter);
+  ASSERT_TRUE(back.bed.container);
+  // With spheres, the reference is theirs and no such header line is written.
+  bed.centres = {{0.0, 0.0, 0.001}};
+  bed.diameters = {0.002};
+  EXPECT_EQ(reference_diameter(bed), 0.002);
+  EXPECT_EQ(bed_to_csv(bed, {"9.9.9", 1ULL, nullptr}).find("reference_diameter_m"), std::string::npos);
+}
+
 TEST(BedIo, ReadsSpacesTabsSemicolonsAndAColumnHeaderInMillimetres) {
   const auto p = write("dem.txt", "x y z d\n1 2 3 4\n5\t6\t7\t8\r\n9;10;11;12\n\n");
   const ImportedBed b = read_bed_text(p, 1e-3);

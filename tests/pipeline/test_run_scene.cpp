@@ -38,6 +38,11 @@ Scene small_scene(const std::string& outputs, const std::string& extra = "",
 // coarsest level stalled in one of two runs (gmsh's mesh differs between builds).
 const std::string kOpenSurface = "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.15\n";
 
+// The empty tube's coarser levels (1.3 k to 2.7 k polyhedra): twice the largest error measured
+// on such meshes, -2.2 % at 1.3 k cells (2026-11-24; the errors differ from mesh to mesh since
+// gmsh's meshes do).
+const double kCoarseTubeError = 0.044;
+
 // What a run printed and which stages it built, from the report's "reused" marks.
 struct RunOutcome {
   std::string printed;
@@ -61,6 +66,17 @@ RunOutcome run(const Scene& scene, const fs::path& dir, bool overwrite = false) 
 }
 
 fs::file_time_type written(const fs::path& p) { return fs::last_write_time(p); }
+
+// A shipped example scene with `overrides` applied.
+Scene example_scene(const std::string& name, const std::vector<Override>& overrides = {}) {
+  const fs::path file = fs::path(BEDFORGE_SOURCE_DIR) / "scenes/examples" / name;
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  toml::table table = parse_scene_text(text.str(), file.string());
+  apply_overrides(table, overrides);
+  return read_scene(table, file.string(), file.parent_path());
+}
 
 }  // namespace
 
@@ -148,7 +164,9 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
     EXPECT_EQ(level["level"], k + 1);
     EXPECT_NEAR(level["scale"].get<double>(), std::pow(1.3, k), 1e-12);
   }
-  EXPECT_EQ(study["levels"][0]["cells"], r.stages["case"]["cells"]);  // the scene's own mesh is the finest
+  // The scene's own mesh is the finest; the flow is solved on its polyhedral dual.
+  EXPECT_EQ(study["levels"][0]["cells"], r.stages["case"]["flow"]["mesh"]["cells"]);
+  EXPECT_EQ(r.stages["case"]["flow"]["mesh"]["mesher"], "gmsh polyhedral dual");
   // The correlation is also taken at the bed's exact void fraction, of the spheres as packed:
   // below the meshed one, since shrinking and inscribed facets only take solid away.
   const auto& flow = r.stages["case"]["flow"];
@@ -208,13 +226,7 @@ TEST(RunScene, AConvergenceRequestThatCannotWorkIsRefusedByKey) {
 // tests/cases/test_openfoam_case.cpp): meshed and written by the pipeline, checked by OpenFOAM's
 // checkMesh; its solve is left to the benchmark.
 TEST(RunScene, TheBoxExampleGivesACaseCheckMeshPasses) {
-  const fs::path file = fs::path(BEDFORGE_SOURCE_DIR) / "scenes/examples/box_bed_flow.toml";
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  toml::table table = parse_scene_text(text.str(), file.string());
-  apply_overrides(table, {{"case.run", false}});
-  const Scene scene = read_scene(table, file.string(), file.parent_path());
+  const Scene scene = example_scene("box_bed_flow.toml", {{"case.run", false}});
   const fs::path dir = test_support::fresh_dir("box_example");
   run_scene(scene, dir, {run_wants(scene), false, false}, {false, true});
   const std::string log = (dir / "checkMesh.log").string();
@@ -225,4 +237,44 @@ TEST(RunScene, TheBoxExampleGivesACaseCheckMeshPasses) {
   std::stringstream out;
   out << check.rdbuf();
   EXPECT_NE(out.str().find("Mesh OK."), std::string::npos) << out.str();
+}
+
+// Verification of the whole route on a case with an exact answer: the shipped empty tube as
+// shipped (three levels from a 0.2 d surface edge, ratio 1.3, the default polyhedral cells)
+// against Hagen-Poiseuille, 32 mu u / D^2. The bound on the finest level is the 1 % the
+// verification must reach (issue 24); the coarser levels' bound is the largest error measured
+// over the benchmark's levels of this size and coarser (docs/mesh_case_benchmark.md).
+TEST(RunScene, TheEmptyTubeExampleMatchesHagenPoiseuille) {
+  const Scene scene = example_scene("empty_tube_verification.toml");
+  const fs::path dir = test_support::fresh_dir("empty_tube");
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& c = r.stages["case"];
+  const double mu = 1.0e-3, d = 0.003, u = 1.0 * mu / (1000.0 * d), diameter = 2.0 * d;
+  const double exact = 32.0 * mu * u / (diameter * diameter);
+  EXPECT_NEAR(c["exact_pressure_gradient_pa_m"].get<double>(), exact, 1e-12 * exact);
+  const nlohmann::json& study = c["convergence"];
+  ASSERT_EQ(study["levels"].size(), 3u) << study.dump();
+  EXPECT_NEAR(study["exact_pa_m"].get<double>(), exact, 1e-12 * exact);
+  for (const auto& level : study["levels"]) {
+    ASSERT_FALSE(level.contains("failure")) << level.dump();
+    const double error = level["pressure_gradient_bed_pa_m"].get<double>() / exact - 1.0;
+    EXPECT_NEAR(level["relative_error_to_exact"].get<double>(), error, 1e-12);
+    EXPECT_LT(std::abs(error), level["level"] == 1 ? 0.01 : kCoarseTubeError) << level.dump();
+  }
+  EXPECT_FALSE(c["flow"].contains("eisfeld_schnitzlein_pa_m"));  // no correlation for an empty tube
+  EXPECT_NE(study["conclusion"].get<std::string>().find("against the exact"), std::string::npos);
+}
+
+// Why case.cells defaults to polyhedra: on gmsh's tetrahedra themselves the same tube's pressure
+// drop settles far from the exact one (+12 to +17 % on 5 k to 160 k tetrahedra, measured
+// 2026-11-24), on their dual within the 1 % above. The bound is a third of that measured bias.
+TEST(RunScene, OnTetrahedraTheEmptyTubeMissesHagenPoiseuille) {
+  const Scene scene = example_scene("empty_tube_verification.toml",
+                                    {{"case.cells", std::string("tetrahedra")}, {"case.convergence.levels", 0LL}});
+  const fs::path dir = test_support::fresh_dir("empty_tube_tetrahedra");
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& flow = r.stages["case"]["flow"];
+  EXPECT_EQ(flow["mesh"]["mesher"], "gmsh tetrahedra");
+  EXPECT_EQ(flow["mesh"]["cells"], r.stages["case"]["cells"]);
+  EXPECT_GT(flow["relative_error_to_exact"].get<double>(), 0.05) << flow.dump();
 }

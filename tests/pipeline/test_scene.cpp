@@ -25,6 +25,23 @@ TEST(Scene, DefaultsAndRequiredKeys) {
   EXPECT_THROW(read("[particles]\ncount = 10\n"), InputError);           // no container size
 }
 
+// particles.count = 0 is the empty container (a run whose flow has an exact answer): there is
+// nothing to analyse, so asking for the analysis is refused by name; the case is allowed.
+TEST(Scene, AnEmptyContainerRefusesTheAnalysisAndKeepsItsUnit) {
+  try {
+    read("[container]\ndiameter_d = 2\n[particles]\ncount = 0\n");  // the default outputs include "analysis"
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"analysis\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("particles.count = 0"), std::string::npos) << e.what();
+  }
+  const Scene s = read("[container]\ndiameter_d = 2\n[particles]\ncount = 0\ndiameter_m = 0.003\n"
+                       "[outputs]\nfiles = [\"positions\"]\n");
+  EXPECT_EQ(s.count, 0);
+  EXPECT_NEAR(dynamic_cast<const Cylinder&>(*s.container).radius(), 0.003, 1e-15);
+  EXPECT_THROW(read("[container]\ndiameter_d = 2\n[particles]\ncount = -1\n"), InputError);
+}
+
 TEST(Scene, AspectRatioIsInSauterMeanDiameters) {
   // d32 of equal numbers of 1 and 2 mm spheres is 1.8 mm.
   const Scene s = read("[container]\ndiameter_d = 10\n[particles]\ncount = 10\ndistribution = \"discrete\"\n"
