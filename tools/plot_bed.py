@@ -67,7 +67,8 @@ def main(d):
 def plot_mesh_convergence(case, path):
     """dp/L against cell size h = (V/N)^(1/3) over d on every level that gave a value; the
     extrapolation to h = 0 with the finest level's GCI as its band, when the study concluded one;
-    the correlation at the bed's exact section void fraction with its data's scatter."""
+    the correlation at the bed's exact section void fraction with its data's scatter, or an empty
+    container's exact value."""
     study, d = case["convergence"], case["d_ref_m"]
     ok = [lv for lv in study["levels"] if "failure" not in lv]
     fig, ax = plt.subplots(figsize=(6, 4.5))
@@ -89,6 +90,8 @@ def plot_mesh_convergence(case, path):
         ax.axhspan(0.8 * es, 1.2 * es, color="g", alpha=0.12)
         ax.axhline(es, color="g", lw=1,
                    label=f"Eisfeld & Schnitzlein +-20 % at the bed's eps {flow['void_fraction_section_bed']:.3f}")
+    if "exact_pa_m" in study:  # an empty container: the known answer
+        ax.axhline(study["exact_pa_m"], color="b", lw=1, label="exact (fully developed laminar flow)")
     ax.set_xlim(left=-0.02 * max(h + [0.1]))
     ax.set_xlabel("cell size (V/N)^(1/3) / d"), ax.set_ylabel("dp/L (Pa/m)"), ax.grid(alpha=0.3)
     ax.set_title(study["conclusion"][:110], fontsize=7), ax.legend(fontsize=7)
