@@ -2,7 +2,9 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <fstream>
+#include <limits>
 #include <string>
 
 namespace bedforge {
@@ -45,6 +47,22 @@ double children_peak_memory_mb() {
   rusage u{};
   getrusage(RUSAGE_CHILDREN, &u);
   return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+double available_memory_bytes() {
+  double available = std::numeric_limits<double>::infinity();
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string key; meminfo >> key;) {
+    double kb = 0.0;
+    meminfo >> kb;
+    if (key == "MemAvailable:") available = kb * 1024.0;
+    meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  std::ifstream max("/sys/fs/cgroup/memory.max"), current("/sys/fs/cgroup/memory.current");
+  std::string limit;
+  double used = 0.0;
+  if (max >> limit && limit != "max" && current >> used) available = std::min(available, std::stod(limit) - used);
+  return available;
 }
 
 }  // namespace bedforge

@@ -25,4 +25,8 @@ class StageMeter {
 // Largest peak resident memory of the child processes waited for so far (OpenFOAM's solvers), MB.
 double children_peak_memory_mb();
 
+// Memory this process may still take, bytes: the kernel's MemAvailable, or what the cgroup's
+// limit leaves if that is less. Infinity when neither can be read.
+double available_memory_bytes();
+
 }  // namespace bedforge

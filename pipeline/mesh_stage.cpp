@@ -2,6 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
 namespace bedforge::pipeline {
 
 MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m3, const Bed& bed,
@@ -33,6 +38,45 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   }
   finish_stage(j, meter, line, console);
   return out;
+}
+
+MeshEstimate estimate_mesh(const Scene& scene) {
+  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24, kBytesPerCell = 950.0;
+  const double pi = std::acos(-1.0);
+  double d = 0.0, solid = 0.0;
+  if (scene.import.bed) {
+    const Bed& b = scene.import.bed->bed;
+    d = sauter_mean(b.diameters);
+    for (double di : b.diameters) solid += pi / 6.0 * di * di * di;
+  } else {
+    d = scene.sizes.sauter_mean();
+    solid = static_cast<double>(scene.count) * scene.sizes.mean_volume();
+  }
+  const double area = scene.container->cross_section_area();
+  const meshing::SurfaceParams& s = scene.surface;
+  MeshEstimate e;
+  if (s.clip) {
+    e.fluid_volume_m3 = area * (s.clip_top_d - s.clip_bottom_d) * d * kDensestVoidFraction;
+  } else {
+    const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
+    e.fluid_volume_m3 = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
+  }
+  const double h = std::min(s.edge_length_d, scene.mesh.max_size_d) * d;
+  e.cells = e.fluid_volume_m3 / (kVolumePerCell * h * h * h);
+  e.peak_bytes = e.cells * kBytesPerCell;
+  return e;
+}
+
+void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes) {
+  const MeshEstimate e = estimate_mesh(scene);
+  if (e.peak_bytes <= available_bytes) return;
+  // Cells scale with h^-3, so the edge that would fit is this one times the cube root of the excess.
+  const double fits = scene.surface.edge_length_d * std::cbrt(e.peak_bytes / available_bytes);
+  throw InputError(fmt::format(
+      "surface.edge_length_d = {}: the volume mesh would take at least {:.3g} million cells and {:.1f} GB (an estimate "
+      "that errs low), and this machine has {:.1f} GB available; allowed: surface.edge_length_d >= {:.3g}, fewer "
+      "spheres, or a clip window (surface.clip_window_d)",
+      scene.surface.edge_length_d, e.cells / 1e6, e.peak_bytes / 1e9, available_bytes / 1e9, fits));
 }
 
 }  // namespace bedforge::pipeline

@@ -6,6 +6,7 @@
 #include "core/bed.hpp"
 #include "meshing/volume_mesh.hpp"
 #include "pipeline/console.hpp"
+#include "pipeline/scene.hpp"
 
 namespace bedforge::pipeline {
 
@@ -22,5 +23,26 @@ struct MeshStage {
 MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m3, const Bed& bed,
                      const meshing::VolumeMeshParams& params, const std::filesystem::path& msh_path,
                      const std::filesystem::path& bad_cells_path, const Console& console);
+
+// The volume mesh a scene asks for, estimated from the scene alone before anything runs, low
+// on purpose: a refusal on it never stops a run that would have fitted.
+//   fluid volume: the domain less the spheres, the bed at the densest random packing
+//                 (eps 0.36, Scott & Kilgour 1969) so the bed is as short as it can be;
+//   cells:        that volume over 0.24 h^3 per cell, h the surface edge (the largest volume
+//                 per cell of the empty tube's meshes, 0.20-0.24 h^3 from 0.2 d to 0.07 d; beds
+//                 have more, being refined at contacts: a = 10, N = 4000 at 0.1 d made 8.65 M
+//                 cells where this gives 5.6 M);
+//   bytes:        950 per cell, the mesh stage's peak at a = 10, N = 4000 (8.2 GB for 8.65 M
+//                 cells, docs/mesh_case_benchmark.md): a calibration on that one run.
+struct MeshEstimate {
+  double fluid_volume_m3 = 0.0;
+  double cells = 0.0;
+  double peak_bytes = 0.0;
+};
+MeshEstimate estimate_mesh(const Scene& scene);
+
+// InputError naming surface.edge_length_d when the estimate's peak exceeds `available_bytes`
+// (core's available_memory_bytes()): said before packing, not as a crash an hour later.
+void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
 
 }  // namespace bedforge::pipeline

@@ -10,6 +10,7 @@
 #include "core/bed_io.hpp"
 #include "core/error.hpp"
 #include "core/report.hpp"
+#include "core/stage_meter.hpp"
 #include "core/version.hpp"
 #include "pipeline/analysis_stage.hpp"
 #include "pipeline/output_files.hpp"
@@ -53,6 +54,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   const StageKeys keys = stage_keys(scene);
   const RunPlan plan = plan_run(opt.wants, keys, previous, [&dir](const std::string& f) { return fs::exists(dir / f); });
   if (plan.case_.build) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (plan.mesh.build) refuse_mesh_beyond_memory(scene, available_memory_bytes());
+#endif
 
   // Results of other stages in DIR may belong to another bed: the report starts afresh.
   Report report;

@@ -15,6 +15,7 @@
 
 #include "analysis/grid_convergence.hpp"
 #include "core/error.hpp"
+#include "pipeline/mesh_stage.hpp"
 #include "support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -277,4 +278,39 @@ TEST(RunScene, OnTetrahedraTheEmptyTubeMissesHagenPoiseuille) {
   EXPECT_EQ(flow["mesh"]["mesher"], "gmsh tetrahedra");
   EXPECT_EQ(flow["mesh"]["cells"], r.stages["case"]["cells"]);
   EXPECT_GT(flow["relative_error_to_exact"].get<double>(), 0.05) << flow.dump();
+}
+
+// The mesh's estimate from the scene alone: for the empty tube its fluid volume is exact, and
+// its cells fall below what gmsh makes (the estimate errs low, so a refusal is never wrong).
+TEST(RunScene, TheMeshEstimateOfTheEmptyTubeIsExactInVolumeAndLowInCells) {
+  const Scene scene = example_scene("empty_tube_verification.toml", {{"case.convergence.levels", 0LL}});
+  const double pi = std::acos(-1.0), exact_volume = pi * 0.003 * 0.003 * 0.036;
+  const MeshEstimate e = estimate_mesh(scene);
+  EXPECT_NEAR(e.fluid_volume_m3, exact_volume, 1e-12 * exact_volume);
+  const fs::path dir = test_support::fresh_dir("empty_tube_estimate");
+  const RunOutcome r = run(scene, dir);
+  EXPECT_LT(e.cells, r.stages["mesh"]["cells"].get<double>());
+}
+
+// A mesh that cannot fit is refused before packing, naming the key and the edge that would fit:
+// a million spheres at 0.05 d need far more than any machine here (and nothing is written).
+TEST(RunScene, AMeshBeyondMemoryIsRefusedBeforePacking) {
+  const Scene scene = read_scene(parse_scene_text("[container]\ndiameter_d = 40\n[particles]\ncount = 1000000\n"
+                                                  "[surface]\nedge_length_d = 0.05\n[outputs]\nfiles = [\"mesh\"]\n",
+                                                  "huge.toml"),
+                                 "huge.toml");
+  EXPECT_GT(estimate_mesh(scene).peak_bytes, 1e12);
+  const fs::path dir = test_support::fresh_dir("mesh_beyond_memory");
+  try {
+    run_scene(scene, dir, {run_wants(scene), false, false}, {false, false});
+    FAIL() << "a mesh of " << estimate_mesh(scene).cells << " cells was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("surface.edge_length_d = 0.05"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("allowed: surface.edge_length_d >="), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "bed.csv"));
+  // The same test against a given memory: a small bed fits in 1 GB and not in 1 MB.
+  const Scene small = small_scene("\"mesh\"");
+  EXPECT_NO_THROW(refuse_mesh_beyond_memory(small, 1e9));
+  EXPECT_THROW(refuse_mesh_beyond_memory(small, 1e6), InputError);
 }
