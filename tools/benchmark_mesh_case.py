@@ -240,6 +240,15 @@ files = ["case"]
     return out
 
 
+def stamp(rows):
+    """The line that says which code made a section: its commit and date, or that it predates them."""
+    r = rows[0] if isinstance(rows, list) else rows
+    if "commit" in r:
+        return [f"Made at commit {r['commit']} on {r['date']}.", ""]
+    return ["Made before this script recorded commits and dates, on gmsh's tetrahedra (before 3d88d5a made "
+            "the polyhedral dual the default, see the Verification section): not regenerated since.", ""]
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -249,7 +258,7 @@ def write(results):
              "the bed top); Eisfeld & Schnitzlein (2001) is evaluated at that section's meshed void "
              "fraction and aspect ratio; *finest* is the finest gmsh level.", ""]
     if "sizes" in results:
-        lines += ["## a = 5, N = 500, bridges: mesh size against the pressure drop", "",
+        lines += ["## a = 5, N = 500, bridges: mesh size against the pressure drop", "", *stamp(results["sizes"]),
                   "| surface edge (d) | cells | surface s | mesh s | case s | simpleFoam s (its) | checkMesh | "
                   "max non-ortho | dp/L (Pa/m) | / E&S | / finest | eps section | peak MB |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -265,7 +274,7 @@ def write(results):
         lines += ["", "![dp against run time](mesh_case_convergence.png)", ""]
         plot(results)
     if "gaps" in results:
-        lines += ["## The same bed, refined across the narrow gaps only (`surface.cells_per_gap`)", "",
+        lines += ["## The same bed, refined across the narrow gaps only (`surface.cells_per_gap`)", "", *stamp(results["gaps"]),
                   "Surface edge 0.2 d, shortened to gap / cells_per_gap (not below the contact edge, 0.0667 d) "
                   "wherever a sphere or the wall faces another surface across a narrow gap.", "",
                   "| cells per gap | cells | surface s | mesh s | simpleFoam s (its) | checkMesh | max non-ortho | "
@@ -278,7 +287,7 @@ def write(results):
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
         lines.append("")
     if "layers" in results:
-        lines += ["## Prism layers on the particles (`[mesh.layers]`): a = 4, N = 40, shrink", "",
+        lines += ["## Prism layers on the particles (`[mesh.layers]`): a = 4, N = 40, shrink", "", *stamp(results["layers"]),
                   "The bed of `scenes/examples/small_bed_flow.toml`. 3 layers growing by 1.2, at most 0.2 of the "
                   "gap ahead of each stack and at least one surface edge of it left to the tetrahedra; none where "
                   "that leaves under half the thickness. */ finest* compares with the 0.07 d mesh without layers.", "",
@@ -304,7 +313,7 @@ def write(results):
                   "8e-4 there. Layers are for surfaces fine enough to resolve the gaps.", ""]
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
-        lines += ["## The same bed by the snappyHexMesh route", "",
+        lines += ["## The same bed by the snappyHexMesh route", "", *stamp(results["snappy"]),
                   "| route | cells | meshing s | simpleFoam s (its) | checkMesh | max non-ortho | max skewness | "
                   "dp/L (Pa/m) | / E&S |", "|---|---|---|---|---|---|---|---|---|"]
         if g:
@@ -319,7 +328,7 @@ def write(results):
     if "scale" in results:
         r = results["scale"]
         st = r["stages_s"]
-        lines += ["## Scale: a = 10, N = 4000, scene to case (default settings: shrink, 0.1 d)", "",
+        lines += ["## Scale: a = 10, N = 4000, scene to case (default settings: shrink, 0.1 d)", "", *stamp(results["scale"]),
                   "| stage | time (s) | peak memory (MB) |", "|---|---|---|"]
         order = [k for k in ("pack", "analysis", "surface", "mesh", "case") if k in st]
         lines += [f"| {k} | {st[k]:.1f} | {r.get('stages_peak_mb', {}).get(k, float('nan')):.0f} |" for k in order]
@@ -449,20 +458,21 @@ def main():
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
         if "sizes" in args.only:
-            results["sizes"] = sizes(tmp, [(e, 0, 0, 0.02) for e in args.edges])
+            results["sizes"] = [{**commit_and_date(), **r} for r in sizes(tmp, [(e, 0, 0, 0.02) for e in args.edges])]
             write(results)
         if "gaps" in args.only:
-            results["gaps"] = sizes(tmp, [(0.2, c, 0, 0.02) for c in args.gap_cells])
+            results["gaps"] = [{**commit_and_date(), **r} for r in sizes(tmp, [(0.2, c, 0, 0.02) for c in args.gap_cells])]
             write(results)
         if "layers" in args.only:
-            results["layers"] = sizes(tmp, [(0.1, 0, 0, 0.02)] + [(0.1, 0, 3, t) for t in args.layer_thickness] +
-                                      [(0.07, 0, 0, 0.02)], a=4, n=40, treatment="shrink")
+            results["layers"] = [{**commit_and_date(), **r} for r in sizes(
+                tmp, [(0.1, 0, 0, 0.02)] + [(0.1, 0, 3, t) for t in args.layer_thickness] + [(0.07, 0, 0, 0.02)],
+                a=4, n=40, treatment="shrink")]
             write(results)
         if "snappy" in args.only:
-            results["snappy"] = snappy(tmp, min(args.edges))
+            results["snappy"] = {**commit_and_date(), **snappy(tmp, min(args.edges))}
             write(results)
         if "scale" in args.only:
-            results["scale"] = scale(tmp)
+            results["scale"] = {**commit_and_date(), **scale(tmp)}
             write(results)
         if "study" in args.only:
             results["study"] = study(tmp, min(args.edges), args.levels, args.ratio)
