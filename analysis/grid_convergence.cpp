@@ -30,6 +30,7 @@ nlohmann::json GridConvergence::to_json() const {
           {"gci_fine", number(gci_fine)},
           {"gci_medium", number(gci_medium)},
           {"asymptotic_ratio", number(asymptotic_ratio)},
+          {"asymptotic", asymptotic},
           {"explanation", explanation}};
 }
 
@@ -92,9 +93,14 @@ GridConvergence grid_convergence(const std::vector<GridLevel>& levels) {
   g.gci_fine = 1.25 * g.relative_error_fine / (r21p - 1.0);
   g.gci_medium = 1.25 * std::abs(e32 / phi2) / (r32p - 1.0);
   g.asymptotic_ratio = g.gci_medium / (r21p * g.gci_fine);
+  g.asymptotic = p >= kAsymptoticOrder[0] && p <= kAsymptoticOrder[1];
   g.explanation = fmt::format("monotone convergence at apparent order {:.2f}; extrapolated {:.6g}, GCI of the finest "
                               "mesh {:.2g} %",
                               p, g.extrapolated, 100.0 * g.gci_fine);
+  if (!g.asymptotic)
+    g.explanation += fmt::format(", but that order is far from the schemes' formal 2 (outside {:g}-{:g}): the meshes are "
+                                 "not in the asymptotic range, so neither the extrapolation nor the GCI can be trusted",
+                                 kAsymptoticOrder[0], kAsymptoticOrder[1]);
   return g;
 }
 

@@ -30,9 +30,17 @@ struct GridConvergence {
   double gci_fine = 0.0;            // GCI_21 = 1.25 e_a21 / (r21^p - 1), relative
   double gci_medium = 0.0;          // GCI_32, for the asymptotic-range check
   double asymptotic_ratio = 0.0;    // GCI_32 / (r21^p GCI_21): near 1 in the asymptotic range
+  // Monotone and the order within kAsymptoticOrder: only then do phi_ext and the GCI mean much
+  // (an order far from the formal one says the meshes are not in the asymptotic range,
+  // verification.md after Celik et al.).
+  bool asymptotic = false;
   std::string explanation;          // one sentence a report can show
   nlohmann::json to_json() const;
 };
+
+// The apparent orders taken as the asymptotic range of OpenFOAM's second-order schemes: half to
+// one and a half times the formal order 2 (the range issue 24 accepts for the observed order).
+inline constexpr double kAsymptoticOrder[2] = {1.0, 3.0};
 
 const char* verdict_name(GridConvergence::Verdict v);
 

@@ -365,7 +365,7 @@ def write(results):
                          f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")
         lines += ["", f"Verdict: {st['conclusion']}."]
         g = st.get("grid_convergence", {})
-        if g.get("extrapolated") is not None:
+        if g.get("extrapolated") is not None and g.get("asymptotic", g.get("apparent_order", 0) >= 1):
             lines += [f"Extrapolated dp/L {g['extrapolated']:.4g} Pa/m = {g['extrapolated'] / r['es_bed_pa_m']:.3f} x "
                       f"Eisfeld & Schnitzlein at the bed's exact section void fraction {r['eps_section_bed']:.4f}; "
                       f"apparent order {g['apparent_order']:.2f}; GCI of the finest mesh {100 * g['gci_fine']:.1f} % "

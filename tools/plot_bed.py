@@ -78,7 +78,7 @@ def plot_mesh_convergence(case, path):
         ax.annotate(str(lv["level"]), (lv["cell_size_m"] / d, lv["pressure_gradient_bed_pa_m"]), fontsize=8,
                     textcoords="offset points", xytext=(4, 4))
     g = study.get("grid_convergence", {})
-    if g.get("extrapolated") is not None:
+    if g.get("extrapolated") is not None and g.get("asymptotic", True):  # drawn only when it means something
         fine = ok[0]["pressure_gradient_bed_pa_m"]
         band = g["gci_fine"] * abs(fine)
         ax.errorbar([0.0], [g["extrapolated"]], fmt="rs", label=f"extrapolated, order {g['apparent_order']:.2f}")

@@ -37,9 +37,23 @@ TEST(GridConvergence, AnExactPowerLawGivesItsOrderAndLimitBack) {
         EXPECT_NEAR(g.extrapolated_error_fine, std::abs(c) * std::pow(0.1, p) / 16.0, 1e-9);
         // In the asymptotic range by construction: GCI_32 / (r21^p GCI_21) = phi1 / phi2.
         EXPECT_NEAR(g.asymptotic_ratio, levels[0].value / levels[1].value, 1e-9);
+        if (p > kAsymptoticOrder[0]) EXPECT_TRUE(g.asymptotic) << p;  // p = 1 sits on the edge, to round-off
         // The GCI is a band, 1.25 times the estimated error: it holds the exact value.
         EXPECT_GE(g.gci_fine * std::abs(levels[0].value), std::abs(levels[0].value - 16.0) * (1 - 1e-9));
       }
+}
+
+// The bridged a = 5 bed on the polyhedral dual (docs/mesh_case_benchmark.md, 2026-11-24):
+// monotone, but at an apparent order of 0.18 its extrapolation (93 Pa/m from 20.7) and GCI (440 %)
+// mean nothing, and the verdict must say so. A power law of order 0.5 or 3.5 is likewise flagged.
+TEST(GridConvergence, AnOrderFarFromTheFormalOneIsNotTrusted) {
+  const GridConvergence bed = grid_convergence({{0.0833, 20.70}, {0.0977, 18.57}, {0.1128, 16.60}});
+  EXPECT_EQ(bed.verdict, GridConvergence::Verdict::monotone);
+  EXPECT_LT(bed.order, kAsymptoticOrder[0]);
+  EXPECT_FALSE(bed.asymptotic);
+  EXPECT_NE(bed.explanation.find("not in the asymptotic range"), std::string::npos) << bed.explanation;
+  EXPECT_EQ(bed.to_json()["asymptotic"], false);
+  for (double p : {0.5, 3.5}) EXPECT_FALSE(grid_convergence(power_law(16.0, 3.0, p, 0.1, 1.3, 1.3)).asymptotic) << p;
 }
 
 TEST(GridConvergence, OscillatingOrGrowingDifferencesAreNotExtrapolated) {
