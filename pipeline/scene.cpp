@@ -151,8 +151,8 @@ SceneSchema scene_schema() {
   // import (which stops at its missing file after its own keys are recorded).
   SceneSchema schema;
   const char* scenes[] = {"container = {diameter_d = 5.0}\nparticles = {count = 1}",
-                          "container = {type = \"annulus\", diameter_d = 5.0, inner_diameter_d = 2.0}\n"
-                          "particles = {count = 1}",
+                          ("container = {type = \"annulus\", diameter_d = 5.0, inner_diameter_d = 2.0}\n"
+                           "particles = {count = 1}"),
                           "container = {type = \"box\", size_x_d = 5.0, size_y_d = 5.0}\nparticles = {count = 1}",
                           "packing = {algorithm = \"import\"}"};
   for (const char* text : scenes) {

@@ -37,7 +37,9 @@ TEST(GridConvergence, AnExactPowerLawGivesItsOrderAndLimitBack) {
         EXPECT_NEAR(g.extrapolated_error_fine, std::abs(c) * std::pow(0.1, p) / 16.0, 1e-9);
         // In the asymptotic range by construction: GCI_32 / (r21^p GCI_21) = phi1 / phi2.
         EXPECT_NEAR(g.asymptotic_ratio, levels[0].value / levels[1].value, 1e-9);
-        if (p > kAsymptoticOrder[0]) EXPECT_TRUE(g.asymptotic) << p;  // p = 1 sits on the edge, to round-off
+        if (p > kAsymptoticOrder[0]) {  // p = 1 sits on the edge, to round-off
+          EXPECT_TRUE(g.asymptotic) << p;
+        }
         // The GCI is a band, 1.25 times the estimated error: it holds the exact value.
         EXPECT_GE(g.gci_fine * std::abs(levels[0].value), std::abs(levels[0].value - 16.0) * (1 - 1e-9));
       }

@@ -92,7 +92,9 @@ void expect_valid_bed(const fs::path& dir, const std::string& name) {
     }
   // A packed bed keeps within the packer's tolerance; an imported bed keeps its file's overlaps
   // (that is the input under test), and then the treated surface must be valid.
-  if (report["stages"]["pack"].value("algorithm", "") != "import") EXPECT_LE(worst, kOverlapTolerance) << name;
+  if (report["stages"]["pack"].value("algorithm", "") != "import") {
+    EXPECT_LE(worst, kOverlapTolerance) << name;
+  }
   if (report["stages"].contains("surface")) {
     const auto& check = report["stages"]["surface"]["check"];
     EXPECT_TRUE(check["closed"].get<bool>() && check["manifold"].get<bool>()) << name << ": " << check.dump();
