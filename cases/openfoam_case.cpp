@@ -238,7 +238,7 @@ std::string allrun(bool snappy, bool polyhedra) {
          "fi\n";
   if (polyhedra)
     s += "# gmsh's tetrahedra become their dual polyhedra, once (the tetrahedra are kept in constant/tetrahedra):\n"
-         "# the pressure drop on tetrahedra settles about 16 % high in an empty tube, on the dual it converges.\n"
+         "# an empty tube's pressure drop converges to the exact one on the dual, not on the tetrahedra.\n"
          "# Edges sharper than 80 degrees (inlet and outlet rims) stay edges of the dual.\n"
          "if [ \"$snappy\" = 0 ]; then\n"
          "    if [ ! -d constant/tetrahedra ]; then\n"
@@ -331,10 +331,9 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                 p.iterations, p.iterations, fmt_word, section.z_low, section.z_high, functions)));
     // Tetrahedra in narrow gaps are far from orthogonal: limited corrections, one
     // non-orthogonal corrector, and SIMPLEC, which converges these creeping flows fast.
-    // Gradients: least squares on the polyhedral dual, whose pressure drop in the empty tube then
-    // converges to the exact one (-0.85 % to +0.03 % from 2.4 k to 89 k cells); with Gauss linear
-    // it crossed the exact value and rose to +0.34 % (docs/defaults.md). On tetrahedra least
-    // squares does not help (+18 % against +14 %), so they keep Gauss linear.
+    // Gradients: least squares on the polyhedral dual, with which the empty tube's pressure drop
+    // converges to the exact one and with Gauss linear it does not; on tetrahedra least squares
+    // does not help, so they keep Gauss linear (docs/defaults.md).
     const std::string grad = p.polyhedra ? "leastSquares" : "Gauss linear";
     write_text(tmp / "system/fvSchemes",
                dict("dictionary", "system", "fvSchemes", note,
@@ -553,7 +552,6 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const double overall = rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
   const double flow = series(case_dir, "flowRate").back();
   FlowResult r;
-  r.snappy = snappy;
   r.mesher = snappy ? "snappyHexMesh" : c.params.polyhedra ? "gmsh polyhedral dual" : "gmsh tetrahedra";
   r.solved_cells = snappy || c.params.polyhedra ? -1 : c.cells;
   if (snappy || c.params.polyhedra) {  // the cells Allrun made, as its checkMesh counted them

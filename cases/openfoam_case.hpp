@@ -30,9 +30,8 @@ struct CaseParams {
   std::string decomposition = "hierarchical";
   bool binary = true;                   // polyMesh and fields in binary, else ASCII
   // cells = "polyhedra": Allrun first replaces gmsh's tetrahedra by their dual polyhedra
-  // (OpenFOAM's polyDualMesh), on which the solved pressure drop converges to the exact one;
-  // "tetrahedra" solves on gmsh's cells, whose pressure drop settles about 16 % high in an empty
-  // tube however fine (docs/mesh_case_benchmark.md, verification).
+  // (OpenFOAM's polyDualMesh), on which an empty tube's pressure drop converges to the exact one;
+  // "tetrahedra" solves on gmsh's cells, where it does not (docs/defaults.md).
   bool polyhedra = true;
   bool snappy = false;                  // also write the snappyHexMesh set-up (Allrun -snappy)
   double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
@@ -113,7 +112,6 @@ struct FlowResult {
   double time_s = 0.0;                   // wall time of Allrun
   double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
   std::string mesher;                    // what made the cells solved on: "gmsh tetrahedra", "gmsh polyhedral dual", "snappyHexMesh"
-  bool snappy = false;                   // solved on snappyHexMesh's mesh instead of gmsh's
   long solved_cells = -1;                // the cells solved on, as Allrun's checkMesh counted them (-1: no checkMesh ran)
   long iterations = 0;
   bool converged = false;                // SIMPLE's own verdict at the residual targets
