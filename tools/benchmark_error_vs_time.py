@@ -30,7 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS, read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line, read_csv  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "error_vs_time.json")
 SECTIONS = ["packer", "surface", "mesh"]
@@ -124,7 +124,8 @@ def mesh_section():
         points.append({"edge_d": r["edge_d"], "cells": r["cells"], "time_s": st["surface"] + st["mesh"] + st["case"],
                        "mesh_time_s": st["surface"] + st["mesh"], "ratio_finest": r["ratio_finest"],
                        "ratio_es": r["ratio_es"]})
-    return {"points": points}
+    made = {k: src["sizes"][0][k] for k in ("commit", "date") if k in src["sizes"][0]}  # the runs', not this copy's
+    return {**made, "points": points}
 
 
 def pareto(ax, xs, ys, labels, **kw):
@@ -175,9 +176,9 @@ def plots(R):
         fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_mesh_case.png"), dpi=110), plt.close(fig)
 
 
-def table(title, intro, columns, rows, image):
-    """A stage's section of the report: heading, what was run, its table and its plot."""
-    return ([f"## {title}", "", intro, "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)] +
+def table(title, made, intro, columns, rows, image):
+    """A stage's section of the report: heading, which commit made it, what was run, its table and its plot."""
+    return ([f"## {title}", "", made_line(made), "", intro, "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)] +
             ["| " + " | ".join(r) + " |" for r in rows] + ["", image, ""])
 
 
@@ -189,7 +190,7 @@ def write_report(R):
          "iterative stage; `tools/plot_bed.py DIR` draws it).", ""]
     if "packer" in R:
         P = R["packer"]
-        L += table("Packer: overlap tolerance and mode",
+        L += table("Packer: overlap tolerance and mode", R["packer"],
                    f"a = 5, N = 500, {P['seeds']} seeds per setting. Error = distance of the seed-mean central void "
                    f"fraction and radial profile from those of the tightest setting (accelerated, 1e-5 d). Seed-to-seed "
                    f"standard error of that mean: {P['noise_eps']:.4f} (void fraction), {P['noise_profile']:.4f} "
@@ -201,7 +202,7 @@ def write_report(R):
                     for p in sorted(P["points"], key=lambda p: (p["mode"], -p["tolerance_d"]))],
                    "![packer](pareto_packer.png)")
     if "surface" in R:
-        L += table("Surface: edge length",
+        L += table("Surface: edge length", R["surface"],
                    "One bed (a = 5, N = 500, seed 1, d = 3 mm), `shrink` (the default), contact edge a third of the "
                    "edge length.",
                    ["edge (d)", "triangles", "time (s)", "peak MB", "volume error", "chordal deviation (d)",
@@ -211,7 +212,7 @@ def write_report(R):
                     for p in R["surface"]["points"]],
                    "![surface](pareto_surface.png)")
     if "mesh" in R:
-        L += table("Mesh and CFD: mesh size",
+        L += table("Mesh and CFD: mesh size", R["mesh"],
                    "From [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, N = 500, bridges, Re_p = 1, "
                    "simpleFoam on 2 processes); the mesh size follows the surface edge.",
                    ["surface edge (d)", "cells", "surface + mesh (s)", "with the solve (s)", "dp/L / finest",
@@ -233,9 +234,9 @@ def main():
     R = json.load(open(RESULTS)) if os.path.exists(RESULTS) and args.only != SECTIONS else {}
     with tempfile.TemporaryDirectory(prefix="bedforge_pareto_") as work:
         if "packer" in args.only:
-            R["packer"] = packer_section(work)
+            R["packer"] = {**commit_and_date(), **packer_section(work)}
         if "surface" in args.only:
-            R["surface"] = surface_section(work)
+            R["surface"] = {**commit_and_date(), **surface_section(work)}
     if "mesh" in args.only:
         R["mesh"] = mesh_section()
     json.dump(R, open(RESULTS, "w"), indent=1)

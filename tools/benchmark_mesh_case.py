@@ -50,7 +50,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "verification"]
@@ -201,12 +201,6 @@ def study(tmp, edge, levels, ratio, a=5, n=500, treatment="bridge"):
             "eps_section_bed": case["flow"]["void_fraction_section_bed"]}
 
 
-def commit_and_date():
-    commit = subprocess.run(["git", "-C", os.path.dirname(DOCS), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    return {"commit": commit, "date": time.strftime("%Y-%m-%d")}
-
-
 def verification(tmp, edge, levels, ratio):
     """The empty tube on tetrahedra and on their dual: each a run with a convergence study."""
     out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": ratio, "runs": {}}
@@ -242,11 +236,9 @@ files = ["case"]
 
 def stamp(rows):
     """The line that says which code made a section: its commit and date, or that it predates them."""
-    r = rows[0] if isinstance(rows, list) else rows
-    if "commit" in r:
-        return [f"Made at commit {r['commit']} on {r['date']}.", ""]
-    return ["Made before this script recorded commits and dates, on gmsh's tetrahedra (before 3d88d5a made "
-            "the polyhedral dual the default, see the Verification section): not regenerated since.", ""]
+    return [made_line(rows, "Made before this script recorded commits and dates, on gmsh's tetrahedra (before 3d88d5a "
+                            "made the polyhedral dual the default, see the Verification section): not regenerated "
+                            "since."), ""]
 
 
 def write(results):
@@ -305,12 +297,8 @@ def write(results):
                          f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['dp_dz_pa_m'] / finest['dp_dz_pa_m']:.3f} | "
                          f"{r['eps_section']:.4f} |")
-        lines += ["", "On the a = 5, N = 500 bed with bridges at a 0.2 d edge, 3 layers of 0.02 d gave a mesh "
-                  "checkMesh passes (max non-orthogonality 83.6, 1086 faces past 70; 11 without layers) on which "
-                  "simpleFoam did not converge: the velocity residual stalls between 0.05 and 0.5 with the case's "
-                  "settings, with U relaxed to 0.7, and with 2 non-orthogonal correctors (2026-11-22). "
-                  "`checkMesh -allGeometry` flags cells of near-zero determinant and interpolation weights down to "
-                  "8e-4 there. Layers are for surfaces fine enough to resolve the gaps.", ""]
+        lines += ["", "Layers on the bridged a = 5 bed did not converge in simpleFoam (2026-11-22, not regenerated): "
+                  "[findings.md](findings.md).", ""]
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
         lines += ["## The same bed by the snappyHexMesh route", "", *stamp(results["snappy"]),

@@ -21,7 +21,12 @@ import shutil
 import subprocess
 import tempfile
 
-from bedforge_files import BEDFORGE, DOCS
+from bedforge_files import BEDFORGE, DOCS, commit_and_date
+
+
+def made(row):
+    """A row's commit and date, or that it is older than the stamps."""
+    return f"{row['commit']}, {row['date']}" if "commit" in row else "before stamps"
 
 TREATMENTS = ["shrink", "bridge", "cap", "enlarge"]
 
@@ -55,7 +60,7 @@ def main():
                 shutil.copytree(bed, work)
                 wall, mb = timed([BEDFORGE, "--quiet", "surface", work, "--contacts", t])
                 s = json.load(open(os.path.join(work, "report.json")))["stages"]["surface"]
-                rows.append({"n": n, "treatment": t, "wall_s": wall, "peak_mb": mb, "build_s": s["time_build_s"],
+                rows.append({**commit_and_date(), "n": n, "treatment": t, "wall_s": wall, "peak_mb": mb, "build_s": s["time_build_s"],
                              "check_s": s["time_check_s"], "triangles": s["triangles"],
                              "self_intersections_checked": s["check"]["self_intersections"] != "not checked",
                              "volume_error": s["fluid_volume_relative_error"],
@@ -84,18 +89,17 @@ def write(rows):
              "`bedforge surface DIR` command, including writing the STL files; *ratio* = time per sphere "
              "over that at the smallest N (1 = linear scaling). The allocator matters here: bedforge is linked "
              "with tcmalloc when `libgoogle-perftools-dev` is installed (these rows: "
-             f"{'tcmalloc' if 'tcmalloc' in allocator() else 'glibc malloc'}); with glibc's malloc the N = 1e4 cap "
-             "surface took 261 s and 162 s against 175 s and 124 s with tcmalloc, in two back-to-back pairs of runs "
-             "(2026-11-22).", "",
+             f"{'tcmalloc' if 'tcmalloc' in allocator() else 'glibc malloc'}; what glibc's malloc cost, measured once: "
+             "[findings.md](findings.md)). *made*: the commit and date of the run that made the row.", "",
              "| N | treatment | contacts treated | triangles | wall s | build s | checks s | peak MB | ratio | "
-             "volume error | chordal d | min angle | smallest gap d |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "volume error | chordal d | min angle | smallest gap d | made |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['n']} | {r['treatment']} | {r['contacts']} | {r['triangles']} | {r['wall_s']:.1f} | "
                      f"{r['build_s']:.1f} | {r['check_s']:.1f}{'' if r['self_intersections_checked'] else ' (no SI)'} | "
                      f"{r['peak_mb']:.0f} | {r['wall_s'] / r['n'] / base.get(r['treatment'], r['wall_s'] / r['n']):.2f} | "
                      f"{r['volume_error']:.2e} | {r['chordal_d']:.1e} | {r['min_angle_deg']:.1f} | "
-                     f"{r['smallest_gap_d']:.3g} |")
+                     f"{r['smallest_gap_d']:.3g} | {made(r)} |")
     lines += ["", "(no SI): above `surface.self_intersection_limit` triangles the CGAL self-intersection test is "
               "skipped and the report says so; closedness and manifoldness are always checked, so the wall "
               "time at N = 1e4 leaves out a test the smaller N include: compare the build column for scaling.",

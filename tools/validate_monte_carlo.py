@@ -32,7 +32,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bedforge_files import BEDFORGE, DOCS, ROOT, read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, ROOT, commit_and_date, made_line, read_csv  # noqa: E402
 from references import de_klerk  # noqa: E402
 
 SCENES = os.path.join(ROOT, "scenes", "examples")
@@ -200,7 +200,7 @@ def write(R):
          "`scenes/examples/abreu1999_*.toml`; method and reading of the paper in docs/monte_carlo.md.", ""]
     if "fig3" in R:
         f = R["fig3"]
-        L += ["## Fig. 3 case: D = 14.1 d, N = 2500, 200 shells", "",
+        L += ["## Fig. 3 case: D = 14.1 d, N = 2500, 200 shells", "", made_line(R.get("made", {}).get("fig3")), "",
               f"{f['runs']} runs of the paper's full schedule. ![](monte_carlo_fig3.png)", "",
               "| measure | value |", "|---|---|",
               f"| central void fraction, Monte Carlo | {ms(f['eps_central_mc'])} |",
@@ -218,7 +218,7 @@ def write(R):
               ""]
     if "annulus" in R:
         a = R["annulus"]
-        L += ["## Annulus: D/d = 20.3, D_int/d = 6.25, N = 4000", "",
+        L += ["## Annulus: D/d = 20.3, D_int/d = 6.25, N = 4000", "", made_line(R.get("made", {}).get("annulus")), "",
               f"{a['runs']} runs. ![](monte_carlo_annulus.png)", "",
               f"- central void fraction {ms(a['eps_central'])}; time per run {statistics.mean(a['time_s']):.0f} s",
               f"- first minimum: outer (concave) wall {a['outer_first_minimum']:.3f}, inner (convex) wall "
@@ -226,7 +226,7 @@ def write(R):
               f"- mean absolute difference of the two profiles within 3 d of the walls: "
               f"{a['mean_abs_difference_first_3d']:.3f}", ""]
     if "segregation" in R:
-        L += ["## Segregation: diameter ratio 1.2, equal numbers, N = 1000", "",
+        L += ["## Segregation: diameter ratio 1.2, equal numbers, N = 1000", "", made_line(R.get("made", {}).get("segregation")), "",
               "Abreu et al. (1999): almost complete segregation after 100 shakes, and about the same with "
               "periodic sides instead of the cylinder wall. Danckwerts' intensity: 0 mixed, 1 fully segregated; "
               "the unshaken control is the same bed after its fall alone. Why the default target acceptance "
@@ -238,7 +238,7 @@ def write(R):
             L.append(f"| {where} | {ms(s['intensity'])} | {hs} | {statistics.mean(s['time_s']):.0f} |")
         L.append("")
     if "speed" in R:
-        L += ["## Speed (1 thread)", "", "| N | a | cycles/s | moves/s |", "|---|---|---|---|"]
+        L += ["## Speed (1 thread)", "", made_line(R.get("made", {}).get("speed")), "", "| N | a | cycles/s | moves/s |", "|---|---|---|---|"]
         for s in R["speed"]:
             L.append(f"| {s['n']} | {s['a']} | {s['cycles_per_s']:.0f} | {s['moves_per_s']:.3g} |")
         L.append("")
@@ -255,6 +255,7 @@ def main():
     for s in args.only:
         t0 = time.time()
         R[s] = speed() if s == "speed" else globals()[s](args.runs)
+        R.setdefault("made", {})[s] = commit_and_date()
         print(f"{s}: {time.time() - t0:.0f} s", flush=True)
         write(R)
 

@@ -28,12 +28,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS, read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line, read_csv  # noqa: E402
 from references import benyahia, de_klerk, dixon, jeschar, zou_yu_dense, zou_yu_loose  # noqa: E402,F401
 
 
 
 SECTIONS = ["paper", "eps0", "by_a", "speed"]
+N_1E5_LIMIT_S = 240.0  # issue 25: every seed of the N = 1e5 bed under this, on this 2-core machine
 
 
 def count_for(a, height_d):
@@ -135,6 +136,7 @@ def main():
             t0 = time.time()
             results[name] = sections[name]()
             results["minutes"][name] = (time.time() - t0) / 60
+            results.setdefault("made", {})[name] = commit_and_date()
     results["quick"] = quick
     json.dump(results, open(os.path.join(DOCS, "validation.json"), "w"), indent=1)
     write_report(results)
@@ -142,6 +144,11 @@ def main():
 
 def fmt(m, s, n, digits=4):
     return f"{m:.{digits}f} ± {s:.{digits}f} (n={n})"
+
+
+def made(R, section):
+    """Which commit made a section's runs, and when."""
+    return made_line(R.get("made", {}).get(section))
 
 
 def write_report(R):
@@ -158,7 +165,7 @@ def write_report(R):
         lines += ["**Failed runs:** " + "; ".join(f"{r['mode']} a={r['a']} N={r['n']} seed={r['seed']}" for r in failed), ""]
 
     # 1. Paper case.
-    lines += ["## a = 5, N = 500, eps_0 = 0.47 (Salvat et al. 2005: eps_F = 0.433)", "",
+    lines += ["## a = 5, N = 500, eps_0 = 0.47 (Salvat et al. 2005: eps_F = 0.433)", "", made(R, "paper"), "",
               "| mode | eps central | eps whole | iterations | time (s) | rms force residual | max overlap (d) |",
               "|---|---|---|---|---|---|---|"]
     per_mode = {}
@@ -178,7 +185,7 @@ def write_report(R):
               ""]
 
     # 2. eps0.
-    lines += ["## Sensitivity to eps_0 (paper, Sec. 4.1: eps_F in [0.43, 0.44] for eps_0 in [0.30, 0.55])", "",
+    lines += ["## Sensitivity to eps_0 (paper, Sec. 4.1: eps_F in [0.43, 0.44] for eps_0 in [0.30, 0.55])", "", made(R, "eps0"), "",
               "| eps_0 | faithful central | faithful whole | accelerated central | accelerated whole |", "|---|---|---|---|---|"]
     for e in (0.30, 0.40, 0.47, 0.55):
         src = R["paper"] if e == 0.47 else R["eps0"]
@@ -190,7 +197,7 @@ def write_report(R):
     lines.append("")
 
     # 3. eps against a, with the correlations.
-    lines += ["## Void fraction against aspect ratio", "",
+    lines += ["## Void fraction against aspect ratio", "", made(R, "by_a"), "",
               "| a | N | mode | eps central | eps whole | Z bulk | time (s) | Benyahia | Dixon | Zou-Yu dense..loose |",
               "|---|---|---|---|---|---|---|---|---|---|"]
     groups = {}
@@ -247,7 +254,7 @@ def write_report(R):
     ax[1].set_xlabel("(R - r)/d"), ax[1].set_ylabel("fraction of centres per 0.05 d"), ax[1].legend(fontsize=8)
     ax[1].grid(alpha=0.3)
     fig.tight_layout(), fig.savefig(os.path.join(DOCS, "validation_radial_7_99.png"), dpi=120), plt.close(fig)
-    lines += ["## Radial structure at a = 7.99 (central slab, bins of 0.05 d)", "",
+    lines += ["## Radial structure at a = 7.99 (central slab, bins of 0.05 d)", "", made(R, "by_a"), "",
               "Reference [A]: eps = 1 at the wall; first minimum near 0.5 d, about 0.20-0.26; first maximum at "
               "0.9-1.05 d, about 0.5-0.6; within ±0.02 of the bulk by 4-5 d.", "",
               "| mode | bin at the wall (0-0.05 d) | first minimum | first maximum | bulk (2.5-3.5 d) | "
@@ -255,7 +262,7 @@ def write_report(R):
               "|---|---|---|---|---|---|"] + feats + ["", "![radial profile](validation_radial_7_99.png)", ""]
 
     # 4. Speed.
-    lines += ["## Time against N (accelerated, 2 threads)", "",
+    lines += ["## Time against N (accelerated, 2 threads)", "", made(R, "speed"), "",
               "| N | a | seed | iterations | time (s) | iterations per second | eps central |",
               "|---|---|---|---|---|---|---|"]
     for r in ok(R["speed"]):
@@ -263,48 +270,14 @@ def write_report(R):
                      f"{r['iterations'] / r['time_s']:.0f} | {r['eps_central']:.4f} |")
     big = [r for r in ok(R["speed"]) if r["n"] == 100000]
     if big:
-        mean = sum(r["time_s"] for r in big) / len(big)
-        met = mean < 300.0
-        slowest = max(r["time_s"] for r in big)
-        # A margin inside the timing noise is said, so a pass is not read as a safe one.
-        thin = (f"The slowest seed is only {100 * (1 - slowest / 300.0):.0f} % under 300 s, inside this machine's "
-                "run-to-run timing noise (5-10 %), so a rerun of it can land over. " if 270.0 < slowest < 300.0 else "")
-        lines += ["", f"The issue's target for N = 1e5 (a about 40), under 5 minutes, is {'met' if met else 'not met'} "
-                  f"on the mean of {len(big)} seeds: {mean:.0f} s ("
-                  + ", ".join(f"seed {r['seed']} {r['time_s']:.0f} s" for r in big) + f"; "
-                  f"{sum(1 for r in big if r['time_s'] < 300.0)} of {len(big)} under 300 s), "
-                  f"{1000 * sum(r['time_s'] for r in big) / sum(r['iterations'] for r in big):.1f} ms per iteration. "
-                  + thin +
-                  "The number of iterations varies with rounding, because the settling bed creeps and the stage "
-                  "ends at a chaotic moment: compaction ends on the force-residual test (rms net force under 0.2 "
-                  "weights), which the agitated bed meets only in a lull after a momentum restart (N = 1e4, seed 1: "
-                  "the residual stays at 1-3 weights, dips to 0.46 and 0.21 after restarts, and ends compaction at "
-                  "0.17), while at N = 1e5 the mass centre still sinks by 5e-4 d per 100 iterations when it ends. "
-                  "On 2026-11-22 the same seed took 44100 iterations, then 57200 after a change that only reordered "
-                  "the neighbour list, with the same void fraction (0.3686 and 0.3683 central); a Verlet skin of "
-                  "0.1 d instead of 0.2 d (which changes the order in which the cells are scanned, not the forces) "
-                  "took seed 1 from 43200 iterations to 34700 at the same 7.7 ms per iteration. Where the time goes "
-                  "at N = 1e5 (seed 1): compaction 35600 iterations (the fall about 6000, then the creep of the "
-                  "settling bed, which moves its mass centre down by 0.43 d, a void fraction change of about 0.008, "
-                  "so it cannot be cut short without changing the bed), the final stage 7400 since its momentum is "
-                  "capped (`final_momentum_bound`, docs/defaults.md; 21400 without the cap, 418 s in all). perf on "
-                  "a running pack (2026-11-23): the force loop 64 % of the samples, thread waits 9 %, the two "
-                  "momentum loops 9 %, neighbour-list builds 7 % (477 builds of 33 ms), the stability limit's power "
-                  "iteration 3 %. The force loop waits mostly on loading the neighbours' centres and radii, not on "
-                  "its square roots: prefetching the neighbours of sphere i + 2 while sphere i is summed (and "
-                  "keeping the squared distances of the first pass) took seed 1 from 326 s to 296 s run back to "
-                  "back (7.55 to 6.84 ms per iteration), with the same bed bit for bit. Tried on 2026-11-23, none "
-                  "adopted: a half list that computes each pair once (exact, but 8-24 % slower: the extra "
-                  "indirection costs more than the square roots it saves), rows sorted by index, a packed "
-                  "(x, y, z, r) array with the same prefetching, splitting the threads by listed neighbours instead "
-                  "of spheres, the descent step fused into the force pass (293 s against 289 s) and pinned or "
-                  "busy-waiting OpenMP threads, all within the machine's timing noise of about 10 %. Tried on "
-                  "2026-11-22: the same cap in compaction too (every size slower), restarting when the speed falls "
-                  "(a = 5, N = 500: 6 times the iterations), the pair arithmetic split into a loop the compiler "
-                  "vectorises, spheres renumbered cell by cell instead of by height, and interleaved chunks for the "
-                  "two threads; earlier, restarting per sphere, restarting when the residual rises, ending the final "
-                  "stage once the bed stops expanding (residual 2.7 weights instead of 0.2) and dynamic scheduling "
-                  "were slower or worse."]
+        # Issue 25: every seed under the bar, not their mean (a mean hid a seed with a 2 % margin).
+        under = [r for r in big if r["time_s"] < N_1E5_LIMIT_S]
+        lines += ["", f"The target for N = 1e5 (a = 40), every seed under {N_1E5_LIMIT_S:.0f} s on this machine, is "
+                  f"**{'met' if len(under) == len(big) else 'not met'}**: {len(under)} of {len(big)} seeds under it ("
+                  + ", ".join(f"seed {r['seed']} {r['time_s']:.0f} s, {r['iterations']} iterations" for r in big)
+                  + f"; {1000 * sum(r['time_s'] for r in big) / sum(r['iterations'] for r in big):.1f} ms per "
+                  "iteration). Why the iteration count varies from seed to seed, where the time goes, and what was "
+                  "tried: [findings.md](findings.md) (dated, not regenerated)."]
     lines.append("")
     open(os.path.join(DOCS, "validation.md"), "w").write("\n".join(lines))
     print("\n".join(lines))
