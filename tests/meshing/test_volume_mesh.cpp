@@ -159,17 +159,17 @@ std::vector<std::vector<int>> cell_points(const PolyMesh& m) {
 }
 
 // Longest piece of the segment a-b inside one cell of `m`, as a fraction of the segment, from
-// 1000 points along it.
-double longest_piece_in_a_cell(const PolyMesh& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const std::vector<std::vector<int>> tets = cell_points(m);
+// 1000 points along it; `cells` lists the candidates (their points).
+double longest_piece_in_a_cell(const PolyMesh& m, const std::vector<std::vector<int>>& cells,
+                               const std::vector<int>& candidates, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   std::map<int, int> samples;  // per cell crossed
   constexpr int kSamples = 1000;
   for (int k = 0; k < kSamples; ++k) {
     const Eigen::Vector3d x = a + (b - a) * ((k + 0.5) / kSamples);
-    for (int c = 0; c < m.cells; ++c) {
+    for (int c : candidates) {
       Eigen::Matrix3d e;
-      for (int j = 0; j < 3; ++j) e.col(j) = m.points[tets[c][j + 1]] - m.points[tets[c][0]];
-      const Eigen::Vector3d l = e.inverse() * (x - m.points[tets[c][0]]);
+      for (int j = 0; j < 3; ++j) e.col(j) = m.points[cells[c][j + 1]] - m.points[cells[c][0]];
+      const Eigen::Vector3d l = e.inverse() * (x - m.points[cells[c][0]]);
       if (l.minCoeff() >= 0.0 && l.sum() <= 1.0) {
         ++samples[c];
         break;
@@ -179,6 +179,29 @@ double longest_piece_in_a_cell(const PolyMesh& m, const Eigen::Vector3d& a, cons
   int most = 0;
   for (const auto& [cell, n] : samples) most = std::max(most, n);
   return static_cast<double>(most) / kSamples;
+}
+
+// The mean over a bundle of 25 segments parallel to a-b (offsets up to `spread` across it, in
+// y and z) of the longest piece of each inside one cell: one line's value depends on where a
+// vertex happens to fall, the bundle's mean much less.
+double mean_longest_piece(const PolyMesh& m, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double spread) {
+  const std::vector<std::vector<int>> cells = cell_points(m);
+  Eigen::AlignedBox3d near(a.cwiseMin(b), a.cwiseMax(b));
+  near.min() -= Eigen::Vector3d(0.0, spread, spread);
+  near.max() += Eigen::Vector3d(0.0, spread, spread);
+  std::vector<int> candidates;
+  for (int c = 0; c < m.cells; ++c) {
+    Eigen::AlignedBox3d box;
+    for (int v : cells[c]) box.extend(m.points[v]);
+    if (box.intersects(near)) candidates.push_back(c);
+  }
+  double sum = 0.0;
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j) {
+      const Eigen::Vector3d o(0.0, 0.5 * spread * i, 0.5 * spread * j);
+      sum += longest_piece_in_a_cell(m, cells, candidates, a + o, b + o);
+    }
+  return sum / 25.0;
 }
 }  // namespace
 
@@ -195,18 +218,16 @@ TEST(VolumeMesh, CellsPerGapPutsThatManyCellsAcrossAGap) {
   Progress quiet("mesh", false);
   // Along the line of centres, from one sphere's surface to the other's.
   const Eigen::Vector3d from(-0.05, 0.0, 0.6), to(0.05, 0.0, 0.6);
-  // One thread: on two, HXT's graded mesh changed from run to run and its longest piece reached
-  // 0.33 of the gap, so 1 in 6 runs failed the ratio below (0.481 against 1.5 x 0.333); on one
-  // it stays at 0.17-0.20.
-  VolumeMeshParams mp;
-  mp.threads = 1;
+  // The default threads, as users run it: HXT's graded mesh then changes from run to run, so
+  // the measure is a bundle's mean rather than one line's (which reached 0.33 in 1 of 6 runs).
+  const VolumeMeshParams mp;
   const VolumeMesh plain = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, mp, {}, {}, quiet);
   sp.cells_per_gap = 4.0;
   const VolumeMesh graded = build_volume_mesh(build_fluid_surface(b, sp).fluid, b, 1.0, mp, {}, {}, quiet);
-  // With 4 cells per gap no cell holds more than a third of the way across (a quarter asked
-  // for, gmsh's sizes within about 1.3 x); without, one cell spans about half of it.
-  const double piece_plain = longest_piece_in_a_cell(plain.mesh, from, to);
-  const double piece = longest_piece_in_a_cell(graded.mesh, from, to);
+  const double piece_plain = mean_longest_piece(plain.mesh, from, to, 0.06);
+  const double piece = mean_longest_piece(graded.mesh, from, to, 0.06);
+  // A quarter asked for, gmsh's sizes within about 1.3 x: at most a third. 32 runs on 2 threads
+  // (2026-11-24) gave 0.206-0.240 graded and 0.59 plain, so both bounds hold with room.
   EXPECT_LE(piece, 1.0 / 3.0);
   EXPECT_GT(piece_plain, 1.5 * piece) << "plain " << piece_plain << ", graded " << piece;
 }
