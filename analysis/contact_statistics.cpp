@@ -25,7 +25,7 @@ ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance) {
   std::vector<double> weight(n);
   double max_pair = 0, max_wall = 0, max_floor = 0;
   const Periodicity per = bed.container->periodicity();
-#pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall, max_floor)
+#pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall, max_floor) if (worth_threads(n))
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& xi = bed.centres[i];
     Eigen::Vector3d p = Eigen::Vector3d::Zero();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/parallel.hpp"
+
 namespace bedforge {
 
 bool NeighbourList::update(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& r,
@@ -22,7 +24,7 @@ bool NeighbourList::update(const std::vector<Eigen::Vector3d>& x, const std::vec
       }
     };
     double first = 0.0, second = 0.0;  // squared displacements
-#pragma omp parallel
+#pragma omp parallel if (worth_threads(x.size()))
     {
       double mine_first = 0.0, mine_second = 0.0;
 #pragma omp for schedule(static) nowait
@@ -103,7 +105,7 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
   for (bool overflow = true; overflow;) {
     overflow = false;
     scratch_.resize(n * capacity_);
-#pragma omp parallel for schedule(dynamic, 256) reduction(|| : overflow)
+#pragma omp parallel for schedule(dynamic, 256) reduction(|| : overflow) if (worth_threads(n))
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d p = per.wrapped(x[i]);
       long cx, cy, cz;
@@ -154,7 +156,7 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
   }
   for (std::size_t i = 0; i < n; ++i) offsets_[i + 1] += offsets_[i];
   list_.resize(offsets_[n]);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
   for (std::size_t i = 0; i < n; ++i)
     std::copy_n(scratch_.data() + i * capacity_, offsets_[i + 1] - offsets_[i], list_.data() + offsets_[i]);
 }

@@ -69,7 +69,7 @@ void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Containe
   double max_pair = 0.0, max_wall = 0.0;
   const Periodicity per = c.periodicity();
   const bool periodic = per.lx > 0.0 || per.ly > 0.0;
-#pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall)
+#pragma omp parallel for schedule(static) reduction(max : max_pair, max_wall) if (worth_threads(n))
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector3d push;
     double e = periodic ? gather_pairs<true>(s, nl, per, i, push, max_pair) : gather_pairs<false>(s, nl, per, i, push, max_pair);
@@ -99,7 +99,7 @@ double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, c
     const double norm = std::sqrt(deterministic_sum(n, [&](std::size_t i) { return v[i].squaredNorm(); }));
     if (!(norm > 0.0)) return lambda;
     for (auto& vi : v) vi /= norm;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
     for (std::size_t i = 0; i < n; ++i) {
       Eigen::Vector3d h = Eigen::Vector3d::Zero();
       for (int j : nl.of(i)) {
@@ -135,7 +135,7 @@ std::size_t lift_floor_spheres(Spheres& s, double height, std::uint64_t salt) {
 std::pair<double, double> force_residual(const Spheres& s, const Contacts& c, double kappa) {
   const std::size_t n = s.size();
   std::vector<double> rel(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector3d f = kappa * c.push[i];
     f.z() -= s.w[i];

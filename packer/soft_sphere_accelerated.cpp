@@ -88,7 +88,7 @@ class AcceleratedDescent {
 
       // Descent step from y (Eq. 4 with C_g = C_k / kappa), floor, cap; then momentum.
       const double cg = gravity ? step_ / kappa : 0.0;  // C_g = C_k / kappa
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
       for (std::size_t i = 0; i < n; ++i) {
         Eigen::Vector3d move = step_ * r.contacts.push[i];
         move.z() -= cg * s_.w[i];
@@ -102,7 +102,7 @@ class AcceleratedDescent {
       if (deterministic_sum(n, [&](std::size_t i) { return uphill[i]; }) < 0.0) t = 1.0;
       const double t_next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t)), beta = (t - 1.0) / t_next;
       t = momentum_bound > 0.0 ? std::min(t_next, momentum_bound) : t_next;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
       for (std::size_t i = 0; i < n; ++i) {
         Eigen::Vector3d y = next[i] + beta * (next[i] - x[i]);
         y.z() = std::max(y.z(), s_.r[i]);

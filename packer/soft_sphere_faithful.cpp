@@ -117,7 +117,7 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
                          con.max_pair_overlap / p.d_min, st.cg);
     });
     const double cg = st.cg;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (worth_threads(n))
     for (std::size_t i = 0; i < n; ++i) {
       Eigen::Vector3d& xi = s.x[i];
       xi += ck * con.push[i];
