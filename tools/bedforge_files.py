@@ -1,5 +1,7 @@
 """Where the tools find bedforge, and readers for the files it writes, shared by the tools."""
+import json
 import os
+import re
 
 import numpy as np
 
@@ -35,3 +37,57 @@ def made_line(result, unstamped=UNSTAMPED):
     if isinstance(r, dict) and "commit" in r:
         return f"Made at commit {r['commit']} on {r['date']}."
     return unstamped
+
+
+def read_bed(path):
+    """bed.csv: (centres (n, 3) m, diameters (n,) m, container dict in metres from its header)."""
+    container = {}
+    for line in open(path):
+        if not line.startswith("#"):
+            break
+        if line.startswith("# container_m:"):
+            container = json.loads(line.split(":", 1)[1])
+    bed = read_csv(path)
+    if "x_m" not in bed:  # an empty container
+        return np.zeros((0, 3)), np.zeros(0), container
+    return np.column_stack([bed["x_m"], bed["y_m"], bed["z_m"]]), bed["d_m"], container
+
+
+def _foam_list(data, start, dtype, width, binary):
+    """The OpenFOAM list at data[start:], `N (items)` raw or as text: (array (N, width), its end)."""
+    m = re.compile(rb"(\d+)\s*\(").search(data, start)
+    n, body = int(m.group(1)), m.end()
+    if binary:
+        end = body + n * width * np.dtype(dtype).itemsize
+        return np.frombuffer(data, dtype, n * width, body).reshape(n, width), end + 1
+    end = data.index(b"\n)" if width > 1 else b")", body)  # the closing parenthesis
+    numbers = re.findall(rb"[-+0-9.eE]+", data[body:end])
+    return np.array(numbers, dtype=np.float64).astype(dtype).reshape(n, width), end + 1
+
+
+def read_poly_mesh(directory):
+    """An OpenFOAM polyMesh directory (ASCII or binary, uncompressed): points (n, 3), the faces as
+    offsets (faces + 1) into labels (their vertices in order), owner (cell per face) and
+    neighbour (cell per internal face)."""
+    def load(name):
+        data = open(os.path.join(directory, name), "rb").read()
+        header_end = data.index(b"}", data.index(b"FoamFile")) + 1
+        return data, header_end, re.search(rb"format\s+binary", data[:header_end]) is not None
+    data, h, binary = load("points")
+    points, _ = _foam_list(data, h, "<f8", 3, binary)
+    data, h, binary = load("faces")
+    if b"faceCompactList" in data[:h]:
+        offsets, end = _foam_list(data, h, "<i4", 1, binary)
+        labels, _ = _foam_list(data, end, "<i4", 1, binary)
+        offsets, labels = offsets.ravel().astype(np.int64), labels.ravel().astype(np.int64)
+    else:
+        body = data[re.compile(rb"(\d+)\s*\(").search(data, h).end():]
+        faces = [np.array(f.split(), dtype=np.int64) for f in re.findall(rb"\d+\(([^)]*)\)", body)]
+        offsets = np.concatenate([[0], np.cumsum([len(f) for f in faces])])
+        labels = np.concatenate(faces)
+    cells = []
+    for name in ("owner", "neighbour"):
+        data, h, binary = load(name)
+        cells.append(_foam_list(data, h, "<i4", 1, binary)[0].ravel())
+    owner, neighbour = cells
+    return points, offsets, labels, owner, neighbour

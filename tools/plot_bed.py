@@ -12,7 +12,10 @@ case ran a mesh-convergence study ([case.convergence]), DIR/mesh_convergence.png
 cell size on each level, the Richardson extrapolation with the grid convergence index of the
 finest mesh, and Eisfeld & Schnitzlein's correlation at the bed's exact void fraction of the
 section with the +-20 % scatter of its data
-(docs/reference.md).
+(docs/reference.md). From bed.csv, DIR/bed.png: the bed seen from the side, spheres coloured by
+their contacts; and when DIR/case holds a mesh, DIR/mesh_section.png: the cells cut by the
+horizontal plane through the contact nearest the bed's middle, coloured by non-orthogonality,
+with a zoom onto that contact's gap.
 """
 import json
 import os
@@ -24,7 +27,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bedforge_files import read_csv  # noqa: E402
+from bedforge_files import read_bed, read_csv, read_poly_mesh  # noqa: E402
+
+CONTACT_GAP_D = 1e-3  # surfaces nearer than this (in d) count as touching in the pictures
 
 
 def main(d):
@@ -59,9 +64,138 @@ def main(d):
         ax.set_xlabel("void fraction"), ax.set_ylabel("height z/d"), ax.grid(alpha=0.3)
         fig.tight_layout(), fig.savefig(os.path.join(d, "axial_profile.png"), dpi=110), plt.close(fig)
     plot_convergence(report, os.path.join(d, "convergence.png"))
+    if os.path.exists(os.path.join(d, "bed.csv")):
+        centres, diameters, container = read_bed(os.path.join(d, "bed.csv"))
+        if len(diameters):
+            plot_bed_picture(centres, diameters, container, os.path.join(d, "bed.png"))
+            mesh = os.path.join(d, "case", "constant", "polyMesh")
+            if os.path.exists(os.path.join(mesh, "owner")):
+                plot_mesh_section(mesh, centres, diameters, os.path.join(d, "mesh_section.png"))
     case = report.get("stages", {}).get("case", {})
     if "convergence" in case:
         plot_mesh_convergence(case, os.path.join(d, "mesh_convergence.png"))
+
+
+def contacts(centres, diameters, container):
+    """Touching pairs (i, j) and each sphere's contact count, walls and floor included."""
+    from scipy.spatial import cKDTree
+    tol = CONTACT_GAP_D * diameters.mean()
+    r = 0.5 * diameters
+    pairs = np.array(sorted(cKDTree(centres).query_pairs(diameters.max() + tol)), dtype=int).reshape(-1, 2)
+    gap = np.linalg.norm(centres[pairs[:, 0]] - centres[pairs[:, 1]], axis=1) - r[pairs[:, 0]] - r[pairs[:, 1]]
+    pairs = pairs[gap < tol]
+    count = np.bincount(pairs.ravel(), minlength=len(r)) + (centres[:, 2] - r < tol)
+    radial = np.hypot(centres[:, 0], centres[:, 1])
+    if container.get("type") in ("cylinder", "annulus"):
+        count += 0.5 * container["diameter"] - radial - r < tol
+    if container.get("type") == "annulus":
+        count += radial - 0.5 * container["inner_diameter"] - r < tol
+    if container.get("type") == "box":
+        for axis, size in ((0, container.get("length_x", 0)), (1, container.get("length_y", 0))):
+            count += (0.5 * size - np.abs(centres[:, axis]) - r < tol)
+    return pairs, count
+
+
+def plot_bed_picture(centres, diameters, container, path):
+    """The bed seen from the side, each sphere shaded as lit from the upper left and coloured by
+    its number of contacts; spheres are painted far to near, so the near ones hide the rest."""
+    from matplotlib.patches import Circle
+    d = diameters.mean()
+    _, count = contacts(centres, diameters, container)
+    cmap = plt.get_cmap("viridis", max(2, count.max() + 1))
+    height = (centres[:, 2].max() + diameters.max()) / d
+    width = 2 * np.abs(centres[:, 0]).max() / d + 1
+    fig, ax = plt.subplots(figsize=(min(12, 2 + 0.9 * width), min(14, 1 + 0.9 * height)))
+    for i in np.argsort(-centres[:, 1]):  # the viewer looks along +y
+        x, z, r = centres[i, 0] / d, centres[i, 2] / d, 0.5 * diameters[i] / d
+        base = np.array(cmap(count[i])[:3])
+        for k, f in enumerate(np.linspace(1.0, 0.2, 10)):  # dark rim to a light spot up and to the left
+            shade = base * (0.45 + 0.55 * k / 9) + (1 - base) * 0.5 * (k / 9) ** 3
+            ax.add_patch(Circle((x - 0.35 * r * (1 - f), z + 0.35 * r * (1 - f)), r * f, color=np.clip(shade, 0, 1),
+                                lw=0))
+    ax.set_xlim(-width / 2, width / 2), ax.set_ylim(0, height), ax.set_aspect("equal")
+    ax.set_xlabel("x / d"), ax.set_ylabel("height z / d")
+    sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(-0.5, count.max() + 0.5))
+    fig.colorbar(sm, ax=ax, shrink=0.6, label=f"contacts per sphere (gap < {CONTACT_GAP_D:g} d, walls included)")
+    ax.set_title(f"{len(diameters)} spheres, side view", fontsize=9)
+    fig.tight_layout(), fig.savefig(path, dpi=110), plt.close(fig)
+
+
+def plot_mesh_section(mesh_dir, centres, diameters, path):
+    """The solved mesh cut by the horizontal plane through the contact nearest the bed's middle:
+    every cell the plane crosses, drawn as its cut and coloured by the largest non-orthogonality
+    of its faces (checkMesh's measure; above 70 degrees checkMesh warns); the right panel zooms
+    onto that contact."""
+    from matplotlib.collections import PolyCollection
+    d = diameters.mean()
+    points, offsets, labels, owner, neighbour = read_poly_mesh(mesh_dir)
+    pairs, _ = contacts(centres, diameters, {})
+    middle = 0.5 * (centres[:, 2].min() + centres[:, 2].max())
+    spots = 0.5 * (centres[pairs[:, 0]] + centres[pairs[:, 1]]) if len(pairs) else centres
+    spot = spots[np.argmin(np.abs(spots[:, 2] - middle))]
+    z0 = spot[2] + 1e-9 * d  # off any vertex exactly on the plane
+    # Face centres and area vectors by fans from the vertex average; cell centres from them.
+    sizes = np.diff(offsets)
+    face = np.repeat(np.arange(len(sizes)), sizes)
+    nxt = np.arange(len(labels)) + 1
+    nxt[offsets[1:] - 1] = offsets[:-1]
+    p, q = points[labels], points[labels[nxt]]
+    mid = np.add.reduceat(p, offsets[:-1]) / sizes[:, None]
+    tri = 0.5 * np.cross(p - mid[face], q - mid[face])
+    area = np.add.reduceat(tri, offsets[:-1])
+    w = np.linalg.norm(tri, axis=1)
+    centre = np.add.reduceat((mid[face] + p + q) / 3 * w[:, None], offsets[:-1]) / \
+        np.maximum(np.add.reduceat(w, offsets[:-1]), 1e-300)[:, None]
+    cells = owner.max() + 1
+    fa = np.linalg.norm(area, axis=1)
+    cell_centre = np.zeros((cells, 3))
+    weight = np.zeros(cells)
+    for c in (owner, np.concatenate([neighbour, -np.ones(len(owner) - len(neighbour), int)])):
+        ok = c >= 0
+        np.add.at(cell_centre, c[ok], centre[ok] * fa[ok, None])
+        np.add.at(weight, c[ok], fa[ok])
+    cell_centre /= weight[:, None]
+    internal = len(neighbour)
+    link = cell_centre[neighbour] - cell_centre[owner[:internal]]
+    cosine = np.einsum("ij,ij->i", link, area[:internal]) / (np.linalg.norm(link, axis=1) * fa[:internal])
+    non_ortho = np.degrees(np.arccos(np.clip(cosine, -1, 1)))
+    worst = np.zeros(cells)
+    np.maximum.at(worst, owner[:internal], non_ortho)
+    np.maximum.at(worst, neighbour, non_ortho)
+    # The plane's cut of each crossed cell: where its faces' edges cross z0.
+    crossing = (p[:, 2] - z0) * (q[:, 2] - z0) < 0
+    t = (z0 - p[crossing, 2]) / (q[crossing, 2] - p[crossing, 2])
+    cut = p[crossing, :2] + t[:, None] * (q[crossing, :2] - p[crossing, :2])
+    faces_cut = face[crossing]
+    by_cell = {}
+    for cell_of in (owner, np.concatenate([neighbour, -np.ones(len(owner) - len(neighbour), int)])):
+        cs = cell_of[faces_cut]
+        for c, xy in zip(cs[cs >= 0], cut[cs >= 0]):
+            by_cell.setdefault(c, []).append(xy)
+    polys, colours = [], []
+    for c, xy in by_cell.items():
+        xy = np.unique(np.round(np.array(xy) / d, 9), axis=0)
+        if len(xy) < 3:
+            continue
+        o = xy.mean(axis=0)
+        polys.append(xy[np.argsort(np.arctan2(xy[:, 1] - o[1], xy[:, 0] - o[0]))])
+        colours.append(worst[c])
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
+    for ax, zoom in zip(axes, (False, True)):
+        pc = PolyCollection(polys, array=np.array(colours), cmap="plasma", clim=(0, 80), edgecolors="k",
+                            linewidths=0.1 if not zoom else 0.3)
+        ax.add_collection(pc)
+        ax.set_aspect("equal")
+        if zoom:
+            ax.set_xlim(spot[0] / d - 0.4, spot[0] / d + 0.4), ax.set_ylim(spot[1] / d - 0.4, spot[1] / d + 0.4)
+            ax.set_title("around the contact", fontsize=9)
+        else:
+            ax.autoscale()
+            ax.plot(spot[0] / d, spot[1] / d, "c+", ms=14, mew=2)
+            ax.set_title(f"{len(polys)} cells cut by z = {z0 / d:.3f} d (+: the contact zoomed on)", fontsize=9)
+        ax.set_xlabel("x / d"), ax.set_ylabel("y / d")
+    fig.colorbar(pc, ax=axes, shrink=0.8, label="largest face non-orthogonality of the cell (deg)")
+    fig.savefig(path, dpi=110), plt.close(fig)
 
 
 def plot_mesh_convergence(case, path):
