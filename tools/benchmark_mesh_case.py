@@ -27,6 +27,8 @@ study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedfor
         [case.convergence] (--levels meshes, --ratio between them): each level's cells, dp/L and
         time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
         run's wall time from scene to that result. The section records the commit and date.
+study_gaps: the same study with surface.cells_per_gap = --study-gap-cells from a finest edge of
+        --study-gap-edge d (the gaps' refinement scales with the levels, through the contact edge).
 verification: the empty tube of scenes/examples/empty_tube_verification.toml (D = 2 d, 12 d long,
         particles.count = 0), whose exact dp/L is Hagen-Poiseuille's, through the same route on
         tetrahedra and on their polyhedral dual (case.cells): one `bedforge run` each with
@@ -53,7 +55,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "verification"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -185,16 +187,16 @@ def scale(tmp):
     return row
 
 
-def study(tmp, edge, levels, ratio, a=5, n=500, treatment="bridge"):
+def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge"):
     """One run of the scene with a mesh-convergence study; its levels and verdict."""
-    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}")
-    text = scene(a, n, treatment, edge, True) + f"[case.convergence]\nlevels = {levels}\nratio = {ratio}\n"
+    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}")
+    text = scene(a, n, treatment, edge, True, cells_per_gap) + f"[case.convergence]\nlevels = {levels}\nratio = {ratio}\n"
     open(path + ".toml", "w").write(text)
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     case = rep["stages"]["case"]
     return {**commit_and_date(), "a": a, "n": n, "treatment": treatment,
-            "edge_d": edge, "ratio": ratio, "wall_s": wall, "peak_mb": peak_mb(rep),
+            "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap, "wall_s": wall, "peak_mb": peak_mb(rep),
             "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
@@ -239,6 +241,43 @@ def stamp(rows):
     return [made_line(rows, "Made before this script recorded commits and dates, on gmsh's tetrahedra (before 3d88d5a "
                             "made the polyhedral dual the default, see the Verification section): not regenerated "
                             "since."), ""]
+
+
+def study_lines(r):
+    """A convergence study's section: its levels against E&S, the verdict, and the extrapolation
+    when the levels are in the asymptotic range."""
+    st = r["study"]
+    gaps = r.get("cells_per_gap", 0)
+    lines = [f"## a = {r['a']}, N = {r['n']}, {r['treatment']}" + (f", {gaps:g} cells across narrow gaps" if gaps else "")
+             + ": mesh-convergence study ([case.convergence])", "",
+             f"Made at commit {r['commit']} on {r['date']}: one `bedforge run` whose finest mesh has a surface "
+             f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
+             f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
+             "| level | lengths x | cells | h / d | dp/L (Pa/m) | / E&S at the bed's eps | "
+             "/ E&S at the finest mesh's eps | time (s) |",
+             "|---|---|---|---|---|---|---|---|"]
+
+    def bed_ratio(dp):  # runs before the bed's eps was recorded (before a877da4) have none
+        return f"{dp / r['es_bed_pa_m']:.3f}" if "es_bed_pa_m" in r else "not recorded"
+
+    for lv in st["levels"]:
+        if "failure" in lv:
+            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | {lv['time_s']:.0f} |")
+            continue
+        lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | "
+                     f"{lv['pressure_gradient_bed_pa_m']:.4g} | "
+                     f"{bed_ratio(lv['pressure_gradient_bed_pa_m'])} | "
+                     f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")
+    lines += ["", f"Verdict: {st['conclusion']}."]
+    g = st.get("grid_convergence", {})
+    if g.get("extrapolated") is not None and g.get("asymptotic", g.get("apparent_order", 0) >= 1):
+        lines += [f"Extrapolated dp/L {g['extrapolated']:.4g} Pa/m = {g['extrapolated'] / r['es_bed_pa_m']:.3f} x "
+                  f"Eisfeld & Schnitzlein at the bed's exact section void fraction {r['eps_section_bed']:.4f}; "
+                  f"apparent order {g['apparent_order']:.2f}; GCI of the finest mesh {100 * g['gci_fine']:.1f} % "
+                  f"(target: at most 5 %); asymptotic-range ratio GCI_32 / (r^p GCI_21) "
+                  f"{g['asymptotic_ratio']:.3f} (1 in the asymptotic range)."]
+    lines += [""]
+    return lines
 
 
 def write(results):
@@ -330,36 +369,9 @@ def write(results):
                   f"gmsh's tetrahedra {gen:.0f} s and the optimiser pass with the quality checks "
                   f"{st['mesh'] - gen:.0f} s; the surface {st['surface'] / r['wall_s']:.0%}, the packer "
                   f"{st['pack'] / r['wall_s']:.1%}.", ""]
-    if "study" in results:
-        r = results["study"]
-        st = r["study"]
-        lines += [f"## a = {r['a']}, N = {r['n']}, {r['treatment']}: mesh-convergence study ([case.convergence])", "",
-                  f"Made at commit {r['commit']} on {r['date']}: one `bedforge run` whose finest mesh has a surface "
-                  f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
-                  f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
-                  "| level | lengths x | cells | h / d | dp/L (Pa/m) | / E&S at the bed's eps | "
-                  "/ E&S at the finest mesh's eps | time (s) |",
-                  "|---|---|---|---|---|---|---|---|"]
-        def bed_ratio(dp):  # runs before the bed's eps was recorded (before a877da4) have none
-            return f"{dp / r['es_bed_pa_m']:.3f}" if "es_bed_pa_m" in r else "not recorded"
-
-        for lv in st["levels"]:
-            if "failure" in lv:
-                lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | {lv['time_s']:.0f} |")
-                continue
-            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | "
-                         f"{lv['pressure_gradient_bed_pa_m']:.4g} | "
-                         f"{bed_ratio(lv['pressure_gradient_bed_pa_m'])} | "
-                         f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")
-        lines += ["", f"Verdict: {st['conclusion']}."]
-        g = st.get("grid_convergence", {})
-        if g.get("extrapolated") is not None and g.get("asymptotic", g.get("apparent_order", 0) >= 1):
-            lines += [f"Extrapolated dp/L {g['extrapolated']:.4g} Pa/m = {g['extrapolated'] / r['es_bed_pa_m']:.3f} x "
-                      f"Eisfeld & Schnitzlein at the bed's exact section void fraction {r['eps_section_bed']:.4f}; "
-                      f"apparent order {g['apparent_order']:.2f}; GCI of the finest mesh {100 * g['gci_fine']:.1f} % "
-                      f"(target: at most 5 %); asymptotic-range ratio GCI_32 / (r^p GCI_21) "
-                      f"{g['asymptotic_ratio']:.3f} (1 in the asymptotic range)."]
-        lines += [""]
+    for key in ("study", "study_gaps"):
+        if key in results:
+            lines += study_lines(results[key])
     if "verification" in results:
         v = results["verification"]
         lines += ["## Verification: the empty tube against Hagen-Poiseuille, tetrahedra and their polyhedral dual", "",
@@ -439,6 +451,8 @@ def main():
     ap.add_argument("--layer-thickness", type=float, nargs="+", default=[0.02, 0.05])
     ap.add_argument("--levels", type=int, default=3, help="study: meshes in all")
     ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
+    ap.add_argument("--study-gap-edge", type=float, default=0.15, help="study_gaps: finest surface edge (d)")
+    ap.add_argument("--study-gap-cells", type=float, default=3, help="study_gaps: surface.cells_per_gap")
     ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
@@ -464,6 +478,9 @@ def main():
             write(results)
         if "study" in args.only:
             results["study"] = study(tmp, min(args.edges), args.levels, args.ratio)
+            write(results)
+        if "study_gaps" in args.only:
+            results["study_gaps"] = study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells)
             write(results)
         if "verification" in args.only:
             results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)
