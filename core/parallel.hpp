@@ -7,8 +7,8 @@ namespace bedforge {
 
 // Loops over fewer particles than this run on the calling thread alone. Below it a pass costs
 // less than waking and joining the other threads, and under load (another process on the
-// cores) every join waited for a descheduled thread: a 10-sphere pack took 6 s. The crossover
-// is measured in docs/defaults.md ("Threads").
+// cores) every join waited for a descheduled thread, so small packs took seconds. The
+// crossover and the slowdown are measured in docs/defaults.md ("Threads").
 constexpr std::size_t kParallelMinItems = 512;
 inline bool worth_threads(std::size_t items) { return items >= kParallelMinItems; }
 

@@ -46,7 +46,7 @@ MeshEstimate estimate_mesh(const Scene& scene) {
   double d = 0.0, solid = 0.0;
   if (scene.import.bed) {
     const Bed& b = scene.import.bed->bed;
-    d = sauter_mean(b.diameters);
+    d = reference_diameter(b);  // an imported empty container keeps its own
     for (double di : b.diameters) solid += pi / 6.0 * di * di * di;
   } else {
     d = scene.sizes.sauter_mean();

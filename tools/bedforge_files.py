@@ -2,6 +2,8 @@
 import json
 import os
 import re
+import subprocess
+import time
 
 import numpy as np
 
@@ -20,8 +22,6 @@ def read_csv(path):
 
 def commit_and_date():
     """Which code made a result: the short commit checked out here and today's date."""
-    import subprocess
-    import time
     commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
     return {"commit": commit, "date": time.strftime("%Y-%m-%d")}

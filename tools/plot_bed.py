@@ -67,10 +67,11 @@ def main(d):
     if os.path.exists(os.path.join(d, "bed.csv")):
         centres, diameters, container = read_bed(os.path.join(d, "bed.csv"))
         if len(diameters):
-            plot_bed_picture(centres, diameters, container, os.path.join(d, "bed.png"))
+            pairs, count = contacts(centres, diameters, container)
+            plot_bed_picture(centres, diameters, count, os.path.join(d, "bed.png"))
             mesh = os.path.join(d, "case", "constant", "polyMesh")
             if os.path.exists(os.path.join(mesh, "owner")):
-                plot_mesh_section(mesh, centres, diameters, os.path.join(d, "mesh_section.png"))
+                plot_mesh_section(mesh, centres, diameters, pairs, os.path.join(d, "mesh_section.png"))
     case = report.get("stages", {}).get("case", {})
     if "convergence" in case:
         plot_mesh_convergence(case, os.path.join(d, "mesh_convergence.png"))
@@ -96,12 +97,11 @@ def contacts(centres, diameters, container):
     return pairs, count
 
 
-def plot_bed_picture(centres, diameters, container, path):
+def plot_bed_picture(centres, diameters, count, path):
     """The bed seen from the side, each sphere shaded as lit from the upper left and coloured by
-    its number of contacts; spheres are painted far to near, so the near ones hide the rest."""
+    its number of contacts (`count`); spheres are painted far to near, so the near ones hide the rest."""
     from matplotlib.patches import Circle
     d = diameters.mean()
-    _, count = contacts(centres, diameters, container)
     cmap = plt.get_cmap("viridis", max(2, count.max() + 1))
     height = (centres[:, 2].max() + diameters.max()) / d
     width = 2 * np.abs(centres[:, 0]).max() / d + 1
@@ -121,15 +121,14 @@ def plot_bed_picture(centres, diameters, container, path):
     fig.tight_layout(), fig.savefig(path, dpi=110), plt.close(fig)
 
 
-def plot_mesh_section(mesh_dir, centres, diameters, path):
+def plot_mesh_section(mesh_dir, centres, diameters, pairs, path):
     """The solved mesh cut by the horizontal plane through the contact nearest the bed's middle:
     every cell the plane crosses, drawn as its cut and coloured by the largest non-orthogonality
     of its faces (checkMesh's measure; above 70 degrees checkMesh warns); the right panel zooms
-    onto that contact."""
+    onto that contact. `pairs`: the touching pairs of `contacts`."""
     from matplotlib.collections import PolyCollection
     d = diameters.mean()
     points, offsets, labels, owner, neighbour = read_poly_mesh(mesh_dir)
-    pairs, _ = contacts(centres, diameters, {})
     middle = 0.5 * (centres[:, 2].min() + centres[:, 2].max())
     spots = 0.5 * (centres[pairs[:, 0]] + centres[pairs[:, 1]]) if len(pairs) else centres
     spot = spots[np.argmin(np.abs(spots[:, 2] - middle))]
@@ -147,10 +146,11 @@ def plot_mesh_section(mesh_dir, centres, diameters, path):
     centre = np.add.reduceat((mid[face] + p + q) / 3 * w[:, None], offsets[:-1]) / \
         np.maximum(np.add.reduceat(w, offsets[:-1]), 1e-300)[:, None]
     cells = owner.max() + 1
+    beyond = np.concatenate([neighbour, -np.ones(len(owner) - len(neighbour), int)])  # -1 on boundary faces
     fa = np.linalg.norm(area, axis=1)
     cell_centre = np.zeros((cells, 3))
     weight = np.zeros(cells)
-    for c in (owner, np.concatenate([neighbour, -np.ones(len(owner) - len(neighbour), int)])):
+    for c in (owner, beyond):
         ok = c >= 0
         np.add.at(cell_centre, c[ok], centre[ok] * fa[ok, None])
         np.add.at(weight, c[ok], fa[ok])
@@ -168,7 +168,7 @@ def plot_mesh_section(mesh_dir, centres, diameters, path):
     cut = p[crossing, :2] + t[:, None] * (q[crossing, :2] - p[crossing, :2])
     faces_cut = face[crossing]
     by_cell = {}
-    for cell_of in (owner, np.concatenate([neighbour, -np.ones(len(owner) - len(neighbour), int)])):
+    for cell_of in (owner, beyond):
         cs = cell_of[faces_cut]
         for c, xy in zip(cs[cs >= 0], cut[cs >= 0]):
             by_cell.setdefault(c, []).append(xy)
