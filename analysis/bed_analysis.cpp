@@ -194,8 +194,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
   csv = "# contacts per sphere (gap tolerance " + fmt::format("{} smallest diameters", p.contact_tolerance_d) +
         ")\nindex,sphere_contacts,wall_contacts,floor_contact\n";
   for (std::size_t i = 0; i < bed.size(); ++i) {
-    const int total = cs.sphere_contacts[i] + cs.wall_contacts[i] + cs.floor_contact[i];
-    const bool rattler = total < 4;
+    const bool rattler = is_rattler(cs, i);
     pair_sum += cs.sphere_contacts[i];
     rattlers += rattler;
     if (!rattler) non_rattler_sum += cs.sphere_contacts[i];
@@ -222,6 +221,12 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
       {"rattler_definition", "fewer than 4 contacts with spheres, walls and floor"},
       {"gap_tolerance_d", p.contact_tolerance_d}};
   if (bulk_n == 0) j["coordination"]["bulk_mean_without_rattlers"] = nullptr;
+  j["coordination"]["central_slab"] = nullptr;
+  if (slab.valid) {
+    const SlabCoordination sl = slab_coordination(bed, cs, slab.lo, slab.hi);
+    j["coordination"]["central_slab"] = {
+        {"spheres", sl.spheres}, {"mean_all", sl.mean_sphere_contacts}, {"rattlers", sl.rattlers}};
+  }
   j["wall_contacts"] = {{"spheres_touching_lateral_wall", wall}, {"spheres_touching_floor", floor}};
   j["overlaps"] = {{"max_pair_overlap_d", cs.max_pair_overlap / sc.d_min},
                    {"max_wall_overlap_d", cs.max_wall_overlap / sc.d_min},

@@ -78,4 +78,18 @@ ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance) {
   return st;
 }
 
+SlabCoordination slab_coordination(const Bed& bed, const ContactStatistics& cs, double z_lo, double z_hi) {
+  SlabCoordination out;
+  long contacts = 0;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const double z = bed.centres[i].z();
+    if (z < z_lo || z > z_hi) continue;
+    ++out.spheres;
+    contacts += cs.sphere_contacts[i];
+    out.rattlers += is_rattler(cs, i);
+  }
+  if (out.spheres > 0) out.mean_sphere_contacts = static_cast<double>(contacts) / static_cast<double>(out.spheres);
+  return out;
+}
+
 }  // namespace bedforge::analysis

@@ -24,4 +24,19 @@ struct ContactStatistics {
 
 ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance);
 
+// A rattler carries no load: fewer than 4 contacts with spheres, walls and floor together.
+inline bool is_rattler(const ContactStatistics& cs, std::size_t i) {
+  return cs.sphere_contacts[i] + cs.wall_contacts[i] + cs.floor_contact[i] < 4;
+}
+
+// Spheres whose centres lie between heights z_lo and z_hi (m), walls included: how many, the
+// mean of their sphere contacts (rattlers counted, as DEM studies of whole cross-sections
+// quote it) and how many of them are rattlers.
+struct SlabCoordination {
+  long spheres = 0;
+  double mean_sphere_contacts = 0;
+  long rattlers = 0;
+};
+SlabCoordination slab_coordination(const Bed& bed, const ContactStatistics& cs, double z_lo, double z_hi);
+
 }  // namespace bedforge::analysis

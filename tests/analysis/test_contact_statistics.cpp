@@ -73,3 +73,29 @@ TEST(ContactStatistics, ResidualOfABalancedStackIsZero) {
   b.centres[2].z() += 0.1;
   EXPECT_GT(contact_statistics(b, 1e-4).residual_max, 0.5);
 }
+
+TEST(ContactStatistics, SlabCoordinationCountsOnlyCentresInsideAndSetsRattlersApart) {
+  // A single-file column of 5 touching spheres in a wide tube: the floor sphere has 2 contacts
+  // (floor, one above), the inner three 2 each, the top one 1; all are rattlers (< 4). The
+  // slab 1.2 <= z <= 3.8 holds the spheres at z = 1.5, 2.5 and 3.5 only.
+  Bed b;
+  b.container = std::make_shared<Cylinder>(5.0);
+  for (int k = 0; k < 5; ++k) b.centres.emplace_back(0, 0, 0.5 + k), b.diameters.push_back(1.0);
+  const auto st = contact_statistics(b, 1e-6);
+  const SlabCoordination in = slab_coordination(b, st, 1.2, 3.8);
+  EXPECT_EQ(in.spheres, 3);
+  EXPECT_DOUBLE_EQ(in.mean_sphere_contacts, 2.0);
+  EXPECT_EQ(in.rattlers, 3);
+  // In an inner lattice plane of the fcc block every sphere touches at least 8 others (even at
+  // a corner of the plane: 4 in the plane below, 4 in the plane above or beside it), the inner
+  // ones 12; none is a rattler.
+  const Bed f = fcc_block(4, 1.0);
+  const auto fs = contact_statistics(f, 1e-9);
+  const double a = std::sqrt(2.0), mid = 10.0 + 1.5 * a;  // middle lattice plane of the block
+  const SlabCoordination core = slab_coordination(f, fs, mid - 0.1, mid + 0.1);
+  EXPECT_GT(core.spheres, 0);
+  EXPECT_EQ(core.rattlers, 0);
+  EXPECT_GT(core.mean_sphere_contacts, 8.0);
+  EXPECT_LT(core.mean_sphere_contacts, 12.0);
+  EXPECT_EQ(slab_coordination(f, fs, -5.0, -1.0).spheres, 0);
+}
