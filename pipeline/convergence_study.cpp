@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
+#include <optional>
 
 #include "core/bed_io.hpp"
 #include "core/stage_meter.hpp"
@@ -20,6 +22,10 @@ nlohmann::json ConvergenceStudy::to_json() const {
   nlohmann::json out = {{"complete", complete}, {"conclusion", conclusion}, {"levels", nlohmann::json::array()}};
   for (const StudyLevel& l : levels) {
     nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}};
+    if (!l.sizing.empty()) {
+      j["sizing"] = nlohmann::json::array();
+      for (const auto& [scale, h] : l.sizing) j["sizing"].push_back({{"scale", scale}, {"predicted_cell_size_m", h}});
+    }
     if (l.failure.empty()) {
       j.update({{"cells", l.cells},
                 {"cell_size_m", l.cell_size_m},
@@ -57,27 +63,58 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
 
 namespace {
 
-// Level k of the study: the scene's mesh lengths scaled by `scale`, solved in `case_dir`.
-StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double scale, const fs::path& case_dir,
-                       const Console& console) {
+// A level's cells must reach their target size within this fraction, tried at most this often.
+constexpr double kSizeTolerance = 0.03;
+constexpr int kSizingAttempts = 4;
+
+// The cells the flow will be solved on, from the tetrahedra before the case is written:
+// polyDualMesh makes one polyhedron per point.
+long cells_to_solve(const meshing::PolyMesh& tets, bool polyhedra) {
+  return polyhedra ? static_cast<long>(tets.points.size()) : tets.cells;
+}
+
+// Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
+// do not set the cell size in proportion (points per sphere and per contact loop, gap and
+// wall rules stay), so the scale is searched: h ~ scale^alpha in log-log secant steps from
+// `scale` and `alpha` (updated with what was measured, for the next level).
+StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_h_m, double& scale, double& alpha,
+                       const fs::path& case_dir, const Console& console) {
   const StageMeter meter;
   StudyLevel l;
   l.level = k;
-  l.scale = scale;
-  meshing::SurfaceParams surface = scene.surface;
-  surface.edge_length_d *= scale;
-  surface.contact_edge_length_d *= scale;
-  meshing::VolumeMeshParams mesh = scene.mesh;
-  mesh.max_size_d *= scale;
   try {
-    const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
-    const MeshStage m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, mesh, {},
-                                   case_dir.parent_path() / "bad_cells.vtk", console);
+    std::optional<MeshStage> m;
+    double last_scale = 0.0, last_h = 0.0;
+    for (int attempt = 1;; ++attempt) {
+      meshing::SurfaceParams surface = scene.surface;
+      surface.edge_length_d *= scale;
+      surface.contact_edge_length_d *= scale;
+      meshing::VolumeMeshParams mesh = scene.mesh;
+      mesh.max_size_d *= scale;
+      const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
+      m.reset();  // the previous attempt's mesh is not needed any more
+      m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, mesh, {}, case_dir.parent_path() / "bad_cells.vtk",
+                     console);
+      const double h = std::cbrt(m->volume->quality.total_volume /
+                                 static_cast<double>(cells_to_solve(m->volume->mesh, scene.case_params.polyhedra)));
+      l.sizing.push_back({scale, h});
+      const double off = h / target_h_m - 1.0;
+      console.line(fmt::format("convergence: level {}, mesh lengths x {:.3g}: cells of {:.4g} d, {:+.1f} % off the "
+                               "target", k, scale, h / reference_diameter(bed), 100.0 * off));
+      if (std::abs(off) <= kSizeTolerance || attempt == kSizingAttempts) break;
+      if (last_scale > 0.0 && std::abs(std::log(scale / last_scale)) > 1e-3)
+        alpha = std::clamp(std::log(h / last_h) / std::log(scale / last_scale), 0.2, 2.0);
+      last_scale = scale, last_h = h;
+      scale *= std::pow(target_h_m / h, 1.0 / alpha);
+    }
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
-    const CaseStage c = case_stage(m.volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
+    const CaseStage c = case_stage(m->volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
                                    case_dir, true, console);
+    const auto sizing = l.sizing;
     l = study_level(c, k, scale, 0.0);
+    l.sizing = sizing;
   } catch (const std::exception& e) {
+    l.scale = scale;
     l.failure = e.what();
   }
   l.time_s = meter.seconds();
@@ -91,10 +128,15 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
   const cases::CaseParams::Convergence& p = scene.case_params.convergence;
   ConvergenceStudy study;
   study.levels.push_back(finest);
+  // Each level's cells `ratio` times the size of the finer one's, measured on the cells solved
+  // on (Celik et al. 2008 ask r >= 1.3 of the grids, not of the settings that make them).
+  double scale = 1.0, alpha = 1.0;  // the first guess: cell size in proportion to the lengths
   for (int k = 2; k <= p.levels; ++k) {
-    const double scale = std::pow(p.ratio, k - 1);
-    console.line(fmt::format("convergence: level {} of {}, mesh lengths x {:.3g}", k, p.levels, scale));
-    study.levels.push_back(solve_level(scene, bed, k, scale, dir / fmt::format("level_{}", k), console));
+    const double target = finest.cell_size_m * std::pow(p.ratio, k - 1);
+    scale *= std::pow(p.ratio, 1.0 / alpha);
+    console.line(fmt::format("convergence: level {} of {}, cells of {:.4g} d wanted", k, p.levels,
+                             target / reference_diameter(bed)));
+    study.levels.push_back(solve_level(scene, bed, k, target, scale, alpha, dir / fmt::format("level_{}", k), console));
   }
   // The finest three levels in a row that gave a value.
   for (std::size_t first = 0; first + 2 < study.levels.size(); ++first) {

@@ -26,6 +26,9 @@ struct StudyLevel {
                               // the flow alone of the finest (its surface and mesh may be reused)
   std::string failure;        // why the level gave no value (empty when it did)
   std::optional<double> exact_pa_m;  // an empty container's known answer (the case's)
+  // The scales tried to bring a coarser level's cells to their target size, with the cell size
+  // each mesh promised ((fluid volume / cells to solve)^(1/3), m), the last one solved.
+  std::vector<std::pair<double, double>> sizing;
 };
 
 // The pressure drop's discretisation error from the flow solved on the scene's mesh and on
@@ -47,9 +50,11 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
 
 // The study of [case.convergence] on `bed` (m): `finest` is the scene's own level, already
 // solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's
-// surface.edge_length_d, surface.contact_edge_length_d and mesh.max_size_d by ratio^(k - 1),
-// builds its surface and mesh in memory and solves its case in `dir`/level_k. A level that
-// fails (a gate, the solver) is reported with its reason, and the others go on.
+// surface.edge_length_d, surface.contact_edge_length_d and mesh.max_size_d by the factor that
+// makes its cells ratio^(k - 1) times the size of the finest's (searched: up to 4 surfaces and
+// meshes, to within 3 %), builds its surface and mesh in memory and solves its case in
+// `dir`/level_k. A level that fails (a gate, the solver) is reported with its reason, and the
+// others go on.
 ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest,
                                    const std::filesystem::path& dir, const Console& console);
 

@@ -253,18 +253,22 @@ def study_lines(r):
              f"Made at commit {r['commit']} on {r['date']}: one `bedforge run` whose finest mesh has a surface "
              f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
              f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
-             "| level | lengths x | cells | h / d | dp/L (Pa/m) | / E&S at the bed's eps | "
+             "| level | lengths x | cells | h / d | h / finer h | dp/L (Pa/m) | / E&S at the bed's eps | "
              "/ E&S at the finest mesh's eps | time (s) |",
-             "|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|"]
 
     def bed_ratio(dp):  # runs before the bed's eps was recorded (before a877da4) have none
         return f"{dp / r['es_bed_pa_m']:.3f}" if "es_bed_pa_m" in r else "not recorded"
 
+    finer = None
     for lv in st["levels"]:
         if "failure" in lv:
-            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | {lv['time_s']:.0f} |")
+            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | | {lv['time_s']:.0f} |")
+            finer = None
             continue
-        lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | "
+        step = f"{lv['cell_size_m'] / finer:.3f}" if finer else ""
+        finer = lv["cell_size_m"]
+        lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | {step} | "
                      f"{lv['pressure_gradient_bed_pa_m']:.4g} | "
                      f"{bed_ratio(lv['pressure_gradient_bed_pa_m'])} | "
                      f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")

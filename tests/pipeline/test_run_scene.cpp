@@ -163,7 +163,14 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
     const auto& level = study["levels"][k];
     ASSERT_FALSE(level.contains("failure")) << level.dump();
     EXPECT_EQ(level["level"], k + 1);
-    EXPECT_NEAR(level["scale"].get<double>(), std::pow(1.3, k), 1e-12);
+  }
+  // Each coarser level's solved cells are 1.3 times the size of the finer one's: the sizing
+  // search stops within 3 % of its target, on the points of the tetrahedra (one polyhedron each).
+  for (int k = 1; k < 3; ++k) {
+    const auto& level = study["levels"][k];
+    const double h = level["cell_size_m"].get<double>(), h1 = study["levels"][0]["cell_size_m"].get<double>();
+    EXPECT_NEAR(h / h1, std::pow(1.3, k), 0.03 * std::pow(1.3, k)) << level.dump();
+    EXPECT_NEAR(level["sizing"].back()["predicted_cell_size_m"].get<double>(), h, 1e-9 * h) << level.dump();
   }
   // The scene's own mesh is the finest; the flow is solved on its polyhedral dual.
   EXPECT_EQ(study["levels"][0]["cells"], r.stages["case"]["flow"]["mesh"]["cells"]);
@@ -175,8 +182,6 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   EXPECT_EQ(flow["void_fraction_section_bed"], r.stages["case"]["section"]["void_fraction_bed"]);
   EXPECT_EQ(study["levels"][0]["pressure_gradient_bed_pa_m"], r.stages["case"]["flow"]["pressure_gradient_bed_pa_m"]);
   for (int k = 1; k < 3; ++k) {
-    // Coarser lengths, fewer cells; the procedure takes each level's own cell size, since the
-    // surface's rules (points per sphere, per loop) keep the fall from being ratio^3 exactly.
     EXPECT_LT(study["levels"][k]["cells"].get<long>(), study["levels"][k - 1]["cells"].get<long>()) << k;
     EXPECT_GT(study["levels"][k]["cell_size_m"].get<double>(), study["levels"][k - 1]["cell_size_m"].get<double>());
   }
@@ -198,7 +203,7 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
 TEST(RunScene, AConvergenceStudyReportsTheLevelsThatFailed) {
   const fs::path dir = test_support::fresh_dir("convergence_failed");
   const Scene scene = small_scene(
-      "\"case\"", "[case]\nrun = true\niterations = 2\n[case.convergence]\nlevels = 3\nratio = 1.4\n", kOpenSurface);
+      "\"case\"", "[case]\nrun = true\niterations = 2\n[case.convergence]\nlevels = 3\nratio = 1.3\n", kOpenSurface);
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& study = r.stages["case"]["convergence"];
   EXPECT_FALSE(study["complete"].get<bool>());
