@@ -17,8 +17,8 @@ gaps:   the same bed, surface edge 0.2 d, refined only where surfaces face each 
         narrow gaps (surface.cells_per_gap = 2 and 3), solved the same way: the pressure drop
         against cells and time, next to the uniformly refined levels.
 layers: a = 4, N = 40 (seed 1), shrink, surface edge 0.1 d without and with 3 prism layers on the
-        particles ([mesh.layers] thickness_d as given), and 0.07 d without, solved the same way.
-        (On the a = 5 bed with bridges at 0.2 d, simpleFoam did not converge with layers.)
+        particles ([mesh.layers] thickness_d as given), and 0.07 d without, solved the same way;
+        then the studies' bridged a = 5, N = 500 bed at 0.15 d without and with 3 layers of 0.02 d.
 snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
         the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
@@ -131,7 +131,7 @@ def sizes(tmp, levels, a=5, n=500, treatment="bridge"):
         ok, cells, non_ortho, skew, _ = check_mesh(os.path.join(path, "case"))
         flow = rep["stages"]["case"]["flow"]
         mesh = rep["stages"]["mesh"]
-        rows.append({"route": "gmsh", "edge_d": edge, "cells_per_gap": gap_cells, "layers": layers,
+        rows.append({"route": "gmsh", "a": a, "n": n, "treatment": treatment, "edge_d": edge, "cells_per_gap": gap_cells, "layers": layers,
                      "layer_thickness_d": thickness if layers else 0, "layer_cells": mesh.get("layers", {}).get("cells"),
                      "layer_mean_thickness_d": mesh.get("layers", {}).get("mean_thickness_d"), "cells": cells,
                      "wall_s": wall,
@@ -325,26 +325,31 @@ def write(results):
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['eps_section']:.4f} | {r['peak_mb']:.0f} |")
         lines.append("")
     if "layers" in results:
-        lines += ["## Prism layers on the particles (`[mesh.layers]`): a = 4, N = 40, shrink", "", *stamp(results["layers"]),
-                  "The bed of `scenes/examples/small_bed_flow.toml`. 3 layers growing by 1.2, at most 0.2 of the "
+        lines += ["## Prism layers on the particles (`[mesh.layers]`)", "", *stamp(results["layers"]),
+                  "a = 4, N = 40, shrink: the bed of `scenes/examples/small_bed_flow.toml`; a = 5, N = 500, bridges: "
+                  "the bed of the studies. 3 layers growing by 1.2, at most 0.2 of the "
                   "gap ahead of each stack and at least one surface edge of it left to the tetrahedra; none where "
-                  "that leaves under half the thickness. */ finest* compares with the 0.07 d mesh without layers.", "",
-                  "| surface edge (d) | layers, thickness (d), mean reached | cells (prisms, pyramids, tets in the "
+                  "that leaves under half the thickness. The flow is solved on the cells `case.cells` makes (the "
+                  "polyhedral dual by default; cells = checkMesh's count). */ finest* compares with the finest mesh "
+                  "without layers of the same bed.", "",
+                  "| bed | surface edge (d) | layers, thickness (d), mean reached | cells (prisms, pyramids, tets in the "
                   "layers) | mesh s | simpleFoam s (its) | whole run s | checkMesh | max non-ortho | dp/L (Pa/m) | "
-                  "/ E&S | / finest | eps section |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-        finest = min(results["layers"], key=lambda r: r["edge_d"])
+                  "/ E&S | / finest | eps section |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        bed = lambda r: (r.get("a", 4), r.get("n", 40), r.get("treatment", "shrink"))  # rows before the bed was recorded
         for r in results["layers"]:
+            finest = min((x for x in results["layers"] if bed(x) == bed(r) and not x["layers"]), key=lambda x: x["edge_d"])
             st, lc = r["stages_s"], r.get("layer_cells") or {}
             reached = f"3, {r['layer_thickness_d']:g}, {r['layer_mean_thickness_d']:.3f}" if r["layers"] else "none"
             cells = f"{r['cells']} ({lc.get('prisms', 0)}, {lc.get('pyramids', 0)}, {lc.get('tetrahedra', 0)})" \
                 if r["layers"] else f"{r['cells']}"
-            lines.append(f"| {r['edge_d']} | {reached} | {cells} | {st.get('mesh', 0):.1f} | {r['solve_s']:.0f} "
+            lines.append(f"| a = {bed(r)[0]:g}, N = {bed(r)[1]}, {bed(r)[2]} | {r['edge_d']} | {reached} | {cells} | "
+                         f"{st.get('mesh', 0):.1f} | {r['solve_s']:.0f} "
                          f"({r['iterations']}{'' if r['converged'] else ', not converged'}) | {r['wall_s']:.0f} | "
                          f"{'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
                          f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} | {r['dp_dz_pa_m'] / finest['dp_dz_pa_m']:.3f} | "
                          f"{r['eps_section']:.4f} |")
-        lines += ["", "Layers on the bridged a = 5 bed did not converge in simpleFoam (2026-11-22, not regenerated): "
-                  "[findings.md](findings.md).", ""]
+        lines += ["", "On gmsh's tetrahedra, layers on the bridged a = 5 bed did not converge in simpleFoam "
+                  "(2026-11-22, not regenerated): [findings.md](findings.md).", ""]
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
         lines += ["## The same bed by the snappyHexMesh route", "", *stamp(results["snappy"]),
@@ -499,6 +504,9 @@ def main():
             results["layers"] = [{**commit_and_date(), **r} for r in sizes(
                 tmp, [(0.1, 0, 0, 0.02)] + [(0.1, 0, 3, t) for t in args.layer_thickness] + [(0.07, 0, 0, 0.02)],
                 a=4, n=40, treatment="shrink")]
+            # The bridged bed of the studies, where layers had stalled simpleFoam on tetrahedra.
+            results["layers"] += [{**commit_and_date(), **r} for r in sizes(
+                tmp, [(0.15, 0, 0, 0.02), (0.15, 0, 3, 0.02)], a=5, n=500, treatment="bridge")]
             write(results)
         if "snappy" in args.only:
             results["snappy"] = {**commit_and_date(), **snappy(tmp, min(args.edges))}
