@@ -73,18 +73,25 @@ long cells_to_solve(const meshing::PolyMesh& tets, bool polyhedra) {
   return polyhedra ? static_cast<long>(tets.points.size()) : tets.cells;
 }
 
+// A mesh scale and the size of the cells it made (m).
+struct Sized {
+  double scale, h;
+};
+
 // Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
 // do not set the cell size in proportion (points per sphere and per contact loop, gap and
-// wall rules stay), so the scale is searched: h ~ scale^alpha in log-log secant steps from
-// `scale` and `alpha` (updated with what was measured, for the next level).
-StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_h_m, double& scale, double& alpha,
+// wall rules stay), so the scale is searched in log-log secant steps, starting from `finer`
+// (the finer level's scale and size; the next level's on return) and an exponent `alpha` of
+// h ~ scale^alpha, updated with what was measured.
+StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_h_m, Sized& finer, double& alpha,
                        const fs::path& case_dir, const Console& console) {
   const StageMeter meter;
   StudyLevel l;
   l.level = k;
+  double scale = finer.scale * std::pow(target_h_m / finer.h, 1.0 / alpha);
   try {
     std::optional<MeshStage> m;
-    double last_scale = 0.0, last_h = 0.0;
+    double last_scale = finer.scale, last_h = finer.h;
     for (int attempt = 1;; ++attempt) {
       meshing::SurfaceParams surface = scene.surface;
       surface.edge_length_d *= scale;
@@ -101,9 +108,12 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       const double off = h / target_h_m - 1.0;
       console.line(fmt::format("convergence: level {}, mesh lengths x {:.3g}: cells of {:.4g} d, {:+.1f} % off the "
                                "target", k, scale, h / reference_diameter(bed), 100.0 * off));
-      if (std::abs(off) <= kSizeTolerance || attempt == kSizingAttempts) break;
-      if (last_scale > 0.0 && std::abs(std::log(scale / last_scale)) > 1e-3)
+      if (std::abs(std::log(scale / last_scale)) > 1e-3)
         alpha = std::clamp(std::log(h / last_h) / std::log(scale / last_scale), 0.2, 2.0);
+      if (std::abs(off) <= kSizeTolerance || attempt == kSizingAttempts) {
+        finer = {scale, h};
+        break;
+      }
       last_scale = scale, last_h = h;
       scale *= std::pow(target_h_m / h, 1.0 / alpha);
     }
@@ -130,13 +140,13 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
   study.levels.push_back(finest);
   // Each level's cells `ratio` times the size of the finer one's, measured on the cells solved
   // on (Celik et al. 2008 ask r >= 1.3 of the grids, not of the settings that make them).
-  double scale = 1.0, alpha = 1.0;  // the first guess: cell size in proportion to the lengths
+  Sized finer{1.0, finest.cell_size_m};
+  double alpha = 1.0;  // the first guess: cell size in proportion to the lengths
   for (int k = 2; k <= p.levels; ++k) {
     const double target = finest.cell_size_m * std::pow(p.ratio, k - 1);
-    scale *= std::pow(p.ratio, 1.0 / alpha);
     console.line(fmt::format("convergence: level {} of {}, cells of {:.4g} d wanted", k, p.levels,
                              target / reference_diameter(bed)));
-    study.levels.push_back(solve_level(scene, bed, k, target, scale, alpha, dir / fmt::format("level_{}", k), console));
+    study.levels.push_back(solve_level(scene, bed, k, target, finer, alpha, dir / fmt::format("level_{}", k), console));
   }
   // The finest three levels in a row that gave a value.
   for (std::size_t first = 0; first + 2 < study.levels.size(); ++first) {
