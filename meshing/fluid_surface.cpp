@@ -144,13 +144,24 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   const double r_in = ann ? ann->inner_radius() : 0.0;
 
   // A curved wall is faceted between vertices on it: its facets lie inside it by up to the
-  // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a sphere.
-  const double wall_sag = box ? 0.0 : ring_sagitta(R, edge);
-  if (wall_sag >= 0.5 * tb.min_concave_wall_gap)
-    throw InputError(fmt::format("surface.edge_length_d = {}: the wall facets lie up to {:.3g} d inside the wall, more "
-                                 "than half the narrowest gap left at the wall ({:.3g} d); allowed: a shorter edge or a "
-                                 "treatment that leaves a wider gap",
-                                 p.edge_length_d, wall_sag / d, tb.min_concave_wall_gap / d));
+  // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a
+  // sphere. Where the spheres' edge is too long for that, the curved walls (a few thousand
+  // triangles; an annulus's two share the end rings' meshes) take the longest edge whose
+  // sagitta is 0.4 of the gap, down to the contact edge.
+  double wall_edge = edge;
+  if (!box && ring_sagitta(R, edge) >= 0.5 * tb.min_concave_wall_gap) {
+    const double allowed = 0.4 * tb.min_concave_wall_gap;
+    const double points = allowed > 0.0 ? std::ceil(std::numbers::pi / std::acos(1.0 - allowed / R)) : HUGE_VAL;
+    wall_edge = 2.0 * std::numbers::pi * R / points * (1.0 + 1e-12);  // ring_points(R, wall_edge) == points
+    if (!(wall_edge >= p.contact_edge_length_d * d))
+      throw InputError(fmt::format(
+          "surface.edge_length_d = {}: the wall facets would lie up to {:.3g} d inside the wall, more than half the "
+          "narrowest gap left at the wall ({:.3g} d), and a wall edge short enough ({:.3g} d) is below "
+          "surface.contact_edge_length_d = {}; allowed: a treatment that leaves a wider gap at the wall",
+          p.edge_length_d, ring_sagitta(R, edge) / d, tb.min_concave_wall_gap / d, wall_edge / d,
+          p.contact_edge_length_d));
+  }
+  const double wall_sag = box ? 0.0 : ring_sagitta(R, wall_edge);
 
   // Edges shortened where the surface faces another across a narrow gap.
   std::optional<GapSpacing> gaps;
@@ -212,23 +223,23 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       add("wall", [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
     }
   } else {
-    add("wall", [&] { return wall_mesh(R, z0, z1, edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
+    add("wall", [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
     if (ann)
       add("inner_wall",
-          [&] { return wall_mesh(r_in, z0, z1, edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
+          [&] { return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
   }
   // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
   using Loops = std::vector<std::vector<Eigen::Vector3d>>;
   auto end_boundary = [&](const Frame& frame, double z) {
     if (box) return Loops{box_face_loop({corner({-1, -1}, z), corner({1, -1}, z), corner({1, 1}, z), corner({-1, 1}, z)}, edge)};
-    Loops boundary{circle_loop(frame, R, ring_points(R, edge))};
-    if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, edge)));
+    Loops boundary{circle_loop(frame, R, ring_points(R, wall_edge))};
+    if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, wall_edge)));
     return boundary;
   };
   for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
     if (!box && !p.clip) {  // nothing cuts it: the structured ring
-      f.append(ring_mesh(frame, r_in, R, edge, up, patch));
+      f.append(ring_mesh(frame, r_in, R, wall_edge, up, patch));
       continue;
     }
     add(patch, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
@@ -262,6 +273,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
   out.report["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
   out.report["wall_sagitta_d"] = wall_sag / d;
+  out.report["wall_edge_d"] = wall_edge / d;
   out.report["triangles"] = f.triangles.size();
   out.report["min_angle_deg"] = q.min_angle_deg;
   out.report["min_edge_d"] = q.min_edge / d;

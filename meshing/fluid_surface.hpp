@@ -58,8 +58,10 @@ struct FluidSurface {
 
 // Treats the contacts of `bed` and builds the fluid domain's surface: patches `inlet`,
 // `outlet`, `wall` (the four sides of a box; and `inner_wall` for an annulus), `particles`. InputError, naming the
-// particles, when the treatment leaves spheres overlapping or touching a wall, or when the
-// wall facets would cut into the gaps left; the report holds the treatment's effect (contacts
+// particles, when the treatment leaves spheres overlapping or touching a wall, or a wall gap
+// so thin that wall facets short enough to keep clear of it would be shorter than the contact
+// edge (the curved walls take a shorter edge than the spheres where their gaps need it); the
+// report holds the treatment's effect (contacts
 // treated, solid volume and area change, smallest gap) and the surface's accuracy (chordal
 // deviation, exact fluid volume, triangle quality).
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& params);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "meshing/primitives.hpp"
 #include "meshing/stl_io.hpp"
 #include "meshing/surface_checks.hpp"
 
@@ -45,6 +46,35 @@ TEST(FluidSurface, ShrinkOpensTouchingContactsInACylinder) {
   const SurfaceCheck kb = check_surface(fs.bed, 10'000'000);
   EXPECT_TRUE(kb.closed && !kb.self_intersecting);
   EXPECT_GT(kb.volume, 0.0);
+}
+
+// A sphere tangent to the wall keeps a gap of 0.005 d after `shrink`. At a surface edge of
+// 0.3 d the wall's chords would lie 0.0075 d inside it, across that gap: the wall alone takes a
+// shorter edge, its sagitta at most 0.4 of the gap, and the surface is valid. A gap thinner
+// than the contact edge can resolve is still refused, naming the setting.
+TEST(FluidSurface, TheWallTakesAShorterEdgeWhereTheSpheresEdgeWouldCutItsGap) {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(1.5);
+  b.centres = {{0.0, 0.0, 0.5}, {0.0, 1.0, 1.5}};
+  b.diameters = {1.0, 1.0};
+  SurfaceParams p;
+  p.edge_length_d = 0.3;
+  p.contact_edge_length_d = 0.1;
+  const FluidSurface fs = build_fluid_surface(b, p);
+  const double gap = fs.report["smallest_gap_d"]["particle_wall"].get<double>();
+  EXPECT_NEAR(gap, 0.005, 1e-9);
+  EXPECT_GT(ring_sagitta(1.5, 0.3), 0.5 * gap);  // the spheres' edge would have cut the gap
+  EXPECT_LE(fs.report["wall_sagitta_d"].get<double>(), 0.4 * gap * (1 + 1e-9));
+  EXPECT_LT(fs.report["wall_edge_d"].get<double>(), 0.3);
+  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
+  EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting);
+  p.shrink_factor = 0.9999;  // a gap of 5e-5 d at the wall: a wall edge of about 0.02 d
+  try {
+    build_fluid_surface(b, p);
+    ADD_FAILURE() << "a wall gap below what the contact edge resolves was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("surface.contact_edge_length_d"), std::string::npos) << e.what();
+  }
 }
 
 TEST(FluidSurface, AnnulusHasAnInnerWallPatch) {
