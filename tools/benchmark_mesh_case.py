@@ -521,8 +521,11 @@ def main():
             results["study_gaps"] = study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells)
             write(results)
         if "study_reynolds" in args.only:
-            results["study_reynolds"] = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells,
-                                               reynolds=re) for re in args.reynolds]
+            # Runs at other Re_p are kept, so one Re_p can be redone alone.
+            kept = [r for r in results.get("study_reynolds", []) if r["reynolds"] not in args.reynolds]
+            new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, reynolds=re)
+                   for re in args.reynolds]
+            results["study_reynolds"] = sorted(kept + new, key=lambda r: r["reynolds"])
             write(results)
         if "verification" in args.only:
             results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)
