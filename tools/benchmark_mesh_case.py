@@ -402,7 +402,8 @@ def write(results):
                          + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} % | "
                             f"{'yes' if g.get('asymptotic') else 'no'}" if ext is not None else "none | | | no")
                          + f" | {r['es_bed_pa_m']:.4g} | " + (f"{finest / r['es_bed_pa_m']:.3f}" if finest else "")
-                         + " | " + (f"{ext / r['es_bed_pa_m']:.3f}" if ext is not None else "") + f" | {r['wall_s'] / 60:.1f} |")
+                         + " | " + (f"{ext / r['es_bed_pa_m']:.3f}" + ("" if g.get("asymptotic") else " (not trusted)")
+                                    if ext is not None else "") + f" | {r['wall_s'] / 60:.1f} |")
         lines.append("")
         for r in results["study_reynolds"]:
             lines += study_lines(r)
