@@ -150,9 +150,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   // sagitta is 0.4 of the gap, down to the contact edge.
   double wall_edge = edge;
   if (!box && ring_sagitta(R, edge) >= 0.5 * tb.min_concave_wall_gap) {
-    const double allowed = 0.4 * tb.min_concave_wall_gap;
-    const double points = allowed > 0.0 ? std::ceil(std::numbers::pi / std::acos(1.0 - allowed / R)) : HUGE_VAL;
-    wall_edge = 2.0 * std::numbers::pi * R / points * (1.0 + 1e-12);  // ring_points(R, wall_edge) == points
+    wall_edge = tb.min_concave_wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * tb.min_concave_wall_gap) : 0.0;
     if (!(wall_edge >= p.contact_edge_length_d * d))
       throw InputError(fmt::format(
           "surface.edge_length_d = {}: the wall facets would lie up to {:.3g} d inside the wall, more than half the "

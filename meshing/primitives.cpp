@@ -128,6 +128,12 @@ int ring_points(double R, double edge) {
 
 double ring_sagitta(double R, double edge) { return R * (1.0 - std::cos(std::numbers::pi / ring_points(R, edge))); }
 
+double ring_edge_for_sagitta(double R, double sagitta) {
+  if (sagitta >= R * (1.0 - std::cos(std::numbers::pi / 8))) return HUGE_VAL;
+  const double points = std::ceil(std::numbers::pi / std::acos(1.0 - sagitta / R));
+  return 2.0 * std::numbers::pi * R / points * (1.0 + 1e-12);  // so that ring_points gives `points`
+}
+
 std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n) {
   std::vector<Eigen::Vector3d> loop;
   for (int j = 0; j < n; ++j) loop.push_back(f.to_world(on_circle(rho, j, n, false, 0.0)));

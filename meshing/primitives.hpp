@@ -31,6 +31,9 @@ Eigen::Vector3d on_circle(double R, int j, int n, bool stagger, double z);
 int ring_points(double R, double edge);
 // How far the chords of that circle lie inside it (its sagitta), in R's unit.
 double ring_sagitta(double R, double edge);
+// The inverse: the longest edge whose circle of radius R has a sagitta of at most `sagitta`
+// (> 0, R's unit); +inf when 8 points already do.
+double ring_edge_for_sagitta(double R, double sagitta);
 // The loop where a shape meets a circle of radius rho in the plane z = 0 of `f`: its n
 // vertices, f.to_world(on_circle(rho, j, n, false, 0)).
 std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n);

@@ -120,9 +120,9 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
     const CaseStage c = case_stage(m->volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
                                    case_dir, true, console);
-    const auto sizing = l.sizing;
-    l = study_level(c, k, scale, 0.0);
-    l.sizing = sizing;
+    StudyLevel solved = study_level(c, k, scale, 0.0);
+    solved.sizing = std::move(l.sizing);
+    l = std::move(solved);
   } catch (const std::exception& e) {
     l.scale = scale;
     l.failure = e.what();

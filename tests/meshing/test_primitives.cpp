@@ -153,3 +153,16 @@ TEST(Primitives, SphereMeshDependsOnItsInputAlone) {
   for (std::size_t k = 0; k < again.size(); ++k) again[k] = sphere_mesh(c, r, cuts, 0.05, 1.3, true, "particles");
   for (const auto& m : again) EXPECT_EQ(m.triangles, first.triangles);
 }
+
+// ring_edge_for_sagitta inverts ring_sagitta: its edge meets the sagitta asked for, and one
+// point fewer on the circle would not.
+TEST(Primitives, RingEdgeForSagittaIsTheLongestEdgeWithinIt) {
+  for (const double R : {0.5, 2.5, 40.0})
+    for (const double s : {1e-4, 2e-3, 0.02}) {
+      const double edge = ring_edge_for_sagitta(R, s);
+      const int n = ring_points(R, edge);
+      EXPECT_LE(ring_sagitta(R, edge), s) << R << " " << s;
+      EXPECT_GT(R * (1.0 - std::cos(std::numbers::pi / (n - 1))), s) << R << " " << s;
+    }
+  EXPECT_EQ(ring_edge_for_sagitta(1.0, 0.5), HUGE_VAL);  // 8 points already lie within it
+}
