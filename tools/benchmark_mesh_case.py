@@ -329,9 +329,9 @@ def write(results):
                   "a = 4, N = 40, shrink: the bed of `scenes/examples/small_bed_flow.toml`; a = 5, N = 500, bridges: "
                   "the bed of the studies. 3 layers growing by 1.2, at most 0.2 of the "
                   "gap ahead of each stack and at least one surface edge of it left to the tetrahedra; none where "
-                  "that leaves under half the thickness. The flow is solved on the cells `case.cells` makes (the "
-                  "polyhedral dual by default; cells = checkMesh's count). */ finest* compares with the finest mesh "
-                  "without layers of the same bed.", "",
+                  "that leaves under half the thickness. The flow is solved on the cells `case.cells` made at the "
+                  "run's commit (the line above; the polyhedral dual by default since 3d88d5a; cells = checkMesh's "
+                  "count). */ finest* compares with the finest mesh without layers of the same bed.", "",
                   "| bed | surface edge (d) | layers, thickness (d), mean reached | cells (prisms, pyramids, tets in the "
                   "layers) | mesh s | simpleFoam s (its) | whole run s | checkMesh | max non-ortho | dp/L (Pa/m) | "
                   "/ E&S | / finest | eps section |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -203,7 +203,7 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
 TEST(RunScene, AConvergenceStudyReportsTheLevelsThatFailed) {
   const fs::path dir = test_support::fresh_dir("convergence_failed");
   const Scene scene = small_scene(
-      "\"case\"", "[case]\nrun = true\niterations = 2\n[case.convergence]\nlevels = 3\nratio = 1.3\n", kOpenSurface);
+      "\"case\"", "[case]\nrun = true\niterations = 2\n[case.convergence]\nlevels = 3\nratio = 1.4\n", kOpenSurface);
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& study = r.stages["case"]["convergence"];
   EXPECT_FALSE(study["complete"].get<bool>());
