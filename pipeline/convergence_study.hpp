@@ -8,6 +8,7 @@
 #include "analysis/grid_convergence.hpp"
 #include "cases/openfoam_case.hpp"
 #include "core/bed.hpp"
+#include "core/report.hpp"
 #include "pipeline/case_stage.hpp"
 #include "pipeline/console.hpp"
 #include "pipeline/scene.hpp"
@@ -22,8 +23,11 @@ struct StudyLevel {
   double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
-  double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one;
-                              // the flow alone of the finest (its surface and mesh may be reused)
+  double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one
+                              // (every sizing attempt); the flow alone of the finest (its surface and
+                              // mesh may be reused)
+  double own_time_s = 0.0;    // surface, mesh and flow of the mesh solved on, each once: what the level
+                              // costs as a run of its own, for error against time
   std::string failure;        // why the level gave no value (empty when it did)
   std::optional<double> exact_pa_m;  // an empty container's known answer (the case's)
   // The scales tried to bring a coarser level's cells to their target size, with the cell size
@@ -45,8 +49,9 @@ struct ConvergenceStudy {
   nlohmann::json to_json() const;
 };
 
-// Level `level` (lengths x `scale`) from its solved case.
-StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s);
+// Level `level` (lengths x `scale`) from its solved case; `surface_mesh_s` the time its surface
+// and mesh took to make.
+StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s, double surface_mesh_s);
 
 // The study of [case.convergence] on `bed` (m): `finest` is the scene's own level, already
 // solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's
@@ -60,8 +65,9 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
 
 // Runs the study of [case.convergence] after the scene's case `solved`, into `dir`/convergence,
 // and adds it to the case's report entry (its "convergence" and a summary that ends with the
-// study's conclusion, which is printed).
-void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const std::filesystem::path& dir,
-                           const Console& console, nlohmann::json& case_entry);
+// study's conclusion, which is printed). `report` is the run's, whose surface and mesh stages
+// made the solved mesh (their times count in the finest level's own).
+void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const Report& report,
+                           const std::filesystem::path& dir, const Console& console, nlohmann::json& case_entry);
 
 }  // namespace bedforge::pipeline

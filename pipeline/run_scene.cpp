@@ -137,7 +137,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
                                    scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(),
                                    dir / "case", opt.overwrite, console);
     nlohmann::json entry = c.report;
-    if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, dir, console, entry);
+    if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, report, dir, console, entry);
     record("case", std::move(entry), keys.case_);
   } else {
     reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));

@@ -31,6 +31,11 @@ study_gaps: the same study with surface.cells_per_gap = --study-gap-cells from a
         --study-gap-edge d (the gaps' refinement scales with the levels, through the contact edge).
 study_reynolds: the study_gaps run at each Re_p of --reynolds (laminar), with a table of the
         extrapolated dp/L against Eisfeld & Schnitzlein's across Re_p = 1 (study_gaps) and these.
+solver: the bed of the studies at a surface edge of 0.2 d, 3 cells across narrow gaps, its case written
+        and solved once by `bedforge run`, then solved again from the same mesh with OpenFOAM's settings
+        changed one at a time (non-orthogonal correction, gradient scheme, SIMPLE against SIMPLEC):
+        iterations, simpleFoam time and dp/L against those of the case as written, and against the
+        study_gaps extrapolation of the same bed.
 verification: the empty tube of scenes/examples/empty_tube_verification.toml (D = 2 d, 12 d long,
         particles.count = 0), whose exact dp/L is Hagen-Poiseuille's, through the same route on
         tetrahedra and on their polyhedral dual (case.cells): one `bedforge run` each with
@@ -45,6 +50,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import subprocess
 import tempfile
 import time
@@ -57,11 +63,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "study_reynolds", "verification"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "study_reynolds", "solver",
+            "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
-def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0):
+def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -83,6 +90,7 @@ count = {layers}
 thickness_d = {layer_thickness}
 [case]
 reynolds = {reynolds}
+iterations = {iterations}
 processors = 2
 run = {"true" if run else "false"}
 [outputs]
@@ -119,12 +127,13 @@ def stage_times(report):
     return {k: v["time_s"] for k, v in report["stages"].items() if "time_s" in v}
 
 
-def sizes(tmp, levels, a=5, n=500, treatment="bridge"):
+def sizes(tmp, levels, a=5, n=500, treatment="bridge", iterations=3000):
     """levels: (surface edge in d, cells per gap, prism layers, their thickness in d)."""
     rows = []
     for edge, gap_cells, layers, thickness in levels:
         path = os.path.join(tmp, f"{treatment}_{a}_{n}_{edge}_{gap_cells}_{layers}_{thickness}")
-        open(path + ".toml", "w").write(scene(a, n, treatment, edge, True, gap_cells, layers, thickness))
+        open(path + ".toml", "w").write(scene(a, n, treatment, edge, True, gap_cells, layers, thickness,
+                                              iterations=iterations))
         wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
         rep = json.load(open(os.path.join(path, "report.json")))
         mb = peak_mb(rep)
@@ -138,7 +147,7 @@ def sizes(tmp, levels, a=5, n=500, treatment="bridge"):
                      "peak_mb": mb,
                      "stages_s": stage_times(rep), "solve_s": flow["time_s"], "mesh_ok": ok,
                      "max_non_orthogonality": non_ortho, "max_skewness": skew,
-                     "iterations": flow["iterations"], "converged": flow["converged"],
+                     "iterations": flow["iterations"], "converged": flow["converged"], "iteration_cap": iterations,
                      "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "es_pa_m": flow["eisfeld_schnitzlein_pa_m"],
                      "ratio_es": flow["ratio_to_eisfeld_schnitzlein"], "eps_section": flow["void_fraction_section"],
                      "flow_rate_error": flow["flow_rate_relative_error"],
@@ -204,6 +213,64 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
             "eps_section_bed": case["flow"]["void_fraction_section_bed"]}
+
+
+# OpenFOAM settings tried against the case as written: (name, [(file, pattern, replacement)]).
+SOLVER_VARIANTS = [
+    ("as written (limited 0.5 non-orthogonal correction, 1 corrector; least-squares gradients; SIMPLEC)", []),
+    ("full non-orthogonal correction, 2 correctors",
+     [("fvSchemes", r"Gauss linear limited 0\.5", "Gauss linear corrected"),
+      ("fvSchemes", r"(snGradSchemes\s*\{\s*default\s+)limited 0\.5", r"\1corrected"),
+      ("fvSolution", r"nNonOrthogonalCorrectors 1", "nNonOrthogonalCorrectors 2")]),
+    ("no non-orthogonal correction",
+     [("fvSchemes", r"Gauss linear limited 0\.5", "Gauss linear uncorrected"),
+      ("fvSchemes", r"(snGradSchemes\s*\{\s*default\s+)limited 0\.5", r"\1uncorrected"),
+      ("fvSolution", r"nNonOrthogonalCorrectors 1", "nNonOrthogonalCorrectors 0")]),
+    ("Gauss linear gradients", [("fvSchemes", r"leastSquares", "Gauss linear")]),
+    ("SIMPLE, not SIMPLEC (relaxation U 0.7, p 0.3)",
+     [("fvSolution", r"consistent\s+yes", "consistent      no"),
+      ("fvSolution", r"(U\s+)0\.9;", r"\g<1>0.7;"), ("fvSolution", r"(p\s+)1;", r"\g<1>0.3;")]),
+]
+
+
+def solver(tmp, edge=0.2, cells_per_gap=3):
+    """The case of the studies' bed written once, solved again under each of SOLVER_VARIANTS."""
+    path = os.path.join(tmp, f"solver_bridge_5_500_{edge}_{cells_per_gap}")
+    open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, cells_per_gap))
+    timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    flow = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]["flow"]
+    case = os.path.join(path, "case")
+    rows = []
+    for name, edits in SOLVER_VARIANTS:
+        run = os.path.join(tmp, f"solver_{len(rows)}")
+        os.makedirs(run)
+        for part in ("0", "constant", "system"):  # constant holds the dual mesh Allrun made
+            subprocess.run(["cp", "-r", os.path.join(case, part), run], check=True)
+        for file, pattern, replacement in edits:
+            f = os.path.join(run, "system", file)
+            text, count = re.subn(pattern, replacement, open(f).read())
+            if count == 0:
+                raise RuntimeError(f"solver variant {name!r}: {pattern!r} not in {file}")
+            open(f, "w").write(text)
+        env = dict(ENV, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        subprocess.run(["decomposePar", "-force", "-case", run], check=True, capture_output=True, env=env)
+        t0 = time.time()
+        out = subprocess.run(["mpirun", "-np", "2", "simpleFoam", "-parallel", "-case", run], capture_output=True,
+                             text=True, env=env)
+        solve_s = time.time() - t0
+        def last(name):
+            return float(open(os.path.join(run, "postProcessing", name, "0", "surfaceFieldValue.dat"))
+                         .read().split()[-1])
+        dp_kin = last("pBedBottom") - last("pBedTop")
+        rows.append({"variant": name, "ok": out.returncode == 0, "solve_s": solve_s,
+                     "iterations": len(re.findall(r"^Time = ", out.stdout, re.M)),
+                     "converged": "SIMPLE solution converged" in out.stdout, "dp_kin": dp_kin})
+        print(rows[-1], flush=True)
+        shutil.rmtree(run)
+    for r in rows:  # bedforge's own conversion of the case as written, applied to each
+        r["dp_dz_pa_m"] = flow["pressure_gradient_bed_pa_m"] * r["dp_kin"] / rows[0]["dp_kin"]
+    return {**commit_and_date(), "edge_d": edge, "cells_per_gap": cells_per_gap, "cells": flow["mesh"]["cells"],
+            "bedforge_solve_s": flow["time_s"], "rows": rows}
 
 
 def verification(tmp, edge, levels, ratio):
@@ -350,6 +417,26 @@ def write(results):
                          f"{r['eps_section']:.4f} |")
         lines += ["", "On gmsh's tetrahedra, layers on the bridged a = 5 bed did not converge in simpleFoam "
                   "(2026-11-22, not regenerated): [findings.md](findings.md).", ""]
+    if "solver" in results:
+        r = results["solver"]
+        ref = results.get("study_gaps", {}).get("study", {}).get("grid_convergence", {})
+        lines += ["## OpenFOAM's settings on the same mesh", "", made_line(r), "",
+                  f"The bed of the studies (a = 5, N = 500, bridges, Re_p = 1), surface edge {r['edge_d']} d with "
+                  f"{r['cells_per_gap']:g} cells across narrow gaps: {r['cells']} polyhedra, written and solved once "
+                  f"by `bedforge run` (simpleFoam {r['bedforge_solve_s']:.0f} s with polyDualMesh and checkMesh), then "
+                  "solved again from that mesh with one setting changed at a time, side by side in one run "
+                  "(simpleFoam alone on 2 processes). dp/L as bedforge converts the case as written."
+                  + (f" Reference: the study_gaps extrapolation of the same bed, {ref['extrapolated']:.4g} Pa/m "
+                     f"(its GCI {100 * ref['gci_fine']:.0f} %)." if ref.get("asymptotic") else ""), "",
+                  "| settings | iterations | simpleFoam s | dp/L (Pa/m) | / as written |"
+                  + (" / extrapolated |" if ref.get("asymptotic") else ""),
+                  "|---|---|---|---|---|" + ("---|" if ref.get("asymptotic") else "")]
+        for v in r["rows"]:
+            state = "" if v["converged"] else (", failed" if not v["ok"] else ", not converged")
+            lines.append(f"| {v['variant']} | {v['iterations']}{state} | {v['solve_s']:.0f} | {v['dp_dz_pa_m']:.4g} | "
+                         f"{v['dp_kin'] / r['rows'][0]['dp_kin']:.4f} |"
+                         + (f" {v['dp_dz_pa_m'] / ref['extrapolated']:.3f} |" if ref.get("asymptotic") else ""))
+        lines.append("")
     if "snappy" in results:
         r, g = results["snappy"], min(results.get("sizes", [{}]), key=lambda x: x.get("edge_d", 1))
         lines += ["## The same bed by the snappyHexMesh route", "", *stamp(results["snappy"]),
@@ -502,12 +589,13 @@ def main():
             results["gaps"] = [{**commit_and_date(), **r} for r in sizes(tmp, [(0.2, c, 0, 0.02) for c in args.gap_cells])]
             write(results)
         if "layers" in args.only:
+            # Without layers these converge in under 100 iterations; a run still going at 1000 has stalled.
             results["layers"] = [{**commit_and_date(), **r} for r in sizes(
                 tmp, [(0.1, 0, 0, 0.02)] + [(0.1, 0, 3, t) for t in args.layer_thickness] + [(0.07, 0, 0, 0.02)],
-                a=4, n=40, treatment="shrink")]
+                a=4, n=40, treatment="shrink", iterations=1000)]
             # The bridged bed of the studies, where layers had stalled simpleFoam on tetrahedra.
             results["layers"] += [{**commit_and_date(), **r} for r in sizes(
-                tmp, [(0.15, 0, 0, 0.02), (0.15, 0, 3, 0.02)], a=5, n=500, treatment="bridge")]
+                tmp, [(0.15, 0, 0, 0.02), (0.15, 0, 3, 0.02)], a=5, n=500, treatment="bridge", iterations=1000)]
             write(results)
         if "snappy" in args.only:
             results["snappy"] = {**commit_and_date(), **snappy(tmp, min(args.edges))}
@@ -527,6 +615,9 @@ def main():
             new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, reynolds=re)
                    for re in args.reynolds]
             results["study_reynolds"] = sorted(kept + new, key=lambda r: r["reynolds"])
+            write(results)
+        if "solver" in args.only:
+            results["solver"] = solver(tmp)
             write(results)
         if "verification" in args.only:
             results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)

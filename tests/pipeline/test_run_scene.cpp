@@ -185,6 +185,18 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
     EXPECT_LT(study["levels"][k]["cells"].get<long>(), study["levels"][k - 1]["cells"].get<long>()) << k;
     EXPECT_GT(study["levels"][k]["cell_size_m"].get<double>(), study["levels"][k - 1]["cell_size_m"].get<double>());
   }
+  // A level's own cost is one surface, mesh and flow: the finest's adds the run's surface and
+  // mesh stages to its flow; a coarser one's is its last sizing attempt and its flow, within the
+  // level's whole time, which counts every attempt.
+  const auto& stages = r.stages;
+  EXPECT_DOUBLE_EQ(study["levels"][0]["own_time_s"].get<double>(),
+                   stages["surface"]["time_s"].get<double>() + stages["mesh"]["time_s"].get<double>() +
+                       stages["case"]["time_s"].get<double>());
+  for (int k = 1; k < 3; ++k) {
+    const auto& level = study["levels"][k];
+    EXPECT_GT(level["own_time_s"].get<double>(), 0.0) << level.dump();
+    EXPECT_LE(level["own_time_s"].get<double>(), level["time_s"].get<double>()) << level.dump();
+  }
   ASSERT_TRUE(study["complete"].get<bool>()) << study.dump();
   std::vector<bedforge::analysis::GridLevel> levels;
   for (const auto& l : study["levels"])
