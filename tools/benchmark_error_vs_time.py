@@ -12,9 +12,11 @@ packer:   a = 5, N = 500, seeds 1-5, the overlap tolerance swept in both modes. 
 surface:  one bed (a = 5, N = 500, seed 1, default contacts), the surface edge length swept (contact
           edge a third of it): volume error against the exact treated geometry and chordal deviation,
           against the stage's time.
-mesh:     mesh and CFD from docs/mesh_case_benchmark.json (tools/benchmark_mesh_case.py, which takes
-          an hour): dp/L over the bed against the finest mesh and against Eisfeld & Schnitzlein,
-          against the time of surface + mesh + solve.
+mesh:     mesh and CFD from the convergence studies in docs/mesh_case_benchmark.json (study_gaps and
+          study_reynolds of tools/benchmark_mesh_case.py): each level's dp/L against the study's
+          Richardson-extrapolated value, with the GCI of the finest mesh as the reference's own band,
+          against the level's own time (one surface, mesh and simpleFoam run). Studies not in the
+          asymptotic range have no trusted reference and are left out, and said so.
 Times are the stages' own (report.json), one run at a time.
 """
 import argparse
@@ -118,14 +120,23 @@ def surface_section(work):
 
 def mesh_section():
     src = json.load(open(os.path.join(DOCS, "mesh_case_benchmark.json")))
-    points = []
-    for r in src["sizes"]:
-        st = r["stages_s"]
-        points.append({"edge_d": r["edge_d"], "cells": r["cells"], "time_s": st["surface"] + st["mesh"] + st["case"],
-                       "mesh_time_s": st["surface"] + st["mesh"], "ratio_finest": r["ratio_finest"],
-                       "ratio_es": r["ratio_es"]})
-    made = {k: src["sizes"][0][k] for k in ("commit", "date") if k in src["sizes"][0]}  # the runs', not this copy's
-    return {**made, "points": points}
+    studies, left_out = [], []
+    for r in [src["study_gaps"]] + src.get("study_reynolds", []):
+        g = r["study"].get("grid_convergence", {})
+        levels = [lv for lv in r["study"]["levels"] if "failure" not in lv]
+        if not g.get("asymptotic") or any("own_time_s" not in lv for lv in levels):
+            left_out.append({"reynolds": r["reynolds"], "commit": r["commit"],
+                             "why": "not in the asymptotic range" if not g.get("asymptotic") else
+                             "made before levels recorded their own time"})
+            continue
+        ext = g["extrapolated"]
+        studies.append({"commit": r["commit"], "date": r["date"], "reynolds": r["reynolds"], "edge_d": r["edge_d"],
+                         "cells_per_gap": r["cells_per_gap"], "extrapolated_pa_m": ext, "gci_fine": g["gci_fine"],
+                         "order": g["apparent_order"], "es_bed_pa_m": r["es_bed_pa_m"],
+                         "points": [{"level": lv["level"], "cells": lv["cells"], "time_s": lv["own_time_s"],
+                                     "dp_pa_m": lv["pressure_gradient_bed_pa_m"],
+                                     "error": abs(lv["pressure_gradient_bed_pa_m"] - ext) / ext} for lv in levels]})
+    return {"studies": studies, "left_out": left_out}
 
 
 def pareto(ax, xs, ys, labels, **kw):
@@ -163,16 +174,18 @@ def plots(R):
         ax.set_title("surface, a = 5, N = 500, shrink (labels: edge length)", fontsize=9)
         fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_surface.png"), dpi=110), plt.close(fig)
     if "mesh" in R:
-        pts = R["mesh"]["points"]
         fig, ax = plt.subplots(figsize=(6, 4))
-        labels = [f"{p['edge_d']:g} d, {p['cells'] / 1e6:.2f}M" for p in pts]
-        coarser = [p for p in pts if p["ratio_finest"] != 1]
-        pareto(ax, [p["time_s"] for p in coarser], [abs(p["ratio_finest"] - 1) for p in coarser],
-               [f"{p['edge_d']:g} d" for p in coarser], marker="o", label="|dp/L / finest - 1|")
-        pareto(ax, [p["time_s"] for p in pts], [abs(p["ratio_es"] - 1) for p in pts], labels, marker="s",
-               label="|dp/L / Eisfeld & Schnitzlein - 1|")
-        ax.set_xlabel("surface + mesh + simpleFoam time (s)"), ax.grid(alpha=0.3, which="both"), ax.legend(fontsize=7)
-        ax.set_title("mesh and CFD, a = 5, N = 500, bridges, Re_p = 1", fontsize=9)
+        for st, marker in zip(R["mesh"]["studies"], "osd^"):
+            pts = st["points"]
+            line, = ax.loglog([p["time_s"] for p in pts], [p["error"] for p in pts], marker=marker,
+                              label=f"Re_p = {st['reynolds']:g}: |dp/L - extrapolated| / extrapolated")
+            ax.axhline(st["gci_fine"], color=line.get_color(), ls=":", lw=1,
+                       label=f"Re_p = {st['reynolds']:g}: GCI of the finest mesh (the reference's band)")
+            for p in pts:
+                ax.annotate(f"{p['cells'] / 1e6:.2f}M", (p["time_s"], p["error"]), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+        ax.set_xlabel("the level's own surface + mesh + simpleFoam time (s)"), ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=6), ax.set_title("mesh and CFD, a = 5, N = 500, bridges, 3 cells across gaps", fontsize=9)
         fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_mesh_case.png"), dpi=110), plt.close(fig)
 
 
@@ -212,14 +225,22 @@ def write_report(R):
                     for p in R["surface"]["points"]],
                    "![surface](pareto_surface.png)")
     if "mesh" in R:
-        L += table("Mesh and CFD: mesh size", R["mesh"],
-                   "From [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, N = 500, bridges, Re_p = 1, "
-                   "simpleFoam on 2 processes); the mesh size follows the surface edge.",
-                   ["surface edge (d)", "cells", "surface + mesh (s)", "with the solve (s)", "dp/L / finest",
-                    "dp/L / E&S"],
-                   [[f"{p['edge_d']:g}", str(p["cells"]), f"{p['mesh_time_s']:.0f}", f"{p['time_s']:.0f}",
-                     f"{p['ratio_finest']:.3f}", f"{p['ratio_es']:.3f}"] for p in R["mesh"]["points"]],
-                   "![mesh and CFD](pareto_mesh_case.png)")
+        L += ["## Mesh and CFD: cell size, against the extrapolated pressure drop", ""]
+        for st in R["mesh"]["studies"]:
+            L += [f"Re_p = {st['reynolds']:g}: " + made_line(st), "",
+                  f"From the convergence study of [mesh_case_benchmark.md](mesh_case_benchmark.md) (a = 5, N = 500, "
+                  f"bridges, finest surface edge {st['edge_d']:g} d, {st['cells_per_gap']:g} cells across narrow gaps, "
+                  f"simpleFoam on 2 processes). Reference: its Richardson extrapolation, {st['extrapolated_pa_m']:.4g} Pa/m "
+                  f"(apparent order {st['order']:.2f}), whose own uncertainty is the GCI of the finest mesh, "
+                  f"{100 * st['gci_fine']:.1f} %: errors below that cannot be told from the reference's.", "",
+                  "| level | cells | own time (s) | dp/L (Pa/m) | error against extrapolated | / E&S at the bed's eps |",
+                  "|---|---|---|---|---|---|"]
+            L += [f"| {p['level']} | {p['cells']} | {p['time_s']:.0f} | {p['dp_pa_m']:.4g} | {100 * p['error']:.1f} % | "
+                  f"{p['dp_pa_m'] / st['es_bed_pa_m']:.3f} |" for p in st["points"]]
+            L += [""]
+        for lo in R["mesh"]["left_out"]:
+            L += [f"Left out: the study at Re_p = {lo['reynolds']:g} (made at {lo['commit']}), {lo['why']}.", ""]
+        L += ["![mesh and CFD](pareto_mesh_case.png)", ""]
     L += ["Why the defaults are what they are, read from these curves: [defaults.md](defaults.md).", ""]
     open(os.path.join(DOCS, "error_vs_time.md"), "w").write("\n".join(L))
 

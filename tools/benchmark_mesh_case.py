@@ -31,6 +31,9 @@ study_gaps: the same study with surface.cells_per_gap = --study-gap-cells from a
         --study-gap-edge d (the gaps' refinement scales with the levels, through the contact edge).
 study_reynolds: the study_gaps run at each Re_p of --reynolds (laminar), with a table of the
         extrapolated dp/L against Eisfeld & Schnitzlein's across Re_p = 1 (study_gaps) and these.
+study_treatments: the study_gaps run with each contact treatment of --treatments (bridge is study_gaps),
+        the same bed: how much of the pressure drop, and of its difference from E&S, the treatment
+        of the contacts carries.
 solver: the bed of the studies at a surface edge of 0.2 d, 3 cells across narrow gaps, its case written
         and solved once by `bedforge run`, then solved again from the same mesh with OpenFOAM's settings
         changed one at a time (non-orthogonal correction, gradient scheme, SIMPLE against SIMPLEC):
@@ -48,6 +51,7 @@ resets the kernel's high-water mark at each stage start, and the rusage peak wit
 """
 import argparse
 import json
+import math
 import os
 import re
 import shutil
@@ -63,8 +67,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "study_reynolds", "solver",
-            "verification"]
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "study_reynolds", "study_treatments",
+            "solver", "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -212,7 +216,8 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
             "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
-            "eps_section_bed": case["flow"]["void_fraction_section_bed"]}
+            "eps_section_bed": case["flow"]["void_fraction_section_bed"],
+            "solid_volume_change_relative": rep["stages"]["surface"]["solid_volume_change_relative"]}
 
 
 # OpenFOAM settings tried against the case as written: (name, [(file, pattern, replacement)]).
@@ -233,6 +238,9 @@ SOLVER_VARIANTS = [
 ]
 
 
+SOLVER_CAP = 400  # iterations: ten times what the case as written needs; a variant still going has stalled
+
+
 def solver(tmp, edge=0.2, cells_per_gap=3):
     """The case of the studies' bed written once, solved again under each of SOLVER_VARIANTS."""
     path = os.path.join(tmp, f"solver_bridge_5_500_{edge}_{cells_per_gap}")
@@ -246,7 +254,7 @@ def solver(tmp, edge=0.2, cells_per_gap=3):
         os.makedirs(run)
         for part in ("0", "constant", "system"):  # constant holds the dual mesh Allrun made
             subprocess.run(["cp", "-r", os.path.join(case, part), run], check=True)
-        for file, pattern, replacement in edits:
+        for file, pattern, replacement in edits + [("controlDict", r"(endTime\s+)\d+;", rf"\g<1>{SOLVER_CAP};")]:
             f = os.path.join(run, "system", file)
             text, count = re.subn(pattern, replacement, open(f).read())
             if count == 0:
@@ -270,7 +278,7 @@ def solver(tmp, edge=0.2, cells_per_gap=3):
     for r in rows:  # bedforge's own conversion of the case as written, applied to each
         r["dp_dz_pa_m"] = flow["pressure_gradient_bed_pa_m"] * r["dp_kin"] / rows[0]["dp_kin"]
     return {**commit_and_date(), "edge_d": edge, "cells_per_gap": cells_per_gap, "cells": flow["mesh"]["cells"],
-            "bedforge_solve_s": flow["time_s"], "rows": rows}
+            "bedforge_solve_s": flow["time_s"], "iteration_cap": SOLVER_CAP, "rows": rows}
 
 
 def verification(tmp, edge, levels, ratio):
@@ -425,7 +433,8 @@ def write(results):
                   f"{r['cells_per_gap']:g} cells across narrow gaps: {r['cells']} polyhedra, written and solved once "
                   f"by `bedforge run` (simpleFoam {r['bedforge_solve_s']:.0f} s with polyDualMesh and checkMesh), then "
                   "solved again from that mesh with one setting changed at a time, side by side in one run "
-                  "(simpleFoam alone on 2 processes). dp/L as bedforge converts the case as written."
+                  f"(simpleFoam alone on 2 processes, at most {r.get('iteration_cap', 3000)} iterations). dp/L as "
+                  "bedforge converts the case as written."
                   + (f" Reference: the study_gaps extrapolation of the same bed, {ref['extrapolated']:.4g} Pa/m "
                      f"(its GCI {100 * ref['gci_fine']:.0f} %)." if ref.get("asymptotic") else ""), "",
                   "| settings | iterations | simpleFoam s | dp/L (Pa/m) | / as written |"
@@ -493,6 +502,39 @@ def write(results):
                                     if ext is not None else "") + f" | {r['wall_s'] / 60:.1f} |")
         lines.append("")
         for r in results["study_reynolds"]:
+            lines += study_lines(r)
+    if "study_treatments" in results:
+        runs = sorted(([results["study_gaps"]] if "study_gaps" in results else []) + results["study_treatments"],
+                      key=lambda r: r["treatment"])
+        lines += ["## The same gap-refined study against the contact treatment", "",
+                  "Each row one `bedforge run` with [case.convergence], the study_gaps settings (Re_p = 1) but for "
+                  "`contacts.treatment`; the same bed, so E&S at the bed's exact section void fraction is the same "
+                  "for all. *Solid change*: the treatment's change of the solid volume, whole bed, exact geometry. "
+                  "*E&S treated*: E&S at the bed's void fraction less that change spread evenly over the height "
+                  "(interpolated log-linearly between bedforge's two E&S values of the run, at the bed's and at the "
+                  "meshed void fraction): how far the treatment's volume alone moves the correlation.", "",
+                  "| treatment | made | solid change | finest dp/L (Pa/m) | extrapolated (Pa/m) | order | GCI fine | "
+                  "E&S (Pa/m) | extrapolated / E&S | E&S treated (Pa/m) | extrapolated / E&S treated | wall (min) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in runs:
+            st, g = r["study"], r["study"].get("grid_convergence", {})
+            finest = st["levels"][0].get("pressure_gradient_bed_pa_m")
+            ext = g.get("extrapolated") if g.get("asymptotic") else None
+            change = r.get("solid_volume_change_relative")
+            treated = None
+            if change is not None and r["eps_section"] != r["eps_section_bed"]:
+                slope = math.log(r["es_pa_m"] / r["es_bed_pa_m"]) / (r["eps_section"] - r["eps_section_bed"])
+                treated = r["es_bed_pa_m"] * math.exp(slope * -change * (1 - r["eps_section_bed"]))
+            lines.append(f"| {r['treatment']} | {r['commit']} {r['date']} | "
+                         + (f"{100 * change:+.2f} %" if change is not None else "not recorded") + " | "
+                         + (f"{finest:.4g}" if finest else "failed") + " | "
+                         + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} %" if ext else
+                            "not in the asymptotic range | | ")
+                         + f" | {r['es_bed_pa_m']:.4g} | " + (f"{ext / r['es_bed_pa_m']:.3f}" if ext else "")
+                         + " | " + (f"{treated:.4g}" if treated else "") + " | "
+                         + (f"{ext / treated:.3f}" if ext and treated else "") + f" | {r['wall_s'] / 60:.1f} |")
+        lines.append("")
+        for r in results["study_treatments"]:
             lines += study_lines(r)
     if "verification" in results:
         v = results["verification"]
@@ -576,6 +618,7 @@ def main():
     ap.add_argument("--study-gap-edge", type=float, default=0.15, help="study_gaps: finest surface edge (d)")
     ap.add_argument("--study-gap-cells", type=float, default=3, help="study_gaps: surface.cells_per_gap")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
+    ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
     ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
@@ -615,6 +658,12 @@ def main():
             new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, reynolds=re)
                    for re in args.reynolds]
             results["study_reynolds"] = sorted(kept + new, key=lambda r: r["reynolds"])
+            write(results)
+        if "study_treatments" in args.only:
+            kept = [r for r in results.get("study_treatments", []) if r["treatment"] not in args.treatments]
+            new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, treatment=t)
+                   for t in args.treatments]
+            results["study_treatments"] = sorted(kept + new, key=lambda r: r["treatment"])
             write(results)
         if "solver" in args.only:
             results["solver"] = solver(tmp)
