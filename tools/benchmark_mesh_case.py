@@ -362,6 +362,13 @@ def study_lines(r):
     return lines
 
 
+def study_values(r):
+    """A study run's verdict on its finest three levels, its finest dp/L (None when that level
+    failed) and its extrapolated dp/L (None when it has none)."""
+    g = r["study"].get("grid_convergence", {})
+    return g, r["study"]["levels"][0].get("pressure_gradient_bed_pa_m"), g.get("extrapolated")
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -490,9 +497,7 @@ def write(results):
                   "E&S (Pa/m) | finest / E&S | extrapolated / E&S | wall (min) |",
                   "|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in runs:
-            st, g = r["study"], r["study"].get("grid_convergence", {})
-            finest = st["levels"][0].get("pressure_gradient_bed_pa_m")
-            ext = g.get("extrapolated")
+            g, finest, ext = study_values(r)
             lines.append(f"| {r.get('reynolds', 1.0):g} | {r['commit']} {r['date']} | "
                          + (f"{finest:.4g}" if finest else "failed") + " | "
                          + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} % | "
@@ -513,13 +518,21 @@ def write(results):
                   "*E&S treated*: E&S at the bed's void fraction less that change spread evenly over the height "
                   "(interpolated log-linearly between bedforge's two E&S values of the run, at the bed's and at the "
                   "meshed void fraction): how far the treatment's volume alone moves the correlation.", "",
-                  "| treatment | made | solid change | finest dp/L (Pa/m) | extrapolated (Pa/m) | order | GCI fine | "
-                  "E&S (Pa/m) | extrapolated / E&S | E&S treated (Pa/m) | extrapolated / E&S treated | wall (min) |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| treatment | made | solid change | finest dp/L (Pa/m) | level 1, 2 / bridge's | extrapolated (Pa/m) | "
+                  "order | GCI fine | E&S (Pa/m) | extrapolated / E&S | E&S treated (Pa/m) | extrapolated / E&S treated | "
+                  "wall (min) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        bridge = next((r for r in runs if r["treatment"] == "bridge"), None)
+
+        def against_bridge(r):  # level by level at the same settings: what the treatment alone changes
+            if not bridge:
+                return ""
+            return ", ".join(f"{lv['pressure_gradient_bed_pa_m'] / b['pressure_gradient_bed_pa_m']:.3f}"
+                             for lv, b in zip(r["study"]["levels"][:2], bridge["study"]["levels"][:2])
+                             if "failure" not in lv and "failure" not in b)
         for r in runs:
-            st, g = r["study"], r["study"].get("grid_convergence", {})
-            finest = st["levels"][0].get("pressure_gradient_bed_pa_m")
-            ext = g.get("extrapolated") if g.get("asymptotic") else None
+            g, finest, ext = study_values(r)
+            ext = ext if g.get("asymptotic") else None
             change = r.get("solid_volume_change_relative")
             treated = None
             if change is not None and r["eps_section"] != r["eps_section_bed"]:
@@ -527,9 +540,10 @@ def write(results):
                 treated = r["es_bed_pa_m"] * math.exp(slope * -change * (1 - r["eps_section_bed"]))
             lines.append(f"| {r['treatment']} | {r['commit']} {r['date']} | "
                          + (f"{100 * change:+.2f} %" if change is not None else "not recorded") + " | "
-                         + (f"{finest:.4g}" if finest else "failed") + " | "
+                         + (f"{finest:.4g}" if finest else "failed") + f" | {against_bridge(r)} | "
                          + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} %" if ext else
-                            "not in the asymptotic range | | ")
+                            ("not in the asymptotic range" if r["study"]["complete"] else "none: a level failed")
+                            + " | | ")
                          + f" | {r['es_bed_pa_m']:.4g} | " + (f"{ext / r['es_bed_pa_m']:.3f}" if ext else "")
                          + " | " + (f"{treated:.4g}" if treated else "") + " | "
                          + (f"{ext / treated:.3f}" if ext and treated else "") + f" | {r['wall_s'] / 60:.1f} |")
@@ -652,19 +666,15 @@ def main():
         if "study_gaps" in args.only:
             results["study_gaps"] = study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells)
             write(results)
-        if "study_reynolds" in args.only:
-            # Runs at other Re_p are kept, so one Re_p can be redone alone.
-            kept = [r for r in results.get("study_reynolds", []) if r["reynolds"] not in args.reynolds]
-            new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, reynolds=re)
-                   for re in args.reynolds]
-            results["study_reynolds"] = sorted(kept + new, key=lambda r: r["reynolds"])
-            write(results)
-        if "study_treatments" in args.only:
-            kept = [r for r in results.get("study_treatments", []) if r["treatment"] not in args.treatments]
-            new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, treatment=t)
-                   for t in args.treatments]
-            results["study_treatments"] = sorted(kept + new, key=lambda r: r["treatment"])
-            write(results)
+        # Runs at other Re_p or treatments are kept, so one can be redone alone.
+        for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
+                                   ("study_treatments", "treatment", args.treatments)):
+            if key in args.only:
+                kept = [r for r in results.get(key, []) if r[field] not in values]
+                new = [study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells, **{field: v})
+                       for v in values]
+                results[key] = sorted(kept + new, key=lambda r: r[field])
+                write(results)
         if "solver" in args.only:
             results["solver"] = solver(tmp)
             write(results)
