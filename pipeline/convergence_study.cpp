@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 nlohmann::json ConvergenceStudy::to_json() const {
   nlohmann::json out = {{"complete", complete}, {"conclusion", conclusion}, {"levels", nlohmann::json::array()}};
   for (const StudyLevel& l : levels) {
-    nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}, {"own_time_s", l.own_time_s}};
+    nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}};
     if (!l.sizing.empty()) {
       j["sizing"] = nlohmann::json::array();
       for (const auto& [scale, h] : l.sizing) j["sizing"].push_back({{"scale", scale}, {"predicted_cell_size_m", h}});
@@ -30,7 +30,8 @@ nlohmann::json ConvergenceStudy::to_json() const {
       j.update({{"cells", l.cells},
                 {"cell_size_m", l.cell_size_m},
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
-                {"converged", l.converged}});
+                {"converged", l.converged},
+                {"own_time_s", l.own_time_s}});
       if (exact_pa_m) j["relative_error_to_exact"] = l.pressure_gradient_pa_m / *exact_pa_m - 1.0;
     } else {
       j["failure"] = l.failure;

@@ -27,7 +27,8 @@ struct StudyLevel {
                               // (every sizing attempt); the flow alone of the finest (its surface and
                               // mesh may be reused)
   double own_time_s = 0.0;    // surface, mesh and flow of the mesh solved on, each once: what the level
-                              // costs as a run of its own, for error against time
+                              // costs as a run of its own, for error against time (a level that
+                              // failed has none)
   std::string failure;        // why the level gave no value (empty when it did)
   std::optional<double> exact_pa_m;  // an empty container's known answer (the case's)
   // The scales tried to bring a coarser level's cells to their target size, with the cell size

@@ -220,8 +220,10 @@ TEST(RunScene, AConvergenceStudyReportsTheLevelsThatFailed) {
   const nlohmann::json& study = r.stages["case"]["convergence"];
   EXPECT_FALSE(study["complete"].get<bool>());
   EXPECT_FALSE(study.contains("grid_convergence"));
-  for (const auto& level : study["levels"])
+  for (const auto& level : study["levels"]) {
     EXPECT_NE(level.value("failure", "").find("did not converge"), std::string::npos) << level.dump();
+    EXPECT_FALSE(level.contains("own_time_s")) << level.dump();  // no value, so no cost of one
+  }
   EXPECT_NE(study["conclusion"].get<std::string>().find("no three successive levels"), std::string::npos);
 }
 
