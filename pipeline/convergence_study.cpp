@@ -48,7 +48,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
   return out;
 }
 
-StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s, double surface_mesh_s) {
+StudyLevel study_level(const CaseStage& solved, int level, double scale, double surface_mesh_s) {
   StudyLevel l;
   l.level = level;
   l.scale = scale;
@@ -58,8 +58,8 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.converged = solved.flow->converged;
   l.exact_pa_m = solved.flow->exact_pa_m;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
-  l.time_s = time_s;
-  l.own_time_s = surface_mesh_s + solved.report["time_s"].get<double>();
+  l.time_s = solved.report["time_s"].get<double>();
+  l.own_time_s = surface_mesh_s + l.time_s;
   return l;
 }
 
@@ -123,7 +123,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
     const CaseStage c = case_stage(m->volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
                                    case_dir, true, console);
-    StudyLevel solved = study_level(c, k, scale, 0.0, surface_mesh_s);
+    StudyLevel solved = study_level(c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);
     l = std::move(solved);
   } catch (const std::exception& e) {
@@ -193,7 +193,7 @@ void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& 
   const nlohmann::json none = nlohmann::json::object(), stages = report.data().value("stages", none);
   const double surface_mesh_s =
       stages.value("surface", none).value("time_s", 0.0) + stages.value("mesh", none).value("time_s", 0.0);
-  const StudyLevel finest = study_level(solved, 1, 1.0, case_entry["time_s"].get<double>(), surface_mesh_s);
+  const StudyLevel finest = study_level(solved, 1, 1.0, surface_mesh_s);
   const ConvergenceStudy study = convergence_study(scene, bed, finest, dir / "convergence", console);
   case_entry["convergence"] = study.to_json();
   const std::string line = "convergence: " + study.conclusion;

@@ -50,9 +50,9 @@ struct ConvergenceStudy {
   nlohmann::json to_json() const;
 };
 
-// Level `level` (lengths x `scale`) from its solved case; `surface_mesh_s` the time its surface
-// and mesh took to make.
-StudyLevel study_level(const CaseStage& solved, int level, double scale, double time_s, double surface_mesh_s);
+// Level `level` (lengths x `scale`) from its solved case, its time the flow's; `surface_mesh_s`
+// the time its surface and mesh took to make.
+StudyLevel study_level(const CaseStage& solved, int level, double scale, double surface_mesh_s);
 
 // The study of [case.convergence] on `bed` (m): `finest` is the scene's own level, already
 // solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's

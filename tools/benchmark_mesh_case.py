@@ -248,28 +248,27 @@ def solver(tmp, edge=0.2, cells_per_gap=3):
     timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     flow = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]["flow"]
     case = os.path.join(path, "case")
+    env = dict(ENV, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+    def last(run, name):  # the last value a surfaceFieldValue function object wrote
+        return float(open(os.path.join(run, "postProcessing", name, "0", "surfaceFieldValue.dat")).read().split()[-1])
     rows = []
     for name, edits in SOLVER_VARIANTS:
         run = os.path.join(tmp, f"solver_{len(rows)}")
-        os.makedirs(run)
         for part in ("0", "constant", "system"):  # constant holds the dual mesh Allrun made
-            subprocess.run(["cp", "-r", os.path.join(case, part), run], check=True)
+            shutil.copytree(os.path.join(case, part), os.path.join(run, part))
         for file, pattern, replacement in edits + [("controlDict", r"(endTime\s+)\d+;", rf"\g<1>{SOLVER_CAP};")]:
             f = os.path.join(run, "system", file)
             text, count = re.subn(pattern, replacement, open(f).read())
             if count == 0:
                 raise RuntimeError(f"solver variant {name!r}: {pattern!r} not in {file}")
             open(f, "w").write(text)
-        env = dict(ENV, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
         subprocess.run(["decomposePar", "-force", "-case", run], check=True, capture_output=True, env=env)
         t0 = time.time()
         out = subprocess.run(["mpirun", "-np", "2", "simpleFoam", "-parallel", "-case", run], capture_output=True,
                              text=True, env=env)
         solve_s = time.time() - t0
-        def last(name):
-            return float(open(os.path.join(run, "postProcessing", name, "0", "surfaceFieldValue.dat"))
-                         .read().split()[-1])
-        dp_kin = last("pBedBottom") - last("pBedTop")
+        dp_kin = last(run, "pBedBottom") - last(run, "pBedTop")
         rows.append({"variant": name, "ok": out.returncode == 0, "solve_s": solve_s,
                      "iterations": len(re.findall(r"^Time = ", out.stdout, re.M)),
                      "converged": "SIMPLE solution converged" in out.stdout, "dp_kin": dp_kin})
