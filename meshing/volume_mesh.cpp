@@ -100,10 +100,7 @@ int load_surface(const TriangleMesh& s) {
   // The surfaces reach gmsh as one .msh file, read in a single pass: through the API every call
   // that adds elements rebuilds gmsh's node cache, O(surfaces x nodes), 51 s for the 4001 shells
   // of a = 10, N = 4000. Tags: surface k + 1 is the k-th group; node v + 1 is point v and
-  // belongs to the first surface that uses it; triangle t + 1 is triangle t. Coordinates have 12
-  // digits, as in fluid.stl, so `bedforge run` and `bedforge mesh DIR` mesh the same points; at
-  // full precision each sphere's points are cospherical to rounding, and gmsh's Delaunay falls
-  // back to exact arithmetic on nearly every test (a = 6, N = 860: 22 s instead of 1.6 s).
+  // belongs to the first surface that uses it; triangle t + 1 is triangle t.
   std::vector<int> node_entity(s.points.size(), 0);
   std::map<int, std::vector<int>> shell_surfaces;
   std::vector<std::vector<int>> patch_surfaces(n_patches);
@@ -129,7 +126,7 @@ int load_surface(const TriangleMesh& s) {
   for (std::size_t e = 1; e <= groups.size(); ++e) {
     fmt::format_to(out, "2 {} 0 {}\n", e, entity_nodes[e].size());
     for (int v : entity_nodes[e]) fmt::format_to(out, "{}\n", v + 1);
-    for (int v : entity_nodes[e]) fmt::format_to(out, "{:.12g} {:.12g} {:.12g}\n", s.points[v].x(), s.points[v].y(), s.points[v].z());
+    for (int v : entity_nodes[e]) fmt::format_to(out, "{:.17g} {:.17g} {:.17g}\n", s.points[v].x(), s.points[v].y(), s.points[v].z());
   }
   fmt::format_to(out, "$EndNodes\n$Elements\n{} {} 1 {}\n", groups.size(), s.triangles.size(), s.triangles.size());
   tag = 0;
