@@ -32,7 +32,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 per cell of the empty tube's meshes, 0.20-0.24 h^3 from 0.2 d to 0.07 d; beds
 //                 have more, being refined at contacts: a = 10, N = 4000 at 0.1 d made 8.65 M
 //                 cells where this gives 5.6 M);
-//   bytes:        490 per cell, the mesh stage's peak at a = 10, N = 4000 (4.0 GB for 8.6 M
+//   bytes:        950 per cell, the mesh stage's peak at a = 10, N = 4000 (8.2 GB for 8.65 M
 //                 cells, docs/mesh_case_benchmark.md): a calibration on that one run.
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
