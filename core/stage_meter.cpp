@@ -1,11 +1,15 @@
 #include "core/stage_meter.hpp"
 
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <fstream>
 #include <limits>
 #include <string>
+
+// tcmalloc's C entry point, null unless the program links tcmalloc.
+extern "C" void MallocExtension_ReleaseFreeMemory() __attribute__((weak));
 
 namespace bedforge {
 
@@ -63,6 +67,13 @@ double available_memory_bytes() {
   double used = 0.0;
   if (max >> limit && limit != "max" && current >> used) available = std::min(available, std::stod(limit) - used);
   return available;
+}
+
+void release_free_memory() {
+  if (MallocExtension_ReleaseFreeMemory)
+    MallocExtension_ReleaseFreeMemory();
+  else
+    malloc_trim(0);
 }
 
 }  // namespace bedforge

@@ -29,4 +29,9 @@ double children_peak_memory_mb();
 // limit leaves if that is less. Infinity when neither can be read.
 double available_memory_bytes();
 
+// Hands memory the allocator keeps after a free back to the system: tcmalloc (when the program
+// links it) and glibc hold freed pages for reuse, and a stage that frees one large structure
+// before building the next would otherwise carry both in its resident peak.
+void release_free_memory();
+
 }  // namespace bedforge

@@ -24,7 +24,7 @@ CellQuality cell_quality(const PolyMesh& m) {
 
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     const auto& t = m.faces[f];
-    const auto& [fc, area] = geometry.faces[f];
+    const auto [fc, area] = face_geometry(m.points, t);
     const int own = m.owner[f];
     const bool internal = f < m.neighbour.size();
     sum_mag_area[own] += area.cwiseAbs();

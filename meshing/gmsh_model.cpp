@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "core/error.hpp"
@@ -30,17 +29,19 @@ PolyMesh extract_poly_mesh() {
   std::vector<std::size_t> node_tags;
   std::vector<double> xyz, uvw;
   gmsh::model::mesh::getNodes(node_tags, xyz, uvw, -1, -1, false, false);
-  std::unordered_map<std::size_t, int> index;
-  index.reserve(node_tags.size());
+  // gmsh numbers its nodes 1..N: a table, not a hash map, takes a node's tag to its index.
+  std::vector<int> index(node_tags.empty() ? 0 : *std::max_element(node_tags.begin(), node_tags.end()) + 1, -1);
   std::vector<Eigen::Vector3d> points(node_tags.size());
   for (std::size_t k = 0; k < node_tags.size(); ++k) {
-    index.emplace(node_tags[k], static_cast<int>(k));
+    index[node_tags[k]] = static_cast<int>(k);
     points[k] = {xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
   }
+  node_tags = {}, xyz = {}, uvw = {};
   std::vector<VolumeCell> cells;
   for (const auto& [type, points] : kCellTypes) {
     std::vector<std::size_t> element_tags, element_nodes;
     gmsh::model::mesh::getElementsByType(type, element_tags, element_nodes);
+    cells.reserve(cells.size() + element_tags.size());
     for (std::size_t e = 0; e < element_tags.size(); ++e) {
       VolumeCell c;
       c.n = points;

@@ -35,16 +35,23 @@ struct KeyHash {
 };
 
 // The faces of a cell in gmsh's node order, in no particular orientation.
-std::vector<Face> faces_of(const VolumeCell& c) {
+struct CellFaces {
+  std::array<Face, 5> face;
+  int n = 0;
+};
+CellFaces faces_of(const VolumeCell& c) {
   const auto& v = c.v;
   switch (c.n) {
     case 4:
-      return {{v[0], v[2], v[1]}, {v[0], v[1], v[3]}, {v[0], v[3], v[2]}, {v[1], v[2], v[3]}};
+      return {{Face{v[0], v[2], v[1]}, Face{v[0], v[1], v[3]}, Face{v[0], v[3], v[2]}, Face{v[1], v[2], v[3]}}, 4};
     case 5:
-      return {{v[0], v[3], v[2], v[1]}, {v[0], v[1], v[4]}, {v[1], v[2], v[4]}, {v[2], v[3], v[4]}, {v[3], v[0], v[4]}};
+      return {{Face{v[0], v[3], v[2], v[1]}, Face{v[0], v[1], v[4]}, Face{v[1], v[2], v[4]}, Face{v[2], v[3], v[4]},
+               Face{v[3], v[0], v[4]}},
+              5};
     case 6:
-      return {{v[0], v[2], v[1]}, {v[3], v[4], v[5]}, {v[0], v[1], v[4], v[3]}, {v[1], v[2], v[5], v[4]},
-              {v[2], v[0], v[3], v[5]}};
+      return {{Face{v[0], v[2], v[1]}, Face{v[3], v[4], v[5]}, Face{v[0], v[1], v[4], v[3]}, Face{v[1], v[2], v[5], v[4]},
+               Face{v[2], v[0], v[3], v[5]}},
+              5};
     default:
       throw std::invalid_argument(fmt::format("a cell of {} points is no tetrahedron, pyramid or prism", c.n));
   }
@@ -78,30 +85,32 @@ FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& p, const Face& f)
 }
 
 CellGeometry cell_geometry(const PolyMesh& m) {
-  std::vector<FaceGeometry> fg(m.faces.size());
-  for (std::size_t f = 0; f < m.faces.size(); ++f) fg[f] = face_geometry(m.points, m.faces[f]);
+  // Face geometry is computed twice rather than kept: at 2 faces per cell it would be the
+  // largest array of the mesh stage.
   std::vector<Eigen::Vector3d> estimate(m.cells, Eigen::Vector3d::Zero());
   std::vector<int> count(m.cells, 0);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
-    estimate[m.owner[f]] += fg[f].centre, ++count[m.owner[f]];
-    if (f < m.neighbour.size()) estimate[m.neighbour[f]] += fg[f].centre, ++count[m.neighbour[f]];
+    const Eigen::Vector3d c = face_geometry(m.points, m.faces[f]).centre;
+    estimate[m.owner[f]] += c, ++count[m.owner[f]];
+    if (f < m.neighbour.size()) estimate[m.neighbour[f]] += c, ++count[m.neighbour[f]];
   }
   for (int c = 0; c < m.cells; ++c) estimate[c] /= std::max(1, count[c]);
-  CellGeometry g{std::vector<Eigen::Vector3d>(m.cells, Eigen::Vector3d::Zero()), std::vector<double>(m.cells, 0.0), {}};
+  count = {};
+  CellGeometry g{std::vector<Eigen::Vector3d>(m.cells, Eigen::Vector3d::Zero()), std::vector<double>(m.cells, 0.0)};
   auto add = [&](int c, const FaceGeometry& face, double sign) {
     const double pyramid3 = sign * face.area.dot(face.centre - estimate[c]);  // 3 x the pyramid's volume
     g.centres[c] += pyramid3 * (0.75 * face.centre + 0.25 * estimate[c]);
     g.volumes[c] += pyramid3;
   };
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
-    add(m.owner[f], fg[f], 1.0);
-    if (f < m.neighbour.size()) add(m.neighbour[f], fg[f], -1.0);
+    const FaceGeometry face = face_geometry(m.points, m.faces[f]);
+    add(m.owner[f], face, 1.0);
+    if (f < m.neighbour.size()) add(m.neighbour[f], face, -1.0);
   }
   for (int c = 0; c < m.cells; ++c) {
     g.centres[c] = std::abs(g.volumes[c]) > 1e-300 ? Eigen::Vector3d(g.centres[c] / g.volumes[c]) : estimate[c];
     g.volumes[c] /= 3.0;
   }
-  g.faces = std::move(fg);
   return g;
 }
 
@@ -112,71 +121,75 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
                               const std::vector<std::string>& names, const std::vector<std::string>& types) {
   // Cells bottom to top.
-  std::vector<double> zc(input.size());
-  for (std::size_t c = 0; c < input.size(); ++c) zc[c] = vertex_mean(points, input[c].v.data(), input[c].n).z();
   std::vector<int> order(input.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return zc[a] < zc[b]; });
-
-  // Every cell face, turned to point out of its cell and keyed by its sorted points: a key met
-  // twice is an internal face.
-  struct CellFace {
-    Key key;
-    Face face;
-    int cell;
-  };
-  std::vector<CellFace> all;
-  all.reserve(4 * input.size());
-  for (int c = 0; c < static_cast<int>(order.size()); ++c) {
-    const VolumeCell& cell = input[order[c]];
-    const Eigen::Vector3d centre = vertex_mean(points, cell.v.data(), cell.n);
-    for (Face f : faces_of(cell)) {
-      const Eigen::Vector3d& a = points[f[0]];
-      // A quad's normal from its two diagonals, robust when it is warped.
-      const Eigen::Vector3d n = f.size() == 4 ? (points[f[2]] - a).cross(points[f[3]] - points[f[1]])
-                                              : (points[f[1]] - a).cross(points[f[2]] - a);
-      if (n.dot(vertex_mean(points, f.begin(), f.size()) - centre) < 0.0) std::reverse(f.begin(), f.end());
-      all.push_back({key_of(f), f, c});
-    }
+  {
+    std::vector<double> zc(input.size());
+    for (std::size_t c = 0; c < input.size(); ++c) zc[c] = vertex_mean(points, input[c].v.data(), input[c].n).z();
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return zc[a] < zc[b]; });
   }
-  std::sort(all.begin(), all.end(), [](const CellFace& a, const CellFace& b) {
-    return a.key != b.key ? a.key < b.key : a.cell < b.cell;
-  });
-
-  std::unordered_map<Key, int, KeyHash> patch_of;
-  patch_of.reserve(boundary.size());
-  for (std::size_t b = 0; b < boundary.size(); ++b) patch_of.emplace(key_of(boundary[b]), patch[b]);
-
+  // Face `local` of (sorted) cell c, turned to point out of it.
+  auto cell_face = [&](int c, int local) {
+    const VolumeCell& cell = input[order[c]];
+    Face f = faces_of(cell).face[local];
+    const Eigen::Vector3d& a = points[f[0]];
+    // A quad's normal from its two diagonals, robust when it is warped.
+    const Eigen::Vector3d n = f.size() == 4 ? (points[f[2]] - a).cross(points[f[3]] - points[f[1]])
+                                            : (points[f[1]] - a).cross(points[f[2]] - a);
+    if (n.dot(vertex_mean(points, f.begin(), f.size()) - vertex_mean(points, cell.v.data(), cell.n)) < 0.0)
+      std::reverse(f.begin(), f.end());
+    return f;
+  };
   auto where = [&](const Face& f) {
     const Eigen::Vector3d c = vertex_mean(points, f.begin(), f.size());
     return fmt::format("({:.6g}, {:.6g}, {:.6g}) m", c.x(), c.y(), c.z());
   };
+
+  // Every cell face by its sorted points and its place in its cell (not the face itself, which
+  // at 4 faces per cell would be the stage's largest array): a key met twice is an internal face.
+  struct CellFace {
+    Key key;
+    int cell, local;
+  };
   struct Internal {
-    int owner, neighbour;
-    Face face;
+    int owner, neighbour, local;  // local: the face's place in its owner
   };
   struct Boundary {
-    int patch, owner;
-    Face face;
+    int patch, owner, local;
   };
   std::vector<Internal> internal;
   std::vector<Boundary> bnd;
-  internal.reserve(2 * input.size());
-  for (std::size_t i = 0; i < all.size();) {
-    std::size_t j = i + 1;
-    while (j < all.size() && all[j].key == all[i].key) ++j;
-    if (j - i > 2)
-      throw std::runtime_error(fmt::format("volume mesh: a face at {} is shared by {} cells", where(all[i].face), j - i));
-    if (j - i == 2) {
-      internal.push_back({all[i].cell, all[i + 1].cell, all[i].face});  // sorted by cell: i is the owner
-    } else {
-      const auto it = patch_of.find(all[i].key);
-      if (it == patch_of.end())
-        throw std::runtime_error(
-            fmt::format("volume mesh: a boundary face at {} belongs to no surface patch", where(all[i].face)));
-      bnd.push_back({it->second, all[i].cell, all[i].face});
+  {
+    std::vector<CellFace> all;
+    all.reserve(4 * input.size());
+    for (int c = 0; c < static_cast<int>(order.size()); ++c) {
+      const CellFaces faces = faces_of(input[order[c]]);
+      for (int k = 0; k < faces.n; ++k) all.push_back({key_of(faces.face[k]), c, k});
     }
-    i = j;
+    std::sort(all.begin(), all.end(), [](const CellFace& a, const CellFace& b) {
+      return a.key != b.key ? a.key < b.key : a.cell < b.cell;
+    });
+    std::unordered_map<Key, int, KeyHash> patch_of;
+    patch_of.reserve(boundary.size());
+    for (std::size_t b = 0; b < boundary.size(); ++b) patch_of.emplace(key_of(boundary[b]), patch[b]);
+    internal.reserve(2 * input.size());
+    for (std::size_t i = 0; i < all.size();) {
+      std::size_t j = i + 1;
+      while (j < all.size() && all[j].key == all[i].key) ++j;
+      if (j - i > 2)
+        throw std::runtime_error(fmt::format("volume mesh: a face at {} is shared by {} cells",
+                                             where(cell_face(all[i].cell, all[i].local)), j - i));
+      if (j - i == 2) {
+        internal.push_back({all[i].cell, all[i + 1].cell, all[i].local});  // sorted by cell: i is the owner
+      } else {
+        const auto it = patch_of.find(all[i].key);
+        if (it == patch_of.end())
+          throw std::runtime_error(fmt::format("volume mesh: a boundary face at {} belongs to no surface patch",
+                                               where(cell_face(all[i].cell, all[i].local))));
+        bnd.push_back({it->second, all[i].cell, all[i].local});
+      }
+      i = j;
+    }
   }
   std::sort(internal.begin(), internal.end(), [](const Internal& a, const Internal& b) {
     return a.owner != b.owner ? a.owner < b.owner : a.neighbour < b.neighbour;
@@ -188,17 +201,20 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
   PolyMesh m;
   m.cells = static_cast<int>(input.size());
   m.faces.reserve(internal.size() + bnd.size());
+  m.owner.reserve(internal.size() + bnd.size());
+  m.neighbour.reserve(internal.size());
   for (const Internal& f : internal) {
-    m.faces.push_back(f.face);
+    m.faces.push_back(cell_face(f.owner, f.local));
     m.owner.push_back(f.owner);
     m.neighbour.push_back(f.neighbour);
   }
+  internal = {};
   for (std::size_t p = 0; p < names.size(); ++p) m.patches.push_back({names[p], types[p], 0, 0});
   std::size_t k = 0;
   for (int p = 0; p < static_cast<int>(names.size()); ++p) {
     m.patches[p].start = static_cast<int>(m.faces.size());
     for (; k < bnd.size() && bnd[k].patch == p; ++k) {
-      m.faces.push_back(bnd[k].face);
+      m.faces.push_back(cell_face(bnd[k].owner, bnd[k].local));
       m.owner.push_back(bnd[k].owner);
     }
     m.patches[p].size = static_cast<int>(m.faces.size()) - m.patches[p].start;

@@ -74,12 +74,10 @@ struct FaceGeometry {
 FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& points, const Face& face);
 
 // Cell centres and volumes (m, m^3; volumes signed) as OpenFOAM computes them
-// (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres;
-// with the face geometry they were built from.
+// (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres.
 struct CellGeometry {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> volumes;
-  std::vector<FaceGeometry> faces;  // per face of the mesh
 };
 CellGeometry cell_geometry(const PolyMesh& mesh);
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/stage_meter.hpp"
 #include "meshing/defect_locations.hpp"
 #include "meshing/gmsh_model.hpp"
 
@@ -312,12 +313,16 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     for (int pass = 0;; ++pass) {
       try {
         if (pass > 0) {
+          out = VolumeMesh();  // the pass remakes them; both at once would double the peak
+          release_free_memory();
           progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", algorithm_name(algorithm), pass,
                                       bad.size()));
           gmsh::model::mesh::optimize("", true, 1, {{3, tetrahedra}});  // the layers are left as built
         }
         progress.update(fmt::format("{}: checking cells", algorithm_name(algorithm)));
+        release_free_memory();  // what gmsh's tetrahedra or optimiser freed
         out.mesh = extract_poly_mesh();
+        release_free_memory();  // the extraction's face table
       } catch (const std::string& e) {
         broken = e;
       } catch (const std::exception& e) {
@@ -325,6 +330,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       }
       if (!broken.empty()) break;
       out.quality = cell_quality(out.mesh);
+      release_free_memory();
       bad = out.quality.bad_cells(p.gate, d_ref);
       history.push_back({{"pass", pass},
                          {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
