@@ -12,7 +12,10 @@
 #include <optional>
 #include <stdexcept>
 #include <unordered_map>
+#include <random>
 #include <thread>
+
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/stage_meter.hpp"
@@ -94,38 +97,61 @@ int load_surface(const TriangleMesh& s) {
 
   std::map<std::pair<int, int>, std::vector<std::size_t>> groups;  // (shell, patch) -> triangles
   for (std::size_t t = 0; t < s.triangles.size(); ++t) groups[{shell[t], s.patch[t]}].push_back(t);
+  // The surfaces reach gmsh as one .msh file, read in a single pass: through the API every call
+  // that adds elements rebuilds gmsh's node cache, O(surfaces x nodes), 51 s for the 4001 shells
+  // of a = 10, N = 4000. Tags: surface k + 1 is the k-th group; node v + 1 is point v and
+  // belongs to the first surface that uses it; triangle t + 1 is triangle t.
   std::vector<int> node_entity(s.points.size(), 0);
   std::map<int, std::vector<int>> shell_surfaces;
   std::vector<std::vector<int>> patch_surfaces(n_patches);
-  std::vector<std::pair<int, const std::vector<std::size_t>*>> entities;
+  int tag = 0;
   for (const auto& [key, tris] : groups) {
-    const int tag = gmsh::model::addDiscreteEntity(2);
-    entities.emplace_back(tag, &tris);
+    ++tag;
     shell_surfaces[key.first].push_back(tag);
     patch_surfaces[key.second].push_back(tag);
     for (std::size_t t : tris)
       for (int v : s.triangles[t])
         if (node_entity[v] == 0) node_entity[v] = tag;
   }
-  // Each node belongs to one entity (the first that uses it); elements may use any node.
-  std::map<int, std::pair<std::vector<std::size_t>, std::vector<double>>> nodes;
-  for (std::size_t v = 0; v < s.points.size(); ++v) {
-    if (node_entity[v] == 0) continue;
-    auto& [tags, xyz] = nodes[node_entity[v]];
-    tags.push_back(v + 1);
-    xyz.insert(xyz.end(), {s.points[v].x(), s.points[v].y(), s.points[v].z()});
+  std::vector<std::vector<int>> entity_nodes(groups.size() + 1);
+  for (std::size_t v = 0; v < s.points.size(); ++v)
+    if (node_entity[v] != 0) entity_nodes[node_entity[v]].push_back(static_cast<int>(v));
+  fmt::memory_buffer msh;
+  auto out = std::back_inserter(msh);
+  fmt::format_to(out, "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 {} 0\n", groups.size());
+  for (std::size_t e = 1; e <= groups.size(); ++e) fmt::format_to(out, "{} 0 0 0 0 0 0 0 0\n", e);
+  std::size_t used = 0;
+  for (const auto& nodes : entity_nodes) used += nodes.size();
+  fmt::format_to(out, "$EndEntities\n$Nodes\n{} {} 1 {}\n", groups.size(), used, s.points.size());
+  for (std::size_t e = 1; e <= groups.size(); ++e) {
+    fmt::format_to(out, "2 {} 0 {}\n", e, entity_nodes[e].size());
+    for (int v : entity_nodes[e]) fmt::format_to(out, "{}\n", v + 1);
+    for (int v : entity_nodes[e]) fmt::format_to(out, "{:.17g} {:.17g} {:.17g}\n", s.points[v].x(), s.points[v].y(), s.points[v].z());
   }
-  for (const auto& [tag, n] : nodes) gmsh::model::mesh::addNodes(2, tag, n.first, n.second);
-  for (const auto& [tag, tris] : entities) {
-    std::vector<std::size_t> element_tags, node_tags;
-    element_tags.reserve(tris->size());
-    node_tags.reserve(3 * tris->size());
-    for (std::size_t t : *tris) {
-      element_tags.push_back(t + 1);
-      for (int v : s.triangles[t]) node_tags.push_back(static_cast<std::size_t>(v) + 1);
-    }
-    gmsh::model::mesh::addElementsByType(tag, 2, element_tags, node_tags);
+  fmt::format_to(out, "$EndNodes\n$Elements\n{} {} 1 {}\n", groups.size(), s.triangles.size(), s.triangles.size());
+  tag = 0;
+  for (const auto& [key, tris] : groups) {
+    fmt::format_to(out, "2 {} 2 {}\n", ++tag, tris.size());
+    for (std::size_t t : tris)
+      fmt::format_to(out, "{} {} {} {}\n", t + 1, s.triangles[t][0] + 1, s.triangles[t][1] + 1, s.triangles[t][2] + 1);
   }
+  fmt::format_to(out, "$EndElements\n");
+  node_entity = {}, entity_nodes = {}, groups = {};
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     fmt::format("bedforge-surface-{}-{:x}.msh", ::getpid(), std::random_device()());
+  {
+    std::ofstream file(path, std::ios::binary);
+    file.write(msh.data(), static_cast<std::streamsize>(msh.size()));
+    if (!file) throw std::runtime_error(fmt::format("volume mesh: cannot write {}", path.string()));
+  }
+  msh = {};
+  try {
+    gmsh::merge(path.string());
+  } catch (...) {
+    std::filesystem::remove(path);
+    throw;
+  }
+  std::filesystem::remove(path);
   // The outer shell first: gmsh takes the first loop as the volume's outside.
   std::vector<int> loops{gmsh::model::geo::addSurfaceLoop(shell_surfaces[outer])};
   for (const auto& [sh, tags] : shell_surfaces)
