@@ -19,6 +19,7 @@
 #include "meshing/contacts.hpp"
 #include "meshing/gap_spacing.hpp"
 #include "meshing/primitives.hpp"
+#include "meshing/stl_io.hpp"
 #include "meshing/vtp_io.hpp"
 #include "meshing/wall_mesh.hpp"
 
@@ -257,6 +258,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       m = TriangleMesh();
     }
   f.weld();
+  round_to_ascii_stl(f);
   out.bed.weld();
 
   const double domain = c.cross_section_area() * (z1 - z0);

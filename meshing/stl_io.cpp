@@ -14,6 +14,8 @@ namespace bedforge::meshing {
 
 namespace {
 
+constexpr int kDigits = 12;  // significant digits of a coordinate in an ASCII STL
+
 Eigen::Vector3d unit_normal(const TriangleMesh& m, const std::array<int, 3>& t) {
   const Eigen::Vector3d n = (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]);
   const double len = n.norm();
@@ -29,6 +31,16 @@ std::vector<std::size_t> triangles_of(const TriangleMesh& m, int patch) {
 }
 
 }  // namespace
+
+void round_to_ascii_stl(TriangleMesh& m) {
+#pragma omp parallel for schedule(static)
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      char text[32];
+      const char* end = fmt::format_to_n(text, sizeof text, "{:.{}g}", m.points[v][k], kDigits).out;
+      std::from_chars(text, end, m.points[v][k]);
+    }
+}
 
 void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {
   constexpr std::size_t kChunk = 1 << 14, kBatch = 16;  // formatting is the slow part: chunks in parallel
@@ -47,7 +59,8 @@ void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {
           const Eigen::Vector3d n = unit_normal(m, t);
           fmt::format_to(it, "  facet normal {:.9g} {:.9g} {:.9g}\n    outer loop\n", n.x(), n.y(), n.z());
           for (int v : t)
-            fmt::format_to(it, "      vertex {:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
+            fmt::format_to(it, "      vertex {:.{}g} {:.{}g} {:.{}g}\n", m.points[v].x(), kDigits, m.points[v].y(), kDigits,
+                           m.points[v].z(), kDigits);
           fmt::format_to(it, "    endloop\n  endfacet\n");
         }
       }

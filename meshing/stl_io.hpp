@@ -6,6 +6,12 @@
 
 namespace bedforge::meshing {
 
+// Rounds every coordinate to the 12 significant digits write_stl_ascii_by_patch keeps, so that a
+// surface read back from its STL is the one in memory, and both mesh the same points. It also
+// keeps gmsh's Delaunay fast: at full precision a sphere's points are cospherical to rounding and
+// its predicates fall back to exact arithmetic on nearly every test.
+void round_to_ascii_stl(TriangleMesh& mesh);
+
 // ASCII STL with one named solid per patch (`solid inlet ... endsolid inlet`), the layout
 // snappyHexMesh and surfaceFeatureExtract read as separate regions. Coordinates in metres.
 void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& mesh);

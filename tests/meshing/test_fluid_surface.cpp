@@ -300,6 +300,27 @@ TEST(StlIo, NamedSolidsAndBinaryRecords) {
   EXPECT_EQ(one.str().size(), 84 + 50 * static_cast<std::size_t>(std::count(fs.fluid.patch.begin(), fs.fluid.patch.end(), particles)));
 }
 
+// fluid.stl is what `bedforge mesh DIR` meshes, the surface in memory what `bedforge run` meshes:
+// they must be the same points, to the last bit.
+TEST(StlIo, TheAsciiStlReadsBackAsTheSurfaceInMemory) {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(0.0123);
+  b.centres = {{0.00113, -0.00071, 0.00352}, {-0.0041, 0.0029, 0.0061}};
+  b.diameters = {0.00517, 0.00517};
+  const FluidSurface fs = build_fluid_surface(b, {});
+  std::ostringstream text;
+  write_stl_ascii_by_patch(text, fs.fluid);
+  const TriangleMesh back = read_stl_ascii_by_patch(text.str(), "memory");
+  auto sorted = [](const TriangleMesh& m) {
+    std::vector<std::array<double, 3>> p;
+    for (const auto& v : m.points) p.push_back({v.x(), v.y(), v.z()});
+    std::sort(p.begin(), p.end());
+    return p;
+  };
+  EXPECT_EQ(back.triangles.size(), fs.fluid.triangles.size());
+  EXPECT_EQ(sorted(back), sorted(fs.fluid));
+}
+
 TEST(FluidSurface, TheSameBedGivesTheSameSurface) {
   // Reproducible: two builds of one bed, in one process and on all threads, give the same
   // vertices and triangles (CGAL's hull lists its faces in an order that varies between calls).
