@@ -338,15 +338,16 @@ class ContactTreatment {
 
   // A planar cut of sphere i at distance h along axis a (unit), its loop of n vertices on the
   // circle of radius rho (given, so a bridge's loop is exactly its tube's) about `at` (default
-  // c + h a); returns the loop's frame.
-  Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, const std::string& name,
-                  std::optional<Eigen::Vector3d> at = std::nullopt) {
+  // c + h a), its rings jittered by `jitter` (SphereCut); returns the loop's frame.
+  Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, double jitter,
+                  const std::string& name, std::optional<Eigen::Vector3d> at = std::nullopt) {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i];
     const Frame f = Frame::along(at.value_or(c + h * a), a);
     SphereCut cut;
     cut.loop = circle_loop(f, rho, n);
     cut.spacing = 2.0 * kPi * rho / n;
+    cut.jitter = jitter;
     cut.axis = a;
     cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
     add_cut(i, std::move(cut), name, std::acos(std::clamp(h / r, -1.0, 1.0)));
@@ -377,8 +378,8 @@ class ContactTreatment {
         throw InputError(fmt::format("{} overlap too deeply to be capped (centre distance {:.3g} d)", who, dist / d_));
       for (auto [k, h, axis] : {std::tuple{i, cut_i, a}, std::tuple{j, cut_j, Eigen::Vector3d(-a)}}) {
         const double r = out_.radius[k], rho = std::sqrt(r * r - h * h);
-        const Frame f = plane_cut(k, axis, h, rho, ring_points(rho, edge_c_), fmt::format("cap towards sphere {}", k == i ? j : i));
-        out_.parts.push_back(ring_mesh(f, 0.0, rho, edge_c_, true, "particles"));
+        const Frame f = plane_cut(k, axis, h, rho, ring_points(rho, edge_c_), 0.0, fmt::format("cap towards sphere {}", k == i ? j : i));
+        out_.parts.push_back(ring_mesh(f, 0.0, rho, edge_c_, 0.0, true, "particles"));
         area_ += kPi * rho * rho;
       }
       ++caps_;
@@ -393,7 +394,7 @@ class ContactTreatment {
         throw InputError(fmt::format("{} overlap so deeply that one centre lies inside the other sphere", who));
       const double rho = std::sqrt(std::max(0.0, ri * ri - cut_i * cut_i));
       const int n = ring_points(rho, edge_c_);
-      const Frame f = plane_cut(i, a, cut_i, rho, n, fmt::format("union with sphere {}", j));
+      const Frame f = plane_cut(i, a, cut_i, rho, n, kBreakCocircular, fmt::format("union with sphere {}", j));
       SphereCut cut;
       cut.loop = out_.cuts[i].back().loop;  // the same vertices on both spheres
       cut.spacing = out_.cuts[i].back().spacing;
@@ -422,7 +423,7 @@ class ContactTreatment {
                                        "contacts.bridge_diameter_d or another treatment",
                                        who, k));
     const int n = ring_points(bridge_radius, edge_c_);
-    const Frame f = plane_cut(i, a, cut_i, bridge_radius, n, fmt::format("bridge to sphere {}", j));
+    const Frame f = plane_cut(i, a, cut_i, bridge_radius, n, kBreakCocircular, fmt::format("bridge to sphere {}", j));
     const GeneratorLength length = [L](double, double) { return L; };
     SphereCut cut;
     cut.loop = tube_end_loop(f, bridge_radius, n, length, edge_c_);
@@ -459,8 +460,8 @@ class ContactTreatment {
       const double g = p_.cap_gap_d * d_, h = to_wall - g;
       if (h <= 0.1 * r) throw InputError(fmt::format("{} overlap too deeply to be capped", who));
       const double rho_c = std::sqrt(r * r - h * h);
-      const Frame f = plane_cut(i, a, h, rho_c, ring_points(rho_c, edge_c_), "cap towards the " + w.name);
-      out_.parts.push_back(ring_mesh(f, 0.0, rho_c, edge_c_, true, "particles"));
+      const Frame f = plane_cut(i, a, h, rho_c, ring_points(rho_c, edge_c_), 0.0, "cap towards the " + w.name);
+      out_.parts.push_back(ring_mesh(f, 0.0, rho_c, edge_c_, 0.0, true, "particles"));
       area_ += kPi * rho_c * rho_c;
       double left = g;  // the disk's rim bends towards a concave wall
       for (const auto& q : out_.cuts[i].back().loop) left = std::min(left, w.reach(q));
@@ -475,7 +476,7 @@ class ContactTreatment {
                                    p_.bridge_diameter_d, i, 2.0 * r / d_));
     const double h = std::sqrt(r * r - bridge_radius * bridge_radius);
     const int n = ring_points(bridge_radius, edge_c_);
-    const Frame f = plane_cut(i, a, h, bridge_radius, n, "bridge to the " + w.name);
+    const Frame f = plane_cut(i, a, h, bridge_radius, n, kBreakCocircular, "bridge to the " + w.name);
     const GeneratorLength length = [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
     double shortest = std::numeric_limits<double>::infinity();
     for (int j = 0; j < 64; ++j) {
@@ -565,7 +566,7 @@ class ContactTreatment {
   void cross_plane(std::size_t i, const Eigen::Vector3d& a, double h, const std::string& name,
                    std::vector<WallHole>& holes, std::optional<Eigen::Vector3d> at) {
     const double r = out_.radius[i], rho = std::sqrt(std::max(0.0, r * r - h * h));
-    plane_cut(i, a, h, rho, ring_points(rho, edge_c_), name, at);
+    plane_cut(i, a, h, rho, ring_points(rho, edge_c_), kBreakCocircular, name, at);
     open_hole(i, holes, -a);
   }
 

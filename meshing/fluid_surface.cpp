@@ -238,7 +238,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
     if (!box && !p.clip) {  // nothing cuts it: the structured ring
-      f.append(ring_mesh(frame, r_in, R, wall_edge, up, patch));
+      f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
       continue;
     }
     add(patch, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });

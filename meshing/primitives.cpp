@@ -13,6 +13,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "core/random.hpp"
+#include "meshing/planar_cdt.hpp"
 #include "meshing/spaced_points.hpp"
 
 namespace bedforge::meshing {
@@ -164,8 +166,13 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   std::vector<double> spacing;
   for (const auto& cut : cuts) spacing.push_back(cut.spacing);
   auto wanted = [&](const Eigen::Vector3d& p, double s) { return field ? std::min(s, field.at(p)) : s; };
+  // Each ring point moves at random along the sphere by up to its cut's jitter / 2 of its
+  // spacing (see kBreakCocircular).
+  Rng nudge(1);
   graded_rings(spacing, h, growth, [&](std::size_t k, int ring, double offset, double next) {
-    for (const auto& p : offset_loop(cuts[k], c, r, offset, next, ring % 2 == 1)) {
+    for (Eigen::Vector3d p : offset_loop(cuts[k], c, r, offset, next, ring % 2 == 1)) {
+      p += cuts[k].jitter * next * Eigen::Vector3d(nudge.uniform() - 0.5, nudge.uniform() - 0.5, nudge.uniform() - 0.5);
+      p = c + r * (p - c).normalized();
       const double s = wanted(p, next);
       if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
     }
@@ -330,41 +337,39 @@ TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength&
   return m;
 }
 
-TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, bool along_w, const std::string& patch) {
+TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, double jitter, bool along_w,
+                       const std::string& patch) {
   TriangleMesh m;
   const int rings = std::max(1, static_cast<int>(std::ceil((r_out - r_in) / (edge * std::sqrt(3.0) / 2.0))));
-  // Ring k from the inside out; ring 0 of a disk is its centre.
-  std::vector<int> first, count;
+  // Ring k from the inside out; ring 0 of a disk is its centre. The sites between the edge loops
+  // move by up to jitter / 2 of the edge (see the header).
+  Rng nudge(1);
+  std::vector<Eigen::Vector2d> sites;
+  std::vector<std::vector<int>> loops;  // the edge loops, kept as constraints
   for (int k = 0; k <= rings; ++k) {
     const double rho = k == rings ? r_out : r_in + (r_out - r_in) * k / rings;
-    first.push_back(static_cast<int>(m.points.size()));
-    if (rho <= 0.0) {
-      m.points.push_back(f.to_world(Eigen::Vector3d::Zero()));
-      count.push_back(1);
-      continue;
-    }
-    const int n = k == 0 || k == rings ? ring_points(rho, edge) : std::max(6, ring_points(rho, edge));
-    for (const auto& p : circle_loop(f, rho, n)) m.points.push_back(p);
-    count.push_back(n);
-  }
-  for (int k = 0; k < rings; ++k) {
-    const int na = count[k], nb = count[k + 1];
-    auto A = [&](int i) { return first[k] + i % na; };
-    auto B = [&](int j) { return first[k + 1] + j % nb; };
-    if (na == 1) {  // fan around the centre
-      for (int j = 0; j < nb; ++j) m.triangles.push_back({A(0), B(j), B(j + 1)});
-      continue;
-    }
-    // Zip the two rings together, always advancing along the ring whose next vertex comes first.
-    for (int i = 0, j = 0; i < na || j < nb;) {
-      if (j >= nb || (i < na && static_cast<double>(i + 1) / na <= static_cast<double>(j + 1) / nb)) {
-        m.triangles.push_back({A(i), A(i + 1), B(j)});
-        ++i;
+    const bool loop = k == rings || (k == 0 && rho > 0.0);
+    const int n = rho <= 0.0 ? 1 : loop ? ring_points(rho, edge) : std::max(6, ring_points(rho, edge));
+    if (loop) loops.emplace_back();
+    for (const Eigen::Vector3d& p : rho <= 0.0 ? std::vector<Eigen::Vector3d>{f.origin} : circle_loop(f, rho, n)) {
+      Eigen::Vector2d q((p - f.origin).dot(f.u), (p - f.origin).dot(f.v));
+      if (loop) {
+        loops.back().push_back(static_cast<int>(sites.size()));
+        m.points.push_back(p);  // as the walls' end rows have them, bit for bit
       } else {
-        m.triangles.push_back({A(i), B(j + 1), B(j)});
-        ++j;
+        q += jitter * edge * Eigen::Vector2d(nudge.uniform() - 0.5, nudge.uniform() - 0.5);
+        m.points.push_back(f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)));
       }
+      sites.push_back(q);
     }
+  }
+  Cdt cdt;
+  const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, sites, edge);
+  for (const auto& loop : loops)
+    for (std::size_t k = 0; k < loop.size(); ++k) cdt.insert_constraint(handle[loop[k]], handle[loop[(k + 1) % loop.size()]]);
+  for (auto fh : cdt.finite_face_handles()) {
+    const std::array<int, 3> t{fh->vertex(0)->info(), fh->vertex(1)->info(), fh->vertex(2)->info()};
+    if ((sites[t[0]] + sites[t[1]] + sites[t[2]]).norm() / 3.0 > r_in) m.triangles.push_back(t);  // not in the hole
   }
   m.patch.assign(m.triangles.size(), 0);
   m.patches = {patch};

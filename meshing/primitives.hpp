@@ -41,9 +41,20 @@ std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n);
 // Where a sphere's mesh stops: a closed loop of vertices on the sphere (a circle for caps,
 // bridges and neighbours, the wall curve for a sphere crossing a wall). The sphere keeps the
 // side where `removed` is false.
+// Regular rings of points (on a flat face, or parallel to a cut on a sphere) hold four points
+// on a circle again and again, where a Delaunay triangulation may take either diagonal: gmsh's
+// tetrahedra then miss the surface's choice and recover the face over the whole volume mesh, at
+// several times their own time and memory (docs/findings.md). Moving each such point at random
+// (seeded, the same every run) by up to kBreakCocircular / 2 of its spacing in each direction
+// leaves one Delaunay triangulation, which the surface and gmsh both find. Caps keep their
+// rings regular (jitter 0): a cap faces another across a thin gap, and two layouts moved
+// independently leave slivers between them.
+constexpr double kBreakCocircular = 2e-3;
+
 struct SphereCut {
   std::vector<Eigen::Vector3d> loop;              // in order, on the sphere (m)
   double spacing = 0.0;                           // distance between loop vertices (m)
+  double jitter = kBreakCocircular;               // of the rings graded from the loop
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, from the centre into the removed part
   std::function<bool(const Eigen::Vector3d&)> removed;
 };
@@ -79,7 +90,10 @@ TriangleMesh tube_mesh(const Frame& f, double rho, int n, const GeneratorLength&
 std::vector<Eigen::Vector3d> tube_end_loop(const Frame& f, double rho, int n, const GeneratorLength& length, double edge);
 
 // Flat ring r_in <= r <= r_out (r_in = 0: a disk) in the plane z = 0 of f, normal +w if
-// `along_w`. Its edge loops are circle_loop(f, r, ring_points(r, edge)).
-TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, bool along_w, const std::string& patch);
+// `along_w`, triangulated Delaunay within its edge loops circle_loop(f, r, ring_points(r, edge)).
+// The sites between the loops move at random by up to jitter / 2 of the edge (see
+// kBreakCocircular).
+TriangleMesh ring_mesh(const Frame& f, double r_in, double r_out, double edge, double jitter, bool along_w,
+                       const std::string& patch);
 
 }  // namespace bedforge::meshing

@@ -19,8 +19,8 @@ constexpr double kPi = std::numbers::pi;
 
 TriangleMesh container(double R, double z0, double z1, double edge, const WallMesh& wall) {
   TriangleMesh m = wall.outside;
-  m.append(ring_mesh(Frame::along({0, 0, z0}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, false, "inlet"));
-  m.append(ring_mesh(Frame::along({0, 0, z1}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, true, "outlet"));
+  m.append(ring_mesh(Frame::along({0, 0, z0}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, false, "inlet"));
+  m.append(ring_mesh(Frame::along({0, 0, z1}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, true, "outlet"));
   m.weld();
   return m;
 }
