@@ -144,7 +144,7 @@ int load_surface(const TriangleMesh& s) {
     file.write(msh.data(), static_cast<std::streamsize>(msh.size()));
     if (!file) throw std::runtime_error(fmt::format("volume mesh: cannot write {}", path.string()));
   }
-  msh = {};
+  msh = fmt::memory_buffer();  // the text is in the file now
   try {
     gmsh::merge(path.string());
   } catch (...) {

@@ -198,8 +198,9 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
     EXPECT_LE(level["own_time_s"].get<double>(), level["time_s"].get<double>()) << level.dump();
     // Sized at the first attempt, the level's whole time is that surface, mesh and flow, and
     // little else (directories, the sizing arithmetic): its own time is nearly all of it.
-    if (level["sizing"].size() == 1)
+    if (level["sizing"].size() == 1) {
       EXPECT_GT(level["own_time_s"].get<double>(), 0.95 * level["time_s"].get<double>()) << level.dump();
+    }
   }
   ASSERT_TRUE(study["complete"].get<bool>()) << study.dump();
   std::vector<bedforge::analysis::GridLevel> levels;
