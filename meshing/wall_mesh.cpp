@@ -234,13 +234,11 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
     }
   }
   const PolygonIndex hole_index(polygons);
-  // Free sites are nudged by up to 1e-3 of their spacing: the lattices and rings below have
-  // cocircular quadruples, whose diagonal CGAL and gmsh's tetrahedra choose differently; a face
-  // gmsh's Delaunay lacks must be recovered, and gmsh recovers it over the whole mesh at a cost
-  // in time and memory several times that of the tetrahedra themselves.
+  // Free sites move by up to kBreakCocircular / 2 of their spacing: the lattices and rings below
+  // hold four points on a circle again and again (see kBreakCocircular).
   Rng nudge(1);
   auto try_add = [&](const Eigen::Vector2d& lattice, double spacing) {
-    const Eigen::Vector2d q = lattice + 2e-3 * spacing * Eigen::Vector2d(nudge.uniform() - 0.5, nudge.uniform() - 0.5);
+    const Eigen::Vector2d q = lattice + kBreakCocircular * spacing * Eigen::Vector2d(nudge.uniform() - 0.5, nudge.uniform() - 0.5);
     const Eigen::Vector3d s(q.x(), q.y(), 0.0);
     if (field) spacing = std::min(spacing, field.at(f.to_world(s)));
     if (!in_region(q) || hole_index.contains(q) || !spaced.fits(s, spacing)) return;
