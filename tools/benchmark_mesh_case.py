@@ -22,7 +22,8 @@ layers: a = 4, N = 40 (seed 1), shrink, surface edge 0.1 d without and with 3 pr
 snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
         the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
-        case, with the time and peak memory of every stage.
+        case, with the time and peak memory of every stage, bytes per cell.
+scale_1e4: the same at a = 14, N = 1e4 with bridges (0.1 d).
 study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedforge run` with
         [case.convergence] (--levels meshes, --ratio between them): each level's cells, dp/L and
         time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
@@ -67,7 +68,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "study", "study_gaps", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "study", "study_gaps", "study_reynolds", "study_treatments",
             "solver", "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -185,14 +186,16 @@ def snappy(tmp, edge):
     return row
 
 
-def scale(tmp):
-    path = os.path.join(tmp, "scale")
-    open(path + ".toml", "w").write(scene(10, 4000, "shrink", 0.1, False))
+def scale(tmp, a, n, treatment):
+    path = os.path.join(tmp, f"scale_{n}")
+    open(path + ".toml", "w").write(scene(a, n, treatment, 0.1, False))
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     mb = peak_mb(rep)
     ok, cells, non_ortho, skew, check_s = check_mesh(os.path.join(path, "case"))
-    row = {"wall_s": wall, "peak_mb": mb, "stages_s": stage_times(rep), "cells": cells, "mesh_ok": ok,
+    row = {"a": a, "n": n, "treatment": treatment, "wall_s": wall, "peak_mb": mb, "stages_s": stage_times(rep),
+           "cells": cells, "bytes_per_cell": mb * 2**20 / cells, "mesh_ok": ok,
+           "self_intersections": rep["stages"]["surface"]["check"]["self_intersections"],
            "check_mesh_s": check_s, "max_non_orthogonality": non_ortho, "max_skewness": skew,
            "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
            "mesh_attempts": [{k: a.get(k) for k in ("algorithm", "cells", "time_generate_s", "optimiser_passes",
@@ -368,6 +371,31 @@ def study_values(r):
     return g, r["study"]["levels"][0].get("pressure_gradient_bed_pa_m"), g.get("extrapolated")
 
 
+def scale_lines(r):
+    """The section of one scale run: each stage's time and peak, the cells and their bytes."""
+    st = r["stages_s"]
+    # Runs before the bed's size and treatment were recorded were all the default scene's bed.
+    a, n, treatment = r.get("a", 10), r.get("n", 4000), r.get("treatment", "shrink")
+    lines = [f"## Scale: a = {a}, N = {n}, {treatment}, 0.1 d, scene to case", "", *stamp(r),
+             "| stage | time (s) | peak memory (MB) |", "|---|---|---|"]
+    order = [k for k in ("pack", "analysis", "surface", "mesh", "case") if k in st]
+    lines += [f"| {k} | {st[k]:.1f} | {r.get('stages_peak_mb', {}).get(k, float('nan')):.0f} |" for k in order]
+    si = r.get("self_intersections")
+    lines += [f"| whole command (wall) | {r['wall_s']:.1f} |", "",
+              f"{r['cells']} cells, peak memory {r['peak_mb'] / 1024:.1f} GB ({r['peak_mb'] * 2**20 / r['cells']:.0f} "
+              f"bytes per cell), checkMesh {'Mesh OK' if r['mesh_ok'] else 'FAILED'} (max non-orthogonality "
+              f"{r['max_non_orthogonality']:.1f}, max skewness {r['max_skewness']:.2f}; checkMesh itself "
+              f"{r['check_mesh_s']:.0f} s). Surface self-intersection test: "
+              f"{'not recorded' if si is None else 'not run' if si == 'not checked' else 'none found' if si is False else 'FOUND'}. "
+              f"Mesh stage attempts: {json.dumps(r['mesh_attempts'])}.", ""]
+    gen = r["mesh_attempts"][-1]["time_generate_s"]
+    lines += [f"Where the time goes: the mesh stage takes {st['mesh'] / r['wall_s']:.0%} of the run, of which "
+              f"gmsh's tetrahedra {gen:.0f} s and the optimiser pass with the quality checks "
+              f"{st['mesh'] - gen:.0f} s; the surface {st['surface'] / r['wall_s']:.0%}, the packer "
+              f"{st['pack'] / r['wall_s']:.1%}.", ""]
+    return lines
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -466,23 +494,9 @@ def write(results):
                      f"({r['iterations']}) | {'OK' if r['mesh_ok'] else 'FAILED'} | {r['max_non_orthogonality']:.1f} | "
                      f"{r['max_skewness']:.2f} | {r['dp_dz_pa_m']:.4g} | {r['ratio_es']:.3f} |")
         lines.append("")
-    if "scale" in results:
-        r = results["scale"]
-        st = r["stages_s"]
-        lines += ["## Scale: a = 10, N = 4000, scene to case (default settings: shrink, 0.1 d)", "", *stamp(results["scale"]),
-                  "| stage | time (s) | peak memory (MB) |", "|---|---|---|"]
-        order = [k for k in ("pack", "analysis", "surface", "mesh", "case") if k in st]
-        lines += [f"| {k} | {st[k]:.1f} | {r.get('stages_peak_mb', {}).get(k, float('nan')):.0f} |" for k in order]
-        lines += [f"| whole command (wall) | {r['wall_s']:.1f} |", "",
-                  f"{r['cells']} cells, peak memory {r['peak_mb'] / 1024:.1f} GB, checkMesh "
-                  f"{'Mesh OK' if r['mesh_ok'] else 'FAILED'} (max non-orthogonality {r['max_non_orthogonality']:.1f}, "
-                  f"max skewness {r['max_skewness']:.2f}; checkMesh itself {r['check_mesh_s']:.0f} s). "
-                  f"Mesh stage attempts: {json.dumps(r['mesh_attempts'])}.", ""]
-        gen = r["mesh_attempts"][-1]["time_generate_s"]
-        lines += [f"Where the time goes: the mesh stage takes {st['mesh'] / r['wall_s']:.0%} of the run, of which "
-                  f"gmsh's tetrahedra {gen:.0f} s and the optimiser pass with the quality checks "
-                  f"{st['mesh'] - gen:.0f} s; the surface {st['surface'] / r['wall_s']:.0%}, the packer "
-                  f"{st['pack'] / r['wall_s']:.1%}.", ""]
+    for key in ("scale", "scale_1e4"):
+        if key in results:
+            lines += scale_lines(results[key])
     for key in ("study", "study_gaps"):
         if key in results:
             lines += study_lines(results[key])
@@ -657,7 +671,10 @@ def main():
             results["snappy"] = {**commit_and_date(), **snappy(tmp, min(args.edges))}
             write(results)
         if "scale" in args.only:
-            results["scale"] = {**commit_and_date(), **scale(tmp)}
+            results["scale"] = {**commit_and_date(), **scale(tmp, 10, 4000, "shrink")}
+            write(results)
+        if "scale_1e4" in args.only:
+            results["scale_1e4"] = {**commit_and_date(), **scale(tmp, 14, 10000, "bridge")}
             write(results)
         if "study" in args.only:
             results["study"] = study(tmp, min(args.edges), args.levels, args.ratio)
