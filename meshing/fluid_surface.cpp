@@ -76,7 +76,6 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   }
   p.clip_shift_d = s.number("clip_shift_d", p.clip_shift_d, Range::closed(0.0, 1.0));
   p.clip_clearance_d = s.number("clip_clearance_d", p.clip_clearance_d, Range::closed(0.0, 0.1));
-  p.self_intersection_limit = s.integer("self_intersection_limit", p.self_intersection_limit, 0, 1'000'000'000);
   p.min_angle_deg = s.number("min_angle_deg", p.min_angle_deg, Range::closed(0.0, 30.0));
   return p;
 }
@@ -99,7 +98,6 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"clip_window_d", p.clip ? nlohmann::json::array({p.clip_bottom_d, p.clip_top_d}) : nlohmann::json(nullptr)},
           {"clip_shift_d", p.clip_shift_d},
           {"clip_clearance_d", p.clip_clearance_d},
-          {"self_intersection_limit", p.self_intersection_limit},
           {"min_angle_deg", p.min_angle_deg}};
 }
 
@@ -196,10 +194,16 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   // (with holes where spheres cross clip planes); what the holes cut out closes the bed solid.
   FluidSurface out;
   TriangleMesh& f = out.fluid;
+  // The triangles appended since the last piece, as a piece of the self-intersection test.
+  auto piece = [&f, &out](bool on_sphere = false, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
+    const std::size_t first = out.pieces.empty() ? 0 : out.pieces.back().last;
+    if (f.triangles.size() > first) out.pieces.push_back({first, f.triangles.size(), on_sphere, centre, radius});
+  };
   auto add = [&](const std::string& what, const std::function<WallMesh()>& mesh) {
     try {
       const WallMesh m = mesh();
       f.append(m.outside);
+      piece();
       out.bed.append(m.inside);
     } catch (const CutConflict& e) {
       throw InputError(fmt::format("the {}: {}", what, e.what()));
@@ -239,6 +243,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
     if (!box && !p.clip) {  // nothing cuts it: the structured ring
       f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
+      piece();
       continue;
     }
     add(patch, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
@@ -250,13 +255,20 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     for (const auto& m : *pieces) points += m.points.size(), triangles += m.triangles.size();
   f.reserve(points, triangles);
   out.bed.reserve(points, triangles);
-  for (auto* pieces : {&spheres, &tb.parts})
-    for (auto& m : *pieces) {
-      out.bed.append(m);
-      for (auto& t : m.triangles) std::swap(t[1], t[2]);
-      f.append(m);
-      m = TriangleMesh();
-    }
+  auto add_solid = [&](TriangleMesh& m) {
+    out.bed.append(m);
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+    f.append(m);
+    m = TriangleMesh();
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    add_solid(spheres[i]);
+    piece(true, bed.centres[i], tb.radius[i]);
+  }
+  for (auto& m : tb.parts) {
+    add_solid(m);
+    piece();
+  }
   f.weld();
   round_to_ascii_stl(f);
   out.bed.weld();
@@ -287,7 +299,7 @@ FluidSurface build_checked_fluid_surface(const Bed& bed, const SurfaceParams& p,
   auto since = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   FluidSurface fs = build_fluid_surface(bed, p);
   const double built_at = since();
-  fs.check = check_surface(fs.fluid, p.self_intersection_limit);
+  fs.check = check_surface(fs.fluid, SelfIntersectionTest::by_pieces, fs.pieces);
   nlohmann::json& j = fs.report;
   j["time_build_s"] = built_at;
   j["time_check_s"] = since() - built_at;

@@ -39,7 +39,6 @@ struct SurfaceParams {
   double clip_bottom_d = 0.0, clip_top_d = 0.0;
   double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
-  long self_intersection_limit = 5'000'000;  // triangles above which the CGAL self-intersection test is skipped
   // Quality gate: a surface with a smaller angle fails, its triangles written to
   // bad_triangles.vtp (0 turns the gate off).
   double min_angle_deg = 2.0;
@@ -52,6 +51,7 @@ struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)
   TriangleMesh bed;    // the closed treated particles, normals outward (m)
   double exact_volume_m3 = 0.0;  // of the treated geometry's fluid domain, what the facets approximate
+  std::vector<SurfacePiece> pieces;  // of `fluid`, each meshed on its own: walls, inlet, outlet, spheres, parts
   SurfaceCheck check;            // CGAL's verdict on `fluid` (build_checked_fluid_surface only)
   nlohmann::json report;
 };
@@ -67,7 +67,7 @@ struct FluidSurface {
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& params);
 
 // The surface stage: build_fluid_surface, then CGAL's check (closed, 2-manifold, no
-// self-intersection below params.self_intersection_limit triangles, the enclosed volume against
+// self-intersection, tested by pieces; the enclosed volume against
 // the exact one, all into the report) and the angle gate. std::runtime_error locating the defects
 // when the surface is not valid (a defect of ours, not of the input); ConvergenceError naming the
 // particles nearest the triangles below params.min_angle_deg, after writing those triangles to

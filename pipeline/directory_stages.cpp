@@ -98,7 +98,7 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
   const fs::path stl = dir / "fluid.stl";
   const meshing::TriangleMesh surface = meshing::read_stl_ascii_by_patch(read_file(stl), stl.string());
   // A surface edited or made elsewhere: gmsh needs it closed, so say where it is not.
-  const meshing::SurfaceCheck check = meshing::check_surface(surface, 0);
+  const meshing::SurfaceCheck check = meshing::check_surface(surface, meshing::SelfIntersectionTest::skip);
   if (!check.closed || !check.manifold)
     throw InputError(fmt::format("{}: the surface is not closed ({} defective edges, first at{}); a volume needs a "
                                  "closed surface: rebuild it with `bedforge surface`",

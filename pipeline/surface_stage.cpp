@@ -22,7 +22,7 @@ SurfaceStage surface_stage(const Bed& bed, const meshing::SurfaceParams& p, cons
       meshing::treatment_name(p.treatment),
       j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"]["particle_wall"].get<long>(),
       built->fluid.triangles.size(),
-      check.self_intersections_checked ? "no self-intersection" : "self-intersections not checked",
+      check.self_intersection_test != meshing::SelfIntersectionTest::skip ? "no self-intersection" : "self-intersections not checked",
       (check.volume - built->exact_volume_m3) / built->exact_volume_m3, j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
       std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()));

@@ -32,8 +32,8 @@ TEST(FluidSurface, ShrinkOpensTouchingContactsInACylinder) {
   b.centres.emplace_back(0.0, 1.0, 1.5), b.diameters.push_back(1.0);
   SurfaceParams p;
   const FluidSurface fs = build_fluid_surface(b, p);
-  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
-  EXPECT_TRUE(k.manifold && k.closed && k.self_intersections_checked && !k.self_intersecting);
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
+  EXPECT_TRUE(k.manifold && k.closed && k.self_intersection_test != SelfIntersectionTest::skip && !k.self_intersecting);
   EXPECT_EQ(fs.report["contacts_treated"]["particle_particle"].get<long>(), 3);
   EXPECT_EQ(fs.report["contacts_treated"]["particle_wall"].get<long>(), 1);
   // Gaps the shrink leaves: 0.01 d between touching spheres, 0.005 d at the wall.
@@ -46,7 +46,7 @@ TEST(FluidSurface, ShrinkOpensTouchingContactsInACylinder) {
   EXPECT_NEAR(exact, std::numbers::pi * 2.25 * (3.0 + 2.0) - 4 * 4.0 / 3.0 * std::numbers::pi * std::pow(0.495, 3), 1e-9);
   EXPECT_NEAR(k.volume, exact, 0.01 * exact);
   // The bed solid is closed too, with outward normals.
-  const SurfaceCheck kb = check_surface(fs.bed, 10'000'000);
+  const SurfaceCheck kb = check_surface(fs.bed, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(kb.closed && !kb.self_intersecting);
   EXPECT_GT(kb.volume, 0.0);
 }
@@ -69,7 +69,7 @@ TEST(FluidSurface, TheWallTakesAShorterEdgeWhereTheSpheresEdgeWouldCutItsGap) {
   EXPECT_GT(ring_sagitta(1.5, 0.3), 0.5 * gap);  // the spheres' edge would have cut the gap
   EXPECT_LE(fs.report["wall_sagitta_d"].get<double>(), 0.4 * gap * (1 + 1e-9));
   EXPECT_LT(fs.report["wall_edge_d"].get<double>(), 0.3);
-  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting);
   p.shrink_factor = 0.9999;  // a gap of 5e-5 d at the wall: a wall edge of about 0.02 d
   try {
@@ -89,7 +89,7 @@ TEST(FluidSurface, AnnulusHasAnInnerWallPatch) {
     b.diameters.push_back(1.0);
   }
   const FluidSurface fs = build_fluid_surface(b, {});
-  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(k.closed && !k.self_intersecting);
   EXPECT_NE(std::find(fs.fluid.patches.begin(), fs.fluid.patches.end(), "inner_wall"), fs.fluid.patches.end());
   const double exact = fs.report["fluid_volume_exact_m3"].get<double>();
@@ -126,9 +126,13 @@ using Treatment = SurfaceParams::Treatment;
 // staggered, so not a prism) take at most the wall sagitta over the wall area.
 FluidSurface valid_surface(const Bed& b, const SurfaceParams& p, const std::string& label) {
   const FluidSurface fs = build_fluid_surface(b, p);
-  const SurfaceCheck k = check_surface(fs.fluid, 10'000'000);
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(k.manifold && k.closed) << label << ": " << k.defects.size() << " defective edges";
-  EXPECT_TRUE(k.self_intersections_checked && !k.self_intersecting) << label;
+  EXPECT_TRUE(k.self_intersection_test != SelfIntersectionTest::skip && !k.self_intersecting) << label;
+  // The stage's test by pieces finds none either, having left the spheres' own pairs to its argument.
+  const SurfaceCheck by_pieces = check_surface(fs.fluid, SelfIntersectionTest::by_pieces, fs.pieces);
+  EXPECT_FALSE(by_pieces.self_intersecting) << label;
+  EXPECT_LT(by_pieces.triangles_tested_pairwise, fs.fluid.triangles.size()) << label;
   const double exact = fs.report["fluid_volume_exact_m3"].get<double>();
   double particle_area = 0.0;
   for (double d : b.diameters) particle_area += std::numbers::pi * d * d;
@@ -139,7 +143,7 @@ FluidSurface valid_surface(const Bed& b, const SurfaceParams& p, const std::stri
                taken = fs.report["wall_sagitta_d"].get<double>() * wall_area;
   EXPECT_GT(k.volume, exact - taken - 1e-9 * exact) << label;
   EXPECT_LT(k.volume, exact + added) << label;
-  const SurfaceCheck kb = check_surface(fs.bed, 10'000'000);
+  const SurfaceCheck kb = check_surface(fs.bed, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(kb.closed && !kb.self_intersecting) << label << ": bed solid";
   EXPECT_GT(kb.volume, 0.0) << label;
   return fs;
@@ -577,8 +581,8 @@ TEST(FluidSurface, CellsPerGapShortensTheEdgesFacingANarrowGap) {
   const FluidSurface plain = build_fluid_surface(b, p);
   p.cells_per_gap = 2.0;
   const FluidSurface graded = build_fluid_surface(b, p);
-  const SurfaceCheck k = check_surface(graded.fluid, 10'000'000);
-  EXPECT_TRUE(k.manifold && k.closed && k.self_intersections_checked && !k.self_intersecting);
+  const SurfaceCheck k = check_surface(graded.fluid, SelfIntersectionTest::all_pairs);
+  EXPECT_TRUE(k.manifold && k.closed && k.self_intersection_test != SelfIntersectionTest::skip && !k.self_intersecting);
   const double exact = graded.report["fluid_volume_exact_m3"].get<double>();
   EXPECT_NEAR(k.volume, exact, 0.01 * exact);
   // Across each 0.1 d gap the edges ask for 0.1 / 2 = 0.05 d; the Poisson-disk spacing and the
@@ -600,7 +604,7 @@ TEST(FluidSurface, CellsPerGapShortensTheEdgesFacingANarrowGap) {
   // A box's flat walls are graded the same way: the same two spheres in a box 3.2 wide.
   b.container = std::make_shared<Box>(3.2, 3.2, false, false);
   const FluidSurface boxed = build_fluid_surface(b, p);
-  EXPECT_TRUE(check_surface(boxed.fluid, 10'000'000).closed);
+  EXPECT_TRUE(check_surface(boxed.fluid, SelfIntersectionTest::all_pairs).closed);
   EXPECT_LE(longest_edge_near(boxed.fluid, "wall", {1.6, 0.0, 0.6}), 1.6 * 0.05);
   EXPECT_LE(longest_edge_near(boxed.fluid, "particles", {1.5, 0.0, 0.6}), 1.6 * 0.05);
 }

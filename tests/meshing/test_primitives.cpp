@@ -42,8 +42,8 @@ TEST(Primitives, SphereIsClosedInscribedAndConverges) {
   double previous_error = 1.0;
   for (double edge : {0.5, 0.25, 0.12, 0.06}) {
     const TriangleMesh m = sphere_mesh(c, 1.0, {}, edge, 1.3, true, "particles");
-    const SurfaceCheck k = check_surface(m, 1'000'000);
-    EXPECT_TRUE(k.manifold && k.closed && k.self_intersections_checked && !k.self_intersecting);
+    const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
+    EXPECT_TRUE(k.manifold && k.closed && k.self_intersection_test != SelfIntersectionTest::skip && !k.self_intersecting);
     const double exact = 4.0 / 3.0 * kPi, error = (exact - signed_volume(m)) / exact;
     EXPECT_NEAR(k.volume, signed_volume(m), 1e-12);
     EXPECT_GT(error, 0.0);  // inscribed: every facet inside the sphere
@@ -81,7 +81,7 @@ TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {
   }
   m.append(sphere_mesh(c, r, cuts, edge, 1.3, true, "particles"));
   m.weld();
-  const SurfaceCheck k = check_surface(m, 1'000'000);
+  const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
   ASSERT_TRUE(k.manifold && k.closed) << "not closed";
   EXPECT_FALSE(k.self_intersecting);
   EXPECT_GT(k.volume, 0.0);
@@ -117,7 +117,7 @@ TEST(Primitives, TubeJoinsTwoLoopsAndFollowsItsGeneratorLengths) {
   orient_by(fan, [&](const Eigen::Vector3d&) { return f.w; });
   m.append(fan);
   m.weld();
-  const SurfaceCheck k = check_surface(m, 1'000'000);
+  const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
   ASSERT_TRUE(k.manifold && k.closed);
   EXPECT_NEAR(k.volume, kPi * rho * rho, 0.005 * kPi * rho * rho);
 }

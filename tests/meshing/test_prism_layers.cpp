@@ -60,9 +60,9 @@ TEST(PrismLayers, AFreeSphereGetsFullStacksFillingTheShellAroundIt) {
   // The layers take the volume between the faceted sphere (radius r, inscribed) and its offset:
   // the fluid the tetrahedra see shrinks by V_facets(r) ((1 + h / r)^3 - 1), to the offset
   // normals' deviation from radial.
-  const double before = check_surface(s.fluid, 0).volume, after = check_surface(layers.top, 0).volume;
+  const double before = check_surface(s.fluid, SelfIntersectionTest::skip).volume, after = check_surface(layers.top, SelfIntersectionTest::skip).volume;
   const double r = 0.5 * b.diameters[0] * SurfaceParams{}.shrink_factor;
-  const double facets = check_surface(s.bed, 0).volume;  // inside the faceted sphere
+  const double facets = check_surface(s.bed, SelfIntersectionTest::skip).volume;  // inside the faceted sphere
   EXPECT_NEAR((before - after) / (facets * (std::pow(1.0 + h / r, 3) - 1.0)), 1.0, 0.01)
       << "faceted sphere " << facets << " m^3 against " << 4.0 / 3.0 * std::numbers::pi * r * r * r;
   EXPECT_TRUE(self_intersecting_triangles(layers.top).empty());

@@ -59,7 +59,7 @@ TEST(VolumeMesh, CellsFillTheSurfaceAndKeepEveryPatch) {
   Progress quiet("mesh", false);
   const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, {}, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
   // The tets' volume is the enclosed volume of the surface (same boundary triangles), to round-off.
-  const double enclosed = check_surface(s.fluid, 0).volume;
+  const double enclosed = check_surface(s.fluid, SelfIntersectionTest::skip).volume;
   EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
   EXPECT_GT(vm.quality.min_volume, 0.0);
   // Every surface triangle is a boundary face of its own patch, none added or lost.
@@ -86,7 +86,7 @@ TEST(VolumeMesh, PrismLayersAndTetrahedraFillTheSurfaceTogether) {
   const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, p, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
   // The layers and the tetrahedra above them fill exactly what the surface encloses, every cell
   // positive, and the particles keep their triangles (now the feet of the stacks).
-  const double enclosed = check_surface(s.fluid, 0).volume;
+  const double enclosed = check_surface(s.fluid, SelfIntersectionTest::skip).volume;
   EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
   EXPECT_GT(vm.quality.min_volume, 0.0);
   for (int d : patch_counts(s.fluid, vm.mesh)) EXPECT_EQ(d, 0);
@@ -141,7 +141,7 @@ TEST(VolumeMesh, AnAnnulusMeshesWithItsInnerWall) {
   Progress quiet("mesh", false);
   const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, {}, {}, {}, quiet);
   for (int d : patch_counts(s.fluid, vm.mesh)) EXPECT_EQ(d, 0);
-  const double enclosed = check_surface(s.fluid, 0).volume;
+  const double enclosed = check_surface(s.fluid, SelfIntersectionTest::skip).volume;
   EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
 }
 
