@@ -43,6 +43,9 @@ bool to_cgal(const TriangleMesh& m, Mesh& mesh) {
 // not apart from its own.
 std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const std::vector<SurfacePiece>& pieces) {
   const std::size_t n = m.triangles.size();
+  // The ball that holds a sphere piece: its radius, plus what rounding the vertices to the 12
+  // significant digits of fluid.stl (round_to_ascii_stl) may move them, far from the origin too.
+  auto reach = [](const SurfacePiece& p) { return p.radius * (1.0 + 1e-9) + 2e-11 * (p.centre.norm() + p.radius); };
   auto box_of = [&m](std::size_t t) {
     CGAL::Bbox_3 b;
     for (int v : m.triangles[t]) b += CGAL::Bbox_3(m.points[v].x(), m.points[v].y(), m.points[v].z(), m.points[v].x(),
@@ -68,10 +71,10 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
     covered = p.last;
     bool on = p.on_sphere;
     for (std::size_t t = p.first; t < p.last && on; ++t)
-      for (int v : m.triangles[t]) on = on && std::abs((m.points[v] - p.centre).norm() - p.radius) <= 1e-9 * p.radius;
+      for (int v : m.triangles[t]) on = on && std::abs((m.points[v] - p.centre).norm() - p.radius) <= reach(p) - p.radius;
     convex[k] = on;
     if (on) {
-      const double r = p.radius * (1.0 + 1e-9);
+      const double r = reach(p);
       units.push_back({k, members.size(), members.size() + (p.last - p.first),
                        CGAL::Bbox_3(p.centre.x() - r, p.centre.y() - r, p.centre.z() - r, p.centre.x() + r,
                                     p.centre.y() + r, p.centre.z() + r)});
@@ -116,7 +119,7 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
     const Unit &u = units[a->info()], &w = units[b->info()];
     if (u.piece == w.piece) return;  // a sphere by the argument; any other piece is tested whole
     const bool cu = convex[u.piece], cw = convex[w.piece];
-    if (cu && cw && (ball(u).centre - ball(w).centre).norm() > (ball(u).radius + ball(w).radius) * (1.0 + 1e-9)) return;
+    if (cu && cw && (ball(u).centre - ball(w).centre).norm() > reach(ball(u)) + reach(ball(w))) return;
     if (cu) near.emplace_back(a->info(), b->info());
     if (cw) near.emplace_back(b->info(), a->info());
   });
@@ -133,7 +136,7 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
     const SurfacePiece& s = pieces[w.piece];
     double gap2 = 0.0;  // squared distance from the ball's centre to the box
     for (int k = 0; k < 3; ++k) gap2 += std::pow(std::max({b.min(k) - s.centre[k], 0.0, s.centre[k] - b.max(k)}), 2);
-    return gap2 <= std::pow(s.radius * (1.0 + 1e-9), 2);
+    return gap2 <= std::pow(reach(s), 2);
   };
 #pragma omp parallel for schedule(dynamic, 64)
   for (std::size_t k = 0; k < near.size(); ++k) {

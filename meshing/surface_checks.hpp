@@ -28,7 +28,8 @@ enum class SelfIntersectionTest {
   // reach it. Nothing else can intersect: a convex polytope's facets meet only in shared edges
   // and vertices, so no two triangles of one sphere piece do; and every triangle of a sphere
   // piece lies in its ball, so two sphere pieces whose balls are disjoint cannot meet. A sphere
-  // piece with a vertex off its sphere (by more than 1e-9 of the radius) is tested like the others.
+  // piece with a vertex off its sphere (by more than 1e-9 of the radius and the rounding to 12
+  // digits) is tested like the others.
   by_pieces,
 };
 
