@@ -70,8 +70,9 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
       throw std::invalid_argument("check_surface: the pieces do not cover the triangles once, in order");
     covered = p.last;
     bool on = p.on_sphere;
+    const double slack = reach(p) - p.radius;
     for (std::size_t t = p.first; t < p.last && on; ++t)
-      for (int v : m.triangles[t]) on = on && std::abs((m.points[v] - p.centre).norm() - p.radius) <= reach(p) - p.radius;
+      for (int v : m.triangles[t]) on = on && std::abs((m.points[v] - p.centre).norm() - p.radius) <= slack;
     convex[k] = on;
     if (on) {
       const double r = reach(p);
@@ -91,7 +92,7 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
       const Eigen::Vector3d c = (m.points[m.triangles[t][0]] + m.points[m.triangles[t][1]] + m.points[m.triangles[t][2]]) / 3.0;
       std::uint64_t key = 0;
       for (int i = 0; i < 3; ++i)  // 21 bits a coordinate: 2e6 cells each way, far more than a piece spans
-        key = key << 21 | (static_cast<std::uint64_t>(std::floor((c[i] - origin[i]) / h) + (1 << 20)) & 0x1fffff);
+        key = key << 21 | (static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor((c[i] - origin[i]) / h)) + (1 << 20)) & 0x1fffff);
       cells.emplace_back(key, static_cast<std::uint32_t>(t));
     }
     std::sort(cells.begin(), cells.end());
@@ -114,7 +115,7 @@ std::vector<Mesh::Face_index> faces_left_by_pieces(const TriangleMesh& m, const 
   std::vector<const Box*> ptr;
   for (const Box& b : boxes) ptr.push_back(&b);
   std::vector<std::pair<std::size_t, std::size_t>> near;  // (sphere unit, other unit)
-  auto ball = [&](const Unit& u) { return pieces[u.piece]; };
+  auto ball = [&](const Unit& u) -> const SurfacePiece& { return pieces[u.piece]; };
   CGAL::box_self_intersection_d(ptr.begin(), ptr.end(), [&](const Box* a, const Box* b) {
     const Unit &u = units[a->info()], &w = units[b->info()];
     if (u.piece == w.piece) return;  // a sphere by the argument; any other piece is tested whole

@@ -177,10 +177,6 @@ nlohmann::json run_accelerated(Spheres& s, const Container& container, const Sof
   // rare here, so unbounded momentum leaves the slow modes undamped; a bound on t damps them
   // (beta <= 1 - 1.5 / bound), scaled up for tolerances tighter than the default because a
   // stiffer stage needs the momentum to persist longer (measurements: docs/defaults.md).
-  // A round ends on the force residual, or on a settled mass centre once the overlaps are within
-  // the tolerance: in a tall column (a = 5, N = 1e4) the stiffened bed's mass centre moves too
-  // slowly for the monitor while its residual is still 0.5-2 weights, and stiffening again each
-  // time it looked settled left the wall overlap at 1.25e-4 d after every round (findings.md).
   const double bound = p.given.final_momentum_bound *
                        std::max(1.0, SoftSphereParams{}.overlap_tolerance_d / p.given.overlap_tolerance_d);
   log.begin_stage("final");
@@ -188,6 +184,10 @@ nlohmann::json run_accelerated(Spheres& s, const Container& container, const Sof
   for (int round = 0;; ++round) {
     const double overlap = std::max(r.contacts.max_pair_overlap, r.contacts.max_wall_overlap);
     if (overlap > target) kappa *= overlap / target;
+    // A round ends on the force residual, or on a settled mass centre once the overlaps are within
+    // the tolerance: in a tall column (a = 5, N = 1e4) the stiffened bed's mass centre moves too
+    // slowly for the monitor while its residual is still 0.5-2 weights, and stiffening again each
+    // time it looked settled left the wall overlap at 1.25e-4 d after every round (findings.md).
     r = descent.relax(kappa, true, max_step, bound, [&](const Relaxed& q) {
       return (q.settled && q.contacts.max_pair_overlap < tol && q.contacts.max_wall_overlap < tol) ||
              q.residual_rms < p.given.force_tolerance;

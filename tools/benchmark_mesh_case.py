@@ -194,13 +194,13 @@ def scale(tmp, a, n, treatment):
     mb = peak_mb(rep)
     ok, cells, non_ortho, skew, check_s = check_mesh(os.path.join(path, "case"))
     row = {"a": a, "n": n, "treatment": treatment, "wall_s": wall, "peak_mb": mb, "stages_s": stage_times(rep),
-           "cells": cells, "bytes_per_cell": mb * 2**20 / cells, "mesh_ok": ok,
+           "cells": cells, "mesh_ok": ok,
            "self_intersections": rep["stages"]["surface"]["check"]["self_intersections"],
            "check_mesh_s": check_s, "max_non_orthogonality": non_ortho, "max_skewness": skew,
            "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
-           "mesh_attempts": [{k: a.get(k) for k in ("algorithm", "cells", "time_generate_s", "optimiser_passes",
-                                                     "cells_failing_gate", "error")}
-                             for a in rep["stages"]["mesh"].get("attempts", [])]}
+           "mesh_attempts": [{k: attempt.get(k) for k in ("algorithm", "cells", "time_generate_s", "optimiser_passes",
+                                                           "cells_failing_gate", "error")}
+                             for attempt in rep["stages"]["mesh"].get("attempts", [])]}
     print(row, flush=True)
     return row
 

@@ -119,8 +119,7 @@ def write(rows):
     if not all(r["self_intersections_checked"] for r in rows):
         lines += ["", "(no SI): rows made before the test went by pieces, when it was skipped above 5e6 triangles "
                   "(the report said so); closedness and manifoldness were always checked."]
-    lines += ["", "A bed that `bedforge pack` could not make with its defaults is not in the table; why some rows "
-              "use another a: [findings.md](findings.md).",
+    lines += ["", "Rows at another a come from `--aspect-ratio` (why: [findings.md](findings.md)).",
               "", "Rows added with `--keep` come from another run; this machine's speed has varied by up to "
               "1.5x between sessions, so a ratio across runs is indicative only."]
     os.makedirs(DOCS, exist_ok=True)
