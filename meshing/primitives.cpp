@@ -1,16 +1,14 @@
 #include "meshing/primitives.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Surface_mesh.h>
+#include <CGAL/Extreme_points_traits_adapter_3.h>
 #include <CGAL/convex_hull_3.h>
+#include <CGAL/property_map.h>
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <numeric>
 #include <numbers>
-#include <tuple>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "core/random.hpp"
@@ -22,7 +20,6 @@ namespace bedforge::meshing {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Hull = CGAL::Surface_mesh<Kernel::Point_3>;
 
 // The loop of `cut` moved away from its axis by the arc `offset` on the sphere (c, r), then
 // resampled at `spacing` (starting half a step on when `stagger`).
@@ -51,20 +48,28 @@ std::vector<Eigen::Vector3d> offset_loop(const SphereCut& cut, const Eigen::Vect
 // again as a fan from its lowest-numbered vertex, so the mesh depends on the points alone.
 // `faces`: hull triangles (indices into `p`, consistently oriented), changed in place.
 void canonical_flat_facets(std::vector<std::array<int, 3>>& faces, const std::vector<Kernel::Point_3>& p) {
-  const int nf = static_cast<int>(faces.size());
-  auto directed = [](int a, int b) { return static_cast<long>(a) << 32 | static_cast<long>(b); };
-  std::vector<std::pair<long, int>> edges;  // directed edge -> its face, sorted
+  const int nf = static_cast<int>(faces.size()), nv = static_cast<int>(p.size());
+  // Directed edges a -> b and their faces, grouped by a (a hull vertex has about six).
+  std::vector<int> first(nv + 1, 0);
+  for (const auto& t : faces)
+    for (int v : t) ++first[v + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<std::pair<int, int>> out_edges(first[nv]);  // (b, face) of each a -> b
+  std::vector<int> fill(first.begin(), first.end() - 1);
   for (int f = 0; f < nf; ++f)
-    for (int e = 0; e < 3; ++e) edges.emplace_back(directed(faces[f][e], faces[f][(e + 1) % 3]), f);
-  std::sort(edges.begin(), edges.end());
+    for (int e = 0; e < 3; ++e) out_edges[fill[faces[f][e]]++] = {faces[f][(e + 1) % 3], f};
   auto face_across = [&](int a, int b) {  // the face holding edge b -> a
-    const auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(directed(b, a), -1));
-    return it != edges.end() && it->first == directed(b, a) ? it->second : -1;
+    for (int k = first[b]; k < first[b + 1]; ++k)
+      if (out_edges[k].first == a) return out_edges[k].second;
+    return -1;
   };
   // Flat facets: faces joined across edges where the neighbour's far vertex is coplanar.
   std::vector<int> group(nf);
   std::iota(group.begin(), group.end(), 0);
-  std::function<int(int)> root = [&](int f) { return group[f] == f ? f : group[f] = root(group[f]); };
+  auto root = [&group](int f) {
+    while (group[f] != f) f = group[f] = group[group[f]];
+    return f;
+  };
   bool flat = false;
   for (int f = 0; f < nf; ++f)
     for (int e = 0; e < 3; ++e) {
@@ -80,21 +85,22 @@ void canonical_flat_facets(std::vector<std::array<int, 3>>& faces, const std::ve
   // lowest vertex, becomes a fan.
   std::vector<int> order(nf);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int f, int g) { return root(f) < root(g); });
+  for (int f = 0; f < nf; ++f) group[f] = root(f);
+  std::stable_sort(order.begin(), order.end(), [&](int f, int g) { return group[f] < group[g]; });
   std::vector<std::array<int, 3>> out;
   std::vector<std::pair<int, int>> boundary;  // a -> b, sorted by a
-  for (std::size_t first = 0, last; first < order.size(); first = last) {
-    const int r = root(order[first]);
-    for (last = first; last < order.size() && root(order[last]) == r; ++last) {}
-    if (last - first == 1) {
-      out.push_back(faces[order[first]]);
+  for (std::size_t first_face = 0, last; first_face < order.size(); first_face = last) {
+    const int r = group[order[first_face]];
+    for (last = first_face; last < order.size() && group[order[last]] == r; ++last) {}
+    if (last - first_face == 1) {
+      out.push_back(faces[order[first_face]]);
       continue;
     }
     boundary.clear();
-    for (std::size_t k = first; k < last; ++k)
+    for (std::size_t k = first_face; k < last; ++k)
       for (int e = 0; e < 3; ++e) {
         const int a = faces[order[k]][e], b = faces[order[k]][(e + 1) % 3], g = face_across(a, b);
-        if (g < 0 || root(g) != r) boundary.emplace_back(a, b);
+        if (g < 0 || group[g] != r) boundary.emplace_back(a, b);
       }
     std::sort(boundary.begin(), boundary.end());
     auto next = [&](int v) { return std::lower_bound(boundary.begin(), boundary.end(), std::make_pair(v, -1))->second; };
@@ -206,31 +212,24 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   // is added and the hull taken again (Delaunay refinement, at most 3 rounds).
   TriangleMesh m;
   std::vector<Kernel::Point_3> kp;
-  std::vector<int> by_position;  // point indices in lexicographic order of (x, y, z)
-  auto lexicographic_less = [&](int a, const Eigen::Vector3d& q) {
-    const Eigen::Vector3d& p = pts.points[a];
-    return std::tie(p.x(), p.y(), p.z()) < std::tie(q.x(), q.y(), q.z());
-  };
+  std::vector<std::size_t> index;
+  std::vector<std::size_t> hull_vertices;
+  std::vector<std::array<int, 3>> faces;
   for (int round = 0;; ++round) {
     kp.clear();
     for (const auto& p : pts.points) kp.emplace_back(p.x(), p.y(), p.z());
-    Hull hull;
-    CGAL::convex_hull_3(kp.begin(), kp.end(), hull);
-    // The hull's vertices are input points, found again by their exact coordinates.
-    by_position.resize(pts.points.size());
-    std::iota(by_position.begin(), by_position.end(), 0);
-    std::sort(by_position.begin(), by_position.end(), [&](int a, int b) { return lexicographic_less(a, pts.points[b]); });
-    std::vector<std::array<int, 3>> faces;
-    for (auto f : hull.faces()) {
-      std::array<int, 3> t;
-      int k = 0;
-      for (auto v : hull.vertices_around_face(hull.halfedge(f))) {
-        const auto& p = hull.point(v);
-        t[k++] = *std::lower_bound(by_position.begin(), by_position.end(), Eigen::Vector3d(p.x(), p.y(), p.z()),
-                                   lexicographic_less);
-      }
-      faces.push_back(t);
-    }
+    // The hull of the points' indices (CGAL's adapter reads each point through the map), so its
+    // vertices come out as indices into pts.points. CGAL 5.5 declares a template parameter of
+    // this overload that no argument deduces, hence the explicit `void`.
+    index.resize(kp.size());
+    std::iota(index.begin(), index.end(), std::size_t{0});
+    hull_vertices.clear();
+    faces.clear();
+    CGAL::convex_hull_3<std::vector<std::size_t>::const_iterator, void>(
+        index.cbegin(), index.cend(), hull_vertices, faces,
+        CGAL::make_extreme_points_traits_adapter(CGAL::make_property_map(kp)));
+    for (auto& t : faces)
+      for (int& v : t) v = static_cast<int>(hull_vertices[v]);
     canonical_flat_facets(faces, kp);
     m.triangles.clear();
     for (auto t : faces) {

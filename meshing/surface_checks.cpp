@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <execution>
 #include <stdexcept>
 #include <tuple>
 
@@ -175,24 +176,25 @@ nlohmann::json SurfaceCheck::to_json() const {
 
 SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, const std::vector<SurfacePiece>& pieces) {
   SurfaceCheck out;
-  // Step 0: every edge used once in each direction. Directed edges a -> b, sorted (a hash map
-  // of 27 M edges at N = 1e4 took gigabytes and a malloc per edge).
-  std::vector<std::uint64_t> half;
-  half.reserve(3 * m.triangles.size());
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) half.push_back(std::uint64_t(t[k]) << 32 | std::uint32_t(t[(k + 1) % 3]));
-  std::sort(half.begin(), half.end());
-  auto uses = [&](std::uint64_t key) {
-    const auto r = std::equal_range(half.begin(), half.end(), key);
-    return static_cast<int>(r.second - r.first);
-  };
+  // Step 0: every edge used once in each direction. Each directed edge a -> b as one number,
+  // (smaller end, larger end, direction), sorted on every core so that an edge's uses are
+  // adjacent (a hash map of 27 M edges at N = 1e4 took gigabytes and a malloc per edge).
+  if (m.points.size() > std::size_t{1} << 31) throw std::invalid_argument("check_surface: more than 2^31 vertices");
+  std::vector<std::uint64_t> half(3 * m.triangles.size());
+#pragma omp parallel for schedule(static)
+  for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t a = static_cast<std::uint32_t>(m.triangles[t][k]);
+      const std::uint64_t b = static_cast<std::uint32_t>(m.triangles[t][(k + 1) % 3]);
+      half[3 * t + k] = std::min(a, b) << 33 | std::max(a, b) << 1 | (a > b ? 1 : 0);
+    }
+  std::sort(std::execution::par, half.begin(), half.end());
   for (std::size_t i = 0, j = 0; i < half.size(); i = j) {
-    while (j < half.size() && half[j] == half[i]) ++j;
-    const std::uint64_t a = half[i] >> 32, b = half[i] & 0xffffffffULL;
-    const int forward = static_cast<int>(j - i), back = uses(b << 32 | a);
-    // Each undirected edge once: from its smaller end, or from its only direction.
-    if ((forward != 1 || back != 1) && (a < b || back == 0))
-      out.defects.push_back({0.5 * (m.points[a] + m.points[b]), forward + back});
+    int back = 0;
+    for (j = i; j < half.size() && half[j] >> 1 == half[i] >> 1; ++j) back += static_cast<int>(half[j] & 1);
+    const int forward = static_cast<int>(j - i) - back;
+    if (forward != 1 || back != 1)
+      out.defects.push_back({0.5 * (m.points[half[i] >> 33] + m.points[half[i] >> 1 & 0xffffffffULL]), forward + back});
   }
   std::sort(out.defects.begin(), out.defects.end(), [](const auto& a, const auto& b) {
     return std::tie(a.at.x(), a.at.y(), a.at.z()) < std::tie(b.at.x(), b.at.y(), b.at.z());

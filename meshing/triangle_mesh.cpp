@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
-#include <unordered_map>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -38,27 +37,33 @@ void TriangleMesh::reserve(std::size_t more_points, std::size_t more_triangles) 
 }
 
 void TriangleMesh::weld() {
-  // Keyed by the coordinates' bits: only bit-identical points merge.
-  struct Bits {
-    std::array<std::uint64_t, 3> b;
-    bool operator==(const Bits&) const = default;
+  // Keyed by the coordinates' bits: only bit-identical points merge. An open-addressing table of
+  // indices into `kept` (a node-based hash map of 1e7 points cost an allocation per point).
+  using Bits = std::array<std::uint64_t, 3>;
+  auto bits = [](const Eigen::Vector3d& p) {
+    Bits b;
+    for (int k = 0; k < 3; ++k) b[k] = std::bit_cast<std::uint64_t>(p[k] == 0.0 ? 0.0 : p[k]);  // -0 as +0
+    return b;
   };
-  struct Hash {
-    std::size_t operator()(const Bits& k) const {
-      return k.b[0] * 0x9E3779B97F4A7C15ULL ^ (k.b[1] * 0xC2B2AE3D27D4EB4FULL + (k.b[2] << 7 | k.b[2] >> 57));
-    }
+  const std::size_t mask = std::bit_ceil(2 * points.size() + 1) - 1;
+  auto home = [mask](const Bits& b) {
+    std::uint64_t h = b[0] * 0x9E3779B97F4A7C15ULL ^ b[1] * 0xC2B2AE3D27D4EB4FULL ^ b[2] * 0x165667B19E3779F9ULL;
+    h ^= h >> 29;
+    return static_cast<std::size_t>(h * 0xBF58476D1CE4E5B9ULL >> 17) & mask;
   };
-  std::unordered_map<Bits, int, Hash> index;
-  index.reserve(points.size());
+  std::vector<int> slot(mask + 1, -1);
   std::vector<int> to(points.size());
   std::vector<Eigen::Vector3d> kept;
   kept.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    Bits key;
-    for (int k = 0; k < 3; ++k) key.b[k] = std::bit_cast<std::uint64_t>(points[i][k] == 0.0 ? 0.0 : points[i][k]);
-    const auto [it, fresh] = index.emplace(key, static_cast<int>(kept.size()));
-    if (fresh) kept.push_back(points[i]);
-    to[i] = it->second;
+    const Bits key = bits(points[i]);
+    std::size_t h = home(key);
+    while (slot[h] >= 0 && bits(kept[slot[h]]) != key) h = (h + 1) & mask;
+    if (slot[h] < 0) {
+      slot[h] = static_cast<int>(kept.size());
+      kept.push_back(points[i]);
+    }
+    to[i] = slot[h];
   }
   points = std::move(kept);
   for (auto& t : triangles)
