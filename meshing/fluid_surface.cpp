@@ -195,15 +195,16 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   FluidSurface out;
   TriangleMesh& f = out.fluid;
   // The triangles appended since the last piece, as a piece of the self-intersection test.
-  auto piece = [&f, &out](bool on_sphere = false, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
+  using Shape = SurfacePiece::Shape;
+  auto piece = [&f, &out](Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
     const std::size_t first = out.pieces.empty() ? 0 : out.pieces.back().last;
-    if (f.triangles.size() > first) out.pieces.push_back({first, f.triangles.size(), on_sphere, centre, radius});
+    if (f.triangles.size() > first) out.pieces.push_back({first, f.triangles.size(), shape, centre, radius});
   };
-  auto add = [&](const std::string& what, const std::function<WallMesh()>& mesh) {
+  auto add = [&](const std::string& what, Shape shape, double radius, const std::function<WallMesh()>& mesh) {
     try {
       const WallMesh m = mesh();
       f.append(m.outside);
-      piece();
+      piece(shape, Eigen::Vector3d::Zero(), radius);
       out.bed.append(m.inside);
     } catch (const CutConflict& e) {
       throw InputError(fmt::format("the {}: {}", what, e.what()));
@@ -223,12 +224,14 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
       const auto& [normal, a, b] = sides[k];
       const auto loop = box_face_loop({corner(a, z0), corner(b, z0), corner(b, z1), corner(a, z1)}, edge);
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
-      add("wall", [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
+      add("wall", Shape::plane, 0.0,
+          [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
     }
   } else {
-    add("wall", [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
+    add("wall", Shape::cylinder, R,
+        [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
     if (ann)
-      add("inner_wall",
+      add("inner_wall", Shape::cylinder, r_in,
           [&] { return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
   }
   // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
@@ -243,10 +246,10 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
     if (!box && !p.clip) {  // nothing cuts it: the structured ring
       f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
-      piece();
+      piece(Shape::plane);
       continue;
     }
-    add(patch, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
+    add(patch, Shape::plane, 0.0, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
   }
   // The bed solid (normals out of it), and the same pieces turned inside out for the fluid;
   // each piece is released once appended (at N = 1e4 the pieces are gigabytes).
@@ -262,12 +265,19 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     m = TriangleMesh();
   };
   for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t before = out.pieces.size();
     add_solid(spheres[i]);
-    piece(true, bed.centres[i], tb.radius[i]);
+    piece(Shape::sphere, bed.centres[i], tb.radius[i]);
+    if (out.pieces.size() > before)  // not a sphere left out by a clip window
+      for (const SphereCut& cut : tb.cuts[i]) {  // at the loop's farthest point along the axis (a curved wall's loop is not flat)
+        double h = -HUGE_VAL;
+        for (const auto& q : cut.loop) h = std::max(h, cut.axis.dot(q - bed.centres[i]));
+        out.pieces.back().cut_planes.emplace_back(cut.axis, h);
+      }
   }
-  for (auto& m : tb.parts) {
+  for (auto& m : tb.parts) {  // cap disks (ring_mesh) or bridges, which the test finds not flat and takes whole
     add_solid(m);
-    piece();
+    piece(Shape::plane);
   }
   f.weld();
   round_to_ascii_stl(f);

@@ -9,27 +9,42 @@
 
 namespace bedforge::meshing {
 
-// A part of a surface meshed on its own: triangles [first, last) of the mesh. A sphere piece's
-// triangles are facets of the convex hull of points on the sphere (centre, radius in m), as
-// sphere_mesh makes them; such a piece is checked by the argument below, the others pair by pair.
+// A part of a surface meshed on its own: triangles [first, last) of the mesh, and what is known
+// of them by how they were made (lengths in m). The test by pieces checks each shape's premise
+// on the vertices (every vertex on the sphere, the plane or the cylinder, up to 1e-9 of its size
+// and the rounding of fluid.stl) and takes a piece that fails it as Shape::other.
 struct SurfacePiece {
+  enum class Shape {
+    other,     // nothing: tested pair by pair with every face near it, its own included
+    sphere,    // facets of the convex hull of points on the sphere (centre, radius), as sphere_mesh makes them
+    plane,     // a triangulation of a planar region (the plane is fitted to its vertices), as ring_mesh and plane_mesh make
+    cylinder,  // a triangulation of the unrolled wall laid on the cylinder (axis through centre along axis, radius), as wall_mesh makes
+  };
   std::size_t first = 0, last = 0;
-  bool on_sphere = false;
+  Shape shape = Shape::other;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double radius = 0.0;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit
+  // Sphere: the planes that cut it (unit normal n out of the piece, offset h from the centre: the
+  // piece lies where n . (x - centre) <= h).
+  std::vector<std::pair<Eigen::Vector3d, double>> cut_planes;
 };
 
 // How check_surface looks for self-intersections.
 enum class SelfIntersectionTest {
   skip,       // not at all (the volume and the topology alone)
   all_pairs,  // CGAL's test on every pair of triangles whose boxes meet
-  // CGAL's test on the triangles that the argument below leaves: every triangle of a piece not on
-  // a sphere, and those of a sphere piece whose box meets a triangle of another piece that can
-  // reach it. Nothing else can intersect: a convex polytope's facets meet only in shared edges
-  // and vertices, so no two triangles of one sphere piece do; and every triangle of a sphere
-  // piece lies in its ball, so two sphere pieces whose balls are disjoint cannot meet. A sphere
-  // piece with a vertex off its sphere (by more than 1e-9 of the radius and the rounding to 12
-  // digits) is tested like the others.
+  // CGAL's test on the triangles that the argument below leaves: every triangle of a piece of no
+  // known shape, and a triangle of the others whose box meets a triangle of another piece, neither
+  // lying outside the region that holds the other's piece. Nothing else can intersect. No two
+  // triangles of a piece of known shape cross: a convex polytope's facets meet only in shared
+  // edges and vertices, and so do the triangles of a planar triangulation, laid on its plane or
+  // on a cylinder (its edges far shorter than the radius). And a triangle cannot meet a piece when
+  // it lies outside the region that holds the piece: a sphere piece's ball, less what lies
+  // beyond its cut planes; a planar piece's slab,
+  // as thick as its vertices stray from the plane; for a cylinder piece, the solid cylinder inside
+  // its facets (at least sqrt(R^2 - (L/2)^2) from the axis with edges up to L), which a triangle
+  // with its three vertices inside cannot leave, being convex.
   by_pieces,
 };
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "meshing/primitives.hpp"
+#include "meshing/wall_mesh.hpp"
 
 using namespace bedforge::meshing;
 
@@ -85,7 +86,7 @@ Pieces spheres(const std::vector<Eigen::Vector3d>& centres, const TriangleMesh& 
   for (const auto& c : centres) {
     const std::size_t first = out.mesh.triangles.size();
     out.mesh.append(sphere_mesh(c, 0.5, {}, 0.2, 1.5, true, "particles"));
-    out.pieces.push_back({first, out.mesh.triangles.size(), true, c, 0.5});
+    out.pieces.push_back({first, out.mesh.triangles.size(), SurfacePiece::Shape::sphere, c, 0.5});
   }
   if (!extra.triangles.empty()) {
     const std::size_t first = out.mesh.triangles.size();
@@ -137,4 +138,119 @@ TEST(SurfaceCheck, ByPiecesRefusesPiecesThatDoNotCoverTheMeshOnce) {
   Pieces s = spheres({{0, 0, 0}, {2, 0, 0}});
   s.pieces.pop_back();
   EXPECT_THROW(check_surface(s.mesh, SelfIntersectionTest::by_pieces, s.pieces), std::invalid_argument);
+}
+
+namespace {
+
+using Shape = SurfacePiece::Shape;
+
+// Appends `part` to `s` as a piece of the given shape.
+void add_piece(Pieces& s, const TriangleMesh& part, SurfacePiece shape) {
+  shape.first = s.mesh.triangles.size();
+  s.mesh.append(part);
+  shape.last = s.mesh.triangles.size();
+  s.pieces.push_back(shape);
+}
+
+// Sphere (c, 0.5) cut where (x - c) . a > h and closed there by a flat disk, as the cap treatment
+// makes it: the sphere a piece with its cut plane, the disk a planar piece.
+void add_capped_sphere(Pieces& s, const Eigen::Vector3d& c, const Eigen::Vector3d& a, double h) {
+  const double r = 0.5, rho = std::sqrt(r * r - h * h), edge = 0.05;
+  const Frame f = Frame::along(c + h * a, a);
+  SphereCut cut;
+  cut.loop = circle_loop(f, rho, ring_points(rho, edge));
+  cut.spacing = 2.0 * std::numbers::pi * rho / static_cast<double>(cut.loop.size());
+  cut.axis = a;
+  cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
+  SurfacePiece sphere{0, 0, Shape::sphere, c, r};
+  sphere.cut_planes = {{a, h}};
+  add_piece(s, sphere_mesh(c, r, {cut}, 0.1, 1.5, true, "particles"), sphere);
+  add_piece(s, ring_mesh(f, 0.0, rho, edge, 0.0, true, "particles"), {0, 0, Shape::plane});
+}
+
+// Two capped spheres whose disks face each other `gap` apart (negative: crossing).
+Pieces capped_pair(double gap) {
+  Pieces s;
+  add_capped_sphere(s, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.3);
+  add_capped_sphere(s, {0.0, 0.0, 0.6 + gap}, -Eigen::Vector3d::UnitZ(), 0.3);
+  s.mesh.weld();
+  return s;
+}
+
+}  // namespace
+
+// The cap treatment's geometry: the balls overlap, the cut planes part the spheres, each disk
+// lies in its plane. Only faces next to a disk's rim are left; spheres whose disks cross are found.
+TEST(SurfaceCheck, ByPiecesPartsCappedSpheresByTheirCutPlanesAndFindsCrossingCaps) {
+  const Pieces apart = capped_pair(0.02);
+  ASSERT_TRUE(check_surface(apart.mesh, SelfIntersectionTest::all_pairs).closed);
+  const SurfaceCheck a = check_surface(apart.mesh, SelfIntersectionTest::by_pieces, apart.pieces);
+  EXPECT_FALSE(a.self_intersecting);
+  const std::size_t disks = apart.pieces[1].last - apart.pieces[1].first + apart.pieces[3].last - apart.pieces[3].first;
+  EXPECT_LT(a.triangles_tested_pairwise, disks) << "neither sphere reaches past the other's cut plane";
+  const Pieces crossing = capped_pair(-0.05);
+  EXPECT_TRUE(check_surface(crossing.mesh, SelfIntersectionTest::all_pairs).self_intersecting);
+  EXPECT_TRUE(check_surface(crossing.mesh, SelfIntersectionTest::by_pieces, crossing.pieces).self_intersecting);
+}
+
+TEST(SurfaceCheck, ByPiecesTestsWholeAPieceOffItsShape) {
+  // A disk vertex lifted 1e-6 off the disk's plane, and a cut plane that the sphere's vertices
+  // cross: both pieces are then tested with every face near them, their own included.
+  Pieces s = capped_pair(0.02);
+  const std::size_t disk = s.pieces[1].first;
+  s.mesh.points[s.mesh.triangles[disk][0]].z() += 1e-6;
+  s.pieces[2].cut_planes[0].second -= 0.01;
+  const SurfaceCheck k = check_surface(s.mesh, SelfIntersectionTest::by_pieces, s.pieces);
+  EXPECT_FALSE(k.self_intersecting);
+  EXPECT_GE(k.triangles_tested_pairwise, (s.pieces[1].last - s.pieces[1].first) + (s.pieces[2].last - s.pieces[2].first));
+}
+
+namespace {
+
+// The tube R = 1, -1 <= z <= 1 (a cylinder piece, its ends planar pieces) and, with `sphere`,
+// a sphere of radius 0.3 at `c`.
+Pieces sphere_in_tube(const Eigen::Vector3d& c, bool sphere = true) {
+  const double R = 1.0, edge = 0.1;
+  Pieces s;
+  add_piece(s, wall_mesh(R, -1.0, 1.0, edge, {}, 1.5, true, "wall").outside, {0, 0, Shape::cylinder, Eigen::Vector3d::Zero(), R});
+  for (double z : {-1.0, 1.0})
+    add_piece(s, ring_mesh(Frame::along({0, 0, z}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, z > 0.0, "end"),
+              {0, 0, Shape::plane});
+  if (sphere) add_piece(s, sphere_mesh(c, 0.3, {}, 0.1, 1.5, true, "particles"), {0, 0, Shape::sphere, c, 0.3});
+  s.mesh.weld();
+  return s;
+}
+
+}  // namespace
+
+TEST(SurfaceCheck, ByPiecesLeavesASphereInsideTheWallAndFindsOneThroughIt) {
+  const Pieces inside = sphere_in_tube({0.5, 0.0, 0.0});  // 0.2 from the wall
+  const SurfaceCheck k = check_surface(inside.mesh, SelfIntersectionTest::by_pieces, inside.pieces);
+  EXPECT_FALSE(k.self_intersecting);
+  const Pieces empty = sphere_in_tube({}, false);
+  EXPECT_EQ(k.triangles_tested_pairwise, check_surface(empty.mesh, SelfIntersectionTest::by_pieces, empty.pieces).triangles_tested_pairwise)
+      << "the sphere lies inside the wall's facets and between the ends' planes: only the faces where the wall meets its ends";
+  const Pieces through = sphere_in_tube({0.75, 0.0, 0.0});
+  EXPECT_TRUE(check_surface(through.mesh, SelfIntersectionTest::all_pairs).self_intersecting);
+  EXPECT_TRUE(check_surface(through.mesh, SelfIntersectionTest::by_pieces, through.pieces).self_intersecting);
+}
+
+TEST(SurfaceCheck, ByPiecesFindsASphereThroughAnEndPlane) {
+  const Pieces through = sphere_in_tube({0.0, 0.0, 0.85});  // 0.15 past the outlet's plane
+  EXPECT_TRUE(check_surface(through.mesh, SelfIntersectionTest::all_pairs).self_intersecting);
+  EXPECT_TRUE(check_surface(through.mesh, SelfIntersectionTest::by_pieces, through.pieces).self_intersecting);
+}
+
+TEST(SurfaceCheck, ByPiecesFindsAPieceReachingPastACutPlaneIntoTheSphere) {
+  // A tetrahedron with one vertex inside the capped sphere, below its cut plane z = 0.3, and
+  // three beyond it but outside the cap's disk (radius 0.4): every face of it crosses the plane,
+  // and it meets the sphere's faces only.
+  Pieces s;
+  add_capped_sphere(s, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.3);
+  TriangleMesh tip = tetrahedron();
+  tip.points = {{0.45, 0.0, 0.2}, {0.6, -0.1, 0.45}, {0.6, 0.1, 0.45}, {0.7, 0.0, 0.35}};
+  add_piece(s, tip, {});
+  s.mesh.weld();
+  EXPECT_TRUE(check_surface(s.mesh, SelfIntersectionTest::all_pairs).self_intersecting);
+  EXPECT_TRUE(check_surface(s.mesh, SelfIntersectionTest::by_pieces, s.pieces).self_intersecting);
 }
