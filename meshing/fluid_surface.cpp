@@ -198,7 +198,10 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   using Shape = SurfacePiece::Shape;
   auto piece = [&f, &out](Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
     const std::size_t first = out.pieces.empty() ? 0 : out.pieces.back().last;
-    if (f.triangles.size() > first) out.pieces.push_back({first, f.triangles.size(), shape, centre, radius});
+    if (f.triangles.size() <= first) return;
+    SurfacePiece p;
+    p.first = first, p.last = f.triangles.size(), p.shape = shape, p.centre = centre, p.radius = radius;
+    out.pieces.push_back(p);
   };
   auto add = [&](const std::string& what, Shape shape, double radius, const std::function<WallMesh()>& mesh) {
     try {

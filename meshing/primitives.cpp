@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
+#include <unordered_map>
 #include <numbers>
 #include <unordered_set>
 
@@ -108,6 +110,73 @@ void canonical_flat_facets(std::vector<std::array<int, 3>>& faces, const std::ve
     for (int v = next(v0); next(v) != v0; v = next(v)) out.push_back({v0, v, next(v)});
   }
   faces = std::move(out);
+}
+
+// Adds the points p[first..] one by one to `faces`, a consistently oriented triangulation of the
+// convex hull of the points before them: the faces a new point sees are replaced by a fan from it
+// to their horizon. `seeds`: for each new point, a face (in the orientation of `faces`) likely
+// to see it; `inside`: a point inside the hull. False, with `faces` unusable, when a point sees
+// no face (it lies on the hull's boundary), for the caller to take the hull afresh.
+bool insert_into_hull(std::vector<std::array<int, 3>>& faces, const std::vector<Kernel::Point_3>& p, std::size_t first,
+                      const std::vector<std::array<int, 3>>& seeds, const Kernel::Point_3& inside) {
+  auto directed = [](int a, int b) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32 | static_cast<std::uint32_t>(b); };
+  std::unordered_map<std::uint64_t, int> face_of;  // directed edge -> the face holding it
+  face_of.reserve(3 * faces.size() + 6 * (p.size() - first) + 16);
+  std::vector<char> alive(faces.size(), 1);
+  for (int f = 0; f < static_cast<int>(faces.size()); ++f)
+    for (int e = 0; e < 3; ++e) face_of[directed(faces[f][e], faces[f][(e + 1) % 3])] = f;
+  const CGAL::Orientation in = CGAL::orientation(p[faces[0][0]], p[faces[0][1]], p[faces[0][2]], inside);
+  std::vector<int> visible, stack;
+  std::vector<std::pair<int, int>> horizon;
+  std::vector<char> seen;
+  for (std::size_t q = first; q < p.size(); ++q) {
+    auto sees = [&](int f) {
+      return alive[f] && CGAL::orientation(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[q]) == -in;
+    };
+    // A face that sees q: the seed, a face now holding the seed's first edge, or any.
+    const std::array<int, 3>& s = seeds[q - first];
+    int start = -1;
+    if (const auto it = face_of.find(directed(s[0], s[1])); it != face_of.end() && sees(it->second)) start = it->second;
+    for (int f = 0; start < 0 && f < static_cast<int>(faces.size()); ++f)
+      if (sees(f)) start = f;
+    if (start < 0) return false;
+    // The faces that see q (a connected set), and the edges between them and the others.
+    seen.assign(faces.size(), 0);
+    visible.clear();
+    horizon.clear();
+    stack = {start};
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const int f = stack.back();
+      stack.pop_back();
+      visible.push_back(f);
+      for (int e = 0; e < 3; ++e) {
+        const int a = faces[f][e], b = faces[f][(e + 1) % 3], g = face_of.at(directed(b, a));
+        if (seen[g]) continue;
+        if (sees(g)) {
+          seen[g] = 1;
+          stack.push_back(g);
+        } else {
+          horizon.emplace_back(a, b);
+        }
+      }
+    }
+    for (int f : visible) {
+      alive[f] = 0;
+      for (int e = 0; e < 3; ++e) face_of.erase(directed(faces[f][e], faces[f][(e + 1) % 3]));
+    }
+    for (const auto& [a, b] : horizon) {
+      faces.push_back({a, b, static_cast<int>(q)});
+      alive.push_back(1);
+      const int f = static_cast<int>(faces.size()) - 1;
+      for (int e = 0; e < 3; ++e) face_of[directed(faces[f][e], faces[f][(e + 1) % 3])] = f;
+    }
+  }
+  std::size_t kept = 0;
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    if (alive[f]) faces[kept++] = faces[f];
+  faces.resize(kept);
+  return true;
 }
 
 long edge_key(int a, int b) { return static_cast<long>(std::min(a, b)) << 32 | static_cast<long>(std::max(a, b)); }
@@ -215,21 +284,27 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   std::vector<std::size_t> index;
   std::vector<std::size_t> hull_vertices;
   std::vector<std::array<int, 3>> faces;
+  std::vector<std::array<int, 3>> seeds;  // of the points added by the last round: the face whose gap each fills
+  std::size_t added_from = 0;
   for (int round = 0;; ++round) {
     kp.clear();
     for (const auto& p : pts.points) kp.emplace_back(p.x(), p.y(), p.z());
-    // The hull of the points' indices (CGAL's adapter reads each point through the map), so its
-    // vertices come out as indices into pts.points. CGAL 5.5 declares a template parameter of
-    // this overload that no argument deduces, hence the explicit `void`.
-    index.resize(kp.size());
-    std::iota(index.begin(), index.end(), std::size_t{0});
-    hull_vertices.clear();
-    faces.clear();
-    CGAL::convex_hull_3<std::vector<std::size_t>::const_iterator, void>(
-        index.cbegin(), index.cend(), hull_vertices, faces,
-        CGAL::make_extreme_points_traits_adapter(CGAL::make_property_map(kp)));
-    for (auto& t : faces)
-      for (int& v : t) v = static_cast<int>(hull_vertices[v]);
+    // After the first round, the points the refinement added go into the last hull one by one;
+    // the hull is taken afresh when that fails. CGAL's hull is over the points' indices (its
+    // adapter reads each point through the map), so its vertices come out as indices into
+    // pts.points; CGAL 5.5 declares a template parameter of this overload that no argument
+    // deduces, hence the explicit `void`.
+    if (round == 0 || !insert_into_hull(faces, kp, added_from, seeds, Kernel::Point_3(c.x(), c.y(), c.z()))) {
+      index.resize(kp.size());
+      std::iota(index.begin(), index.end(), std::size_t{0});
+      hull_vertices.clear();
+      faces.clear();
+      CGAL::convex_hull_3<std::vector<std::size_t>::const_iterator, void>(
+          index.cbegin(), index.cend(), hull_vertices, faces,
+          CGAL::make_extreme_points_traits_adapter(CGAL::make_property_map(kp)));
+      for (auto& t : faces)
+        for (int& v : t) v = static_cast<int>(hull_vertices[v]);
+    }
     canonical_flat_facets(faces, kp);
     m.triangles.clear();
     for (auto t : faces) {
@@ -242,6 +317,7 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     std::sort(m.triangles.begin(), m.triangles.end());
     if (round == 3) break;
     const std::size_t before = pts.points.size();
+    seeds.clear();
     for (const auto& t : m.triangles) {
       const Eigen::Vector3d &a = pts.points[t[0]], &b = pts.points[t[1]], &q = pts.points[t[2]];
       const Eigen::Vector3d ab = b - a, aq = q - a, n = ab.cross(aq);
@@ -249,9 +325,10 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
       const double local = std::max({pts.spacing(t[0]), pts.spacing(t[1]), pts.spacing(t[2])});
       if ((centre - a).norm() <= 0.7 * local) continue;
       const Eigen::Vector3d p = c + r * (centre - c).normalized();
-      if (!is_removed(p) && pts.fits(p, 0.7 * local)) pts.add(p, local), owner.push_back(-1);
+      if (!is_removed(p) && pts.fits(p, 0.7 * local)) pts.add(p, local), owner.push_back(-1), seeds.push_back(t);
     }
     if (pts.points.size() == before) break;
+    added_from = before;
   }
   m.points = pts.points;
   std::unordered_set<long> edges;

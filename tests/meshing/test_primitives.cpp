@@ -90,6 +90,25 @@ TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {
   EXPECT_GT(mesh_quality(m).min_angle_deg, 15.0);
 }
 
+// The refinement adds points to the hull of the first round one at a time (sphere_mesh): the
+// faces must still be facets of the convex hull of all the vertices, no vertex beyond any face's
+// plane, with cuts and a graded field as in the bed.
+TEST(Primitives, SphereFacesAreFacetsOfTheHullOfItsVertices) {
+  const Eigen::Vector3d c(1.0, 2.0, 3.0);
+  const double r = 0.5;
+  const std::vector<SphereCut> cuts{plane(c, r, Eigen::Vector3d::UnitZ(), 0.2, 0.0125),
+                                    plane(c, r, Eigen::Vector3d(1, 0, 0), 0.49, 0.0125)};
+  const SpacingField field{[&c](const Eigen::Vector3d& q) { return 0.02 + 0.1 * std::abs((q - c).x()); }, 0.02};
+  for (const TriangleMesh& m : {sphere_mesh(c, r, cuts, 0.05, 1.3, true, "p"), sphere_mesh(c, r, {}, 0.08, 1.3, true, "p", field)}) {
+    std::size_t beyond = 0;
+    for (const auto& t : m.triangles) {
+      const Eigen::Vector3d &a = m.points[t[0]], n = (m.points[t[1]] - a).cross(m.points[t[2]] - a).normalized();
+      for (const auto& q : m.points) beyond += n.dot(q - a) > 1e-12;
+    }
+    EXPECT_EQ(beyond, 0u) << m.triangles.size() << " faces";
+  }
+}
+
 TEST(Primitives, CutsThatOverlapOnTheSphereAreRefused) {
   const Eigen::Vector3d c = Eigen::Vector3d::Zero();
   std::vector<SphereCut> cuts{plane(c, 1.0, Eigen::Vector3d::UnitX(), 0.2, 0.05),
