@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <future>
 #include <numbers>
 #include <optional>
 #include <tuple>
@@ -169,26 +170,27 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
                 : SpacingField{};
   };
 
-  // Spheres, each on its own (in parallel), stopping at their cuts.
+  // Spheres, each on its own (in parallel), stopping at their cuts: meshed on other threads
+  // while this one meshes the container, whose wall is one large piece.
   const std::size_t n = bed.size();
   std::vector<TriangleMesh> spheres(n);
   std::vector<double> chordal(n, 0.0);
   std::vector<std::string> failure(n);
+  std::future<void> spheres_meshed = std::async(std::launch::async, [&] {
 #pragma omp parallel for schedule(dynamic, 16)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!tb.kept[i]) continue;
-    try {
-      spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
-                               field(static_cast<int>(i)));
-      chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
-    } catch (const CutConflict& e) {
-      failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
-                               "another treatment",
-                               i, fmt::join(tb.cut_names[i], ", "), e.what());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!tb.kept[i]) continue;
+      try {
+        spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
+                                 field(static_cast<int>(i)));
+        chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
+      } catch (const CutConflict& e) {
+        failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
+                                 "another treatment",
+                                 i, fmt::join(tb.cut_names[i], ", "), e.what());
+      }
     }
-  }
-  for (const auto& f : failure)
-    if (!f.empty()) throw InputError(f);
+  });
 
   // Container: walls with holes where the bed meets them, inlet and outlet sharing their edges
   // (with holes where spheres cross clip planes); what the holes cut out closes the bed solid.
@@ -254,6 +256,9 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     }
     add(patch, Shape::plane, 0.0, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
   }
+  spheres_meshed.get();
+  for (const auto& message : failure)
+    if (!message.empty()) throw InputError(message);
   // The bed solid (normals out of it), and the same pieces turned inside out for the fluid;
   // each piece is released once appended (at N = 1e4 the pieces are gigabytes).
   std::size_t points = 0, triangles = 0;

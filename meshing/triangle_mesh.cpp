@@ -104,15 +104,18 @@ TriangleMesh triangles_below_angle(const TriangleMesh& m, double limit_deg) {
 
 MeshQuality mesh_quality(const TriangleMesh& m) {
   MeshQuality q;
-  q.min_edge = std::numeric_limits<double>::infinity();
+  double min_edge = std::numeric_limits<double>::infinity(), max_edge = 0.0, min_angle = 180.0;
+#pragma omp parallel for schedule(static) reduction(min : min_edge, min_angle) reduction(max : max_edge)
   for (std::size_t t = 0; t < m.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const double l = (m.points[m.triangles[t][(k + 1) % 3]] - m.points[m.triangles[t][k]]).norm();
-      q.min_edge = std::min(q.min_edge, l), q.max_edge = std::max(q.max_edge, l);
+      min_edge = std::min(min_edge, l), max_edge = std::max(max_edge, l);
     }
-    q.min_angle_deg = std::min(q.min_angle_deg, min_angle_deg(m, t));
+    min_angle = std::min(min_angle, min_angle_deg(m, t));
   }
-  if (m.triangles.empty()) q.min_edge = 0.0;
+  q.min_edge = m.triangles.empty() ? 0.0 : min_edge;
+  q.max_edge = max_edge;
+  q.min_angle_deg = min_angle;
   return q;
 }
 
