@@ -218,8 +218,12 @@ std::vector<std::size_t> faces_left_by_pieces(const TriangleMesh& m, const std::
     if (units[a->info()].piece == units[b->info()].piece) return;  // a piece's own pairs: its shape, or tested whole
     if (ru.shape == Shape::other && rw.shape == Shape::other) return;  // both tested whole
     if (ru.shape == Shape::sphere && rw.shape == Shape::sphere && (ru.centre - rw.centre).norm() > ru.radius + rw.radius) return;
-    near.emplace_back(a->info(), b->info());
+    const bool larger = units[a->info()].last - units[a->info()].first >= units[b->info()].last - units[b->info()].first;
+    near.emplace_back(larger ? a->info() : b->info(), larger ? b->info() : a->info());
   });
+  // Grouped by their larger unit (a sphere's faces, with their boxes, are then gathered once for
+  // all the units near it).
+  std::sort(near.begin(), near.end());
   // Step 3: every face of a piece of no known shape, and the faces of the others that may meet a
   // face of another piece.
   std::vector<char> left(n, 0);
@@ -229,25 +233,31 @@ std::vector<std::size_t> faces_left_by_pieces(const TriangleMesh& m, const std::
   auto leave = [&left](std::size_t t) { std::atomic_ref<char>(left[t]).store(1, std::memory_order_relaxed); };
 #pragma omp parallel
   {
-    std::vector<Box> a_faces, b_faces;
-    // The faces of unit u that meet w's box and are not outside w's region.
-    auto may_meet = [&](const Unit& u, const Unit& w, std::vector<Box>& out) {
+    std::vector<Box> a_faces, b_faces, faces_of_u, faces_of_w;
+    std::size_t u_gathered = units.size();
+    // The faces of a unit with their boxes.
+    auto gather = [&](const Unit& u, std::vector<Box>& out) {
+      out.clear();
+      for (std::size_t i = u.first; i < u.last; ++i) out.emplace_back(box_of(members[i]), members[i]);
+    };
+    // Of `faces`, those that meet w's box and are not outside w's region.
+    auto may_meet = [&](const std::vector<Box>& faces, const Unit& w, std::vector<Box>& out) {
       out.clear();
       const Region& r = region[w.piece];
-      for (std::size_t i = u.first; i < u.last; ++i) {
-        const std::uint32_t t = members[i];
-        const CGAL::Bbox_3 b = box_of(t);
-        const auto& tri = m.triangles[t];
-        if (!CGAL::do_overlap(b, w.box) || outside(r, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]])) continue;
-        out.emplace_back(b, t);
+      for (const Box& b : faces) {
+        const auto& tri = m.triangles[b.info()];
+        if (CGAL::do_overlap(b.bbox(), w.box) && !outside(r, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]))
+          out.push_back(b);
       }
     };
 #pragma omp for schedule(dynamic, 16)
     for (std::size_t k = 0; k < near.size(); ++k) {
       const Unit &u = units[near[k].first], &w = units[near[k].second];
-      may_meet(u, w, a_faces);
+      if (u_gathered != near[k].first) gather(u, faces_of_u), u_gathered = near[k].first;
+      may_meet(faces_of_u, w, a_faces);
       if (a_faces.empty()) continue;
-      may_meet(w, u, b_faces);
+      gather(w, faces_of_w);
+      may_meet(faces_of_w, u, b_faces);
       if (b_faces.empty()) continue;
       CGAL::box_intersection_d(a_faces.begin(), a_faces.end(), b_faces.begin(), b_faces.end(),
                                [&](const Box& x, const Box& y) { leave(x.info()), leave(y.info()); });
