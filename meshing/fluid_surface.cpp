@@ -198,12 +198,14 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   TriangleMesh& f = out.fluid;
   // The triangles appended since the last piece, as a piece of the self-intersection test.
   using Shape = SurfacePiece::Shape;
-  auto piece = [&f, &out](Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
+  auto piece = [&f, &out](Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0,
+                          std::vector<std::pair<Eigen::Vector3d, double>> cut_planes = {}) {
     const std::size_t first = out.pieces.empty() ? 0 : out.pieces.back().last;
     if (f.triangles.size() <= first) return;
     SurfacePiece p;
     p.first = first, p.last = f.triangles.size(), p.shape = shape, p.centre = centre, p.radius = radius;
-    out.pieces.push_back(p);
+    p.cut_planes = std::move(cut_planes);
+    out.pieces.push_back(std::move(p));
   };
   auto add = [&](const std::string& what, Shape shape, double radius, const std::function<WallMesh()>& mesh) {
     try {
@@ -273,15 +275,14 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     m = TriangleMesh();
   };
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t before = out.pieces.size();
+    std::vector<std::pair<Eigen::Vector3d, double>> cut_planes;
+    for (const SphereCut& cut : tb.cuts[i]) {  // at the loop's farthest point along the axis (a curved wall's loop is not flat)
+      double h = -HUGE_VAL;
+      for (const auto& q : cut.loop) h = std::max(h, cut.axis.dot(q - bed.centres[i]));
+      cut_planes.emplace_back(cut.axis, h);
+    }
     add_solid(spheres[i]);
-    piece(Shape::sphere, bed.centres[i], tb.radius[i]);
-    if (out.pieces.size() > before)  // not a sphere left out by a clip window
-      for (const SphereCut& cut : tb.cuts[i]) {  // at the loop's farthest point along the axis (a curved wall's loop is not flat)
-        double h = -HUGE_VAL;
-        for (const auto& q : cut.loop) h = std::max(h, cut.axis.dot(q - bed.centres[i]));
-        out.pieces.back().cut_planes.emplace_back(cut.axis, h);
-      }
+    piece(Shape::sphere, bed.centres[i], tb.radius[i], std::move(cut_planes));
   }
   for (auto& m : tb.parts) {  // cap disks (ring_mesh) or bridges, which the test finds not flat and takes whole
     add_solid(m);

@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <numeric>
 #include <unordered_map>
-#include <numbers>
 #include <unordered_set>
 
 #include "core/random.hpp"

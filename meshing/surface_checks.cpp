@@ -47,6 +47,18 @@ bool to_cgal(const TriangleMesh& m, const std::vector<std::size_t>& faces, Mesh&
   return true;
 }
 
+// Distance from v to the line through `centre` along the unit `axis`.
+double from_axis(const Eigen::Vector3d& v, const Eigen::Vector3d& centre, const Eigen::Vector3d& axis) {
+  return (v - centre - (v - centre).dot(axis) * axis).norm();
+}
+
+// The indices 0 .. n-1 of n triangles.
+std::vector<std::size_t> all_of(std::size_t n) {
+  std::vector<std::size_t> all(n);
+  std::iota(all.begin(), all.end(), std::size_t{0});
+  return all;
+}
+
 // Where a piece's triangles lie, as far as the argument uses it (lengths in m). A piece whose
 // vertices stray from its shape by more than rounding is taken as Shape::other.
 struct Region {
@@ -67,7 +79,7 @@ Region region_of(const TriangleMesh& m, const SurfacePiece& p) {
     for (std::size_t t = p.first; t < p.last; ++t)
       for (int v : m.triangles[t]) f(m.points[v]);
   };
-  double far = 0.0, longest = 0.0;  // from the centre; the longest edge
+  double far = 0.0;  // from the centre
   each_vertex([&](const Eigen::Vector3d& v) { far = std::max(far, (v - p.centre).norm()); });
   const double rounding = 2e-11 * (p.centre.norm() + far);
   bool kept = true;
@@ -82,8 +94,8 @@ Region region_of(const TriangleMesh& m, const SurfacePiece& p) {
     // A triangle with its vertices within `slack` of the cylinder and edges up to L lies at least
     // sqrt((R - slack)^2 - (L / 2)^2) from the axis (the nearest point of a chord).
     const double slack = 1e-9 * p.radius + rounding;
-    auto from_axis = [&](const Eigen::Vector3d& v) { return (v - p.centre - (v - p.centre).dot(p.axis) * p.axis).norm(); };
-    each_vertex([&](const Eigen::Vector3d& v) { kept = kept && std::abs(from_axis(v) - p.radius) <= slack; });
+    each_vertex([&](const Eigen::Vector3d& v) { kept = kept && std::abs(from_axis(v, p.centre, p.axis) - p.radius) <= slack; });
+    double longest = 0.0;
     for (std::size_t t = p.first; t < p.last; ++t)
       for (int k = 0; k < 3; ++k) longest = std::max(longest, (m.points[m.triangles[t][(k + 1) % 3]] - m.points[m.triangles[t][k]]).norm());
     const double inner = p.radius - slack;
@@ -131,8 +143,7 @@ bool outside(const Region& r, const Eigen::Vector3d& a, const Eigen::Vector3d& b
     return std::min({sa, sb, sc}) > r.half_width || std::max({sa, sb, sc}) < -r.half_width;
   }
   if (r.shape == Shape::cylinder) {  // inside the solid cylinder within the wall's facets (convex)
-    auto from_axis = [&](const Eigen::Vector3d& v) { return (v - r.centre - (v - r.centre).dot(r.axis) * r.axis).norm(); };
-    return std::max({from_axis(a), from_axis(b), from_axis(c)}) < r.radius;
+    return std::max({from_axis(a, r.centre, r.axis), from_axis(b, r.centre, r.axis), from_axis(c, r.centre, r.axis)}) < r.radius;
   }
   return false;
 }
@@ -291,7 +302,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
   // Step 0: the directed edges a -> b leaving each vertex a, with their triangles (about six a
   // vertex), so that every check below is a look-up in a short list.
   const std::size_t nv = m.points.size(), nt = m.triangles.size();
-  if (nv > std::size_t{1} << 31 || nt > std::size_t{1} << 32) throw std::invalid_argument("check_surface: more than 2^31 vertices");
+  if (nv > std::size_t{1} << 31 || nt > std::size_t{1} << 32) throw std::invalid_argument("check_surface: more than 2^31 vertices or 2^32 triangles");
   std::vector<std::size_t> first(nv + 1, 0);
   for (const auto& t : m.triangles)
     for (int v : t) ++first[v + 1];
@@ -314,9 +325,10 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
   for (std::size_t a = 0; a < nv; ++a)
     for (std::size_t k = first[a]; k < first[a + 1]; ++k) {
       const int b = leaving[k].first;
-      bool repeated = b == static_cast<int>(a);
+      const bool loop = b == static_cast<int>(a);
+      degenerate = degenerate || loop;
+      bool repeated = loop;  // or reported from its first use
       for (std::size_t j = first[a]; j < k; ++j) repeated = repeated || leaving[j].first == b;
-      degenerate = degenerate || b == static_cast<int>(a);
       if (repeated) continue;
       const int forward = uses(static_cast<int>(a), b), back = uses(b, static_cast<int>(a));
       if ((forward != 1 || back != 1) && (static_cast<int>(a) < b || back == 0)) {
@@ -336,6 +348,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
 #pragma omp parallel for schedule(dynamic, 4096) reduction(|| : pinched)
     for (std::size_t a = 0; a < nv; ++a) {
       const std::size_t degree = first[a + 1] - first[a];
+      if (degree == 0) continue;  // a vertex no triangle uses
       std::size_t k = first[a], steps = 0;
       do {
         const auto& t = m.triangles[leaving[k].second];
@@ -343,7 +356,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
         for (k = first[a]; leaving[k].first != c; ++k) {}
         ++steps;
       } while (k != first[a] && steps <= degree);
-      pinched = pinched || (degree > 0 && steps != degree);
+      pinched = pinched || steps != degree;
     }
   }
   out.manifold = out.closed && !degenerate && !pinched;
@@ -355,13 +368,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
   // surface share it there too.
   out.self_intersection_test = test;
   if (test == SelfIntersectionTest::skip) return out;
-  std::vector<std::size_t> tested;
-  if (test == SelfIntersectionTest::all_pairs) {
-    tested.resize(nt);
-    std::iota(tested.begin(), tested.end(), std::size_t{0});
-  } else {
-    tested = faces_left_by_pieces(m, pieces);
-  }
+  const std::vector<std::size_t> tested = test == SelfIntersectionTest::all_pairs ? all_of(nt) : faces_left_by_pieces(m, pieces);
   out.triangles_tested_pairwise = tested.size();
   Mesh mesh;
   if (to_cgal(m, tested, mesh)) {
@@ -373,18 +380,14 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
   std::vector<Mesh::Face_index> faces;
   for (std::size_t t : tested) faces.emplace_back(static_cast<Mesh::size_type>(t));
   mesh.clear();
-  tested.resize(nt);
-  std::iota(tested.begin(), tested.end(), std::size_t{0});
-  if (!to_cgal(m, tested, mesh)) throw std::logic_error("check_surface: CGAL refused a closed manifold surface");
+  if (!to_cgal(m, all_of(nt), mesh)) throw std::logic_error("check_surface: CGAL refused a closed manifold surface");
   out.self_intersecting = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(faces, mesh);
   return out;
 }
 
 std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_triangles(const TriangleMesh& m) {
-  std::vector<std::size_t> all(m.triangles.size());
-  std::iota(all.begin(), all.end(), std::size_t{0});
   Mesh mesh;
-  if (!to_cgal(m, all, mesh)) throw std::invalid_argument("self_intersecting_triangles: the surface is not manifold");
+  if (!to_cgal(m, all_of(m.triangles.size()), mesh)) throw std::invalid_argument("self_intersecting_triangles: the surface is not manifold");
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
   PMP::self_intersections<CGAL::Parallel_if_available_tag>(mesh, std::back_inserter(pairs));
   std::vector<std::pair<std::size_t, std::size_t>> out;

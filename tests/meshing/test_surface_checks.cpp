@@ -31,6 +31,14 @@ TEST(SurfaceCheck, AClosedTetrahedronEnclosesItsVolume) {
   EXPECT_NEAR(k.volume, 1.0 / 6.0, 1e-15);
 }
 
+TEST(SurfaceCheck, AVertexNoTriangleUsesIsNoDefect) {
+  TriangleMesh m = tetrahedron();
+  m.points.push_back({5.0, 5.0, 5.0});  // last, so that its edge list is empty at the end of the lists
+  const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
+  EXPECT_TRUE(k.closed && k.manifold && !k.self_intersecting);
+  EXPECT_NEAR(k.volume, 1.0 / 6.0, 1e-15);
+}
+
 TEST(SurfaceCheck, AMissingFaceLeavesItsThreeEdgesUsedOnce) {
   TriangleMesh m = tetrahedron();
   m.triangles.pop_back();  // face (1, 2, 3)
@@ -76,23 +84,32 @@ TEST(SurfaceCheck, TwoSolidsSharingOneVertexAreClosedButNotManifold) {
 
 namespace {
 
-// Unit spheres (edge 0.2) at `centres`, each a sphere piece, and then `extra` as a piece of its own.
 struct Pieces {
   TriangleMesh mesh;
   std::vector<SurfacePiece> pieces;
 };
+using Shape = SurfacePiece::Shape;
+
+// A piece of that shape (its triangles set by add_piece).
+SurfacePiece shaped(Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0) {
+  SurfacePiece p;
+  p.shape = shape, p.centre = centre, p.radius = radius;
+  return p;
+}
+
+// Appends `part` to `s` as a piece of the given shape.
+void add_piece(Pieces& s, const TriangleMesh& part, SurfacePiece shape) {
+  shape.first = s.mesh.triangles.size();
+  s.mesh.append(part);
+  shape.last = s.mesh.triangles.size();
+  s.pieces.push_back(shape);
+}
+
+// Unit spheres (edge 0.2) at `centres`, each a sphere piece, and then `extra` as a piece of its own.
 Pieces spheres(const std::vector<Eigen::Vector3d>& centres, const TriangleMesh& extra = {}) {
   Pieces out;
-  for (const auto& c : centres) {
-    const std::size_t first = out.mesh.triangles.size();
-    out.mesh.append(sphere_mesh(c, 0.5, {}, 0.2, 1.5, true, "particles"));
-    out.pieces.push_back({first, out.mesh.triangles.size(), SurfacePiece::Shape::sphere, c, 0.5});
-  }
-  if (!extra.triangles.empty()) {
-    const std::size_t first = out.mesh.triangles.size();
-    out.mesh.append(extra);
-    out.pieces.push_back({first, out.mesh.triangles.size()});
-  }
+  for (const auto& c : centres) add_piece(out, sphere_mesh(c, 0.5, {}, 0.2, 1.5, true, "particles"), shaped(Shape::sphere, c, 0.5));
+  if (!extra.triangles.empty()) add_piece(out, extra, shaped(Shape::other));
   return out;
 }
 
@@ -142,16 +159,6 @@ TEST(SurfaceCheck, ByPiecesRefusesPiecesThatDoNotCoverTheMeshOnce) {
 
 namespace {
 
-using Shape = SurfacePiece::Shape;
-
-// Appends `part` to `s` as a piece of the given shape.
-void add_piece(Pieces& s, const TriangleMesh& part, SurfacePiece shape) {
-  shape.first = s.mesh.triangles.size();
-  s.mesh.append(part);
-  shape.last = s.mesh.triangles.size();
-  s.pieces.push_back(shape);
-}
-
 // Sphere (c, 0.5) cut where (x - c) . a > h and closed there by a flat disk, as the cap treatment
 // makes it: the sphere a piece with its cut plane, the disk a planar piece.
 void add_capped_sphere(Pieces& s, const Eigen::Vector3d& c, const Eigen::Vector3d& a, double h) {
@@ -162,10 +169,10 @@ void add_capped_sphere(Pieces& s, const Eigen::Vector3d& c, const Eigen::Vector3
   cut.spacing = 2.0 * std::numbers::pi * rho / static_cast<double>(cut.loop.size());
   cut.axis = a;
   cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
-  SurfacePiece sphere{0, 0, Shape::sphere, c, r};
+  SurfacePiece sphere = shaped(Shape::sphere, c, r);
   sphere.cut_planes = {{a, h}};
   add_piece(s, sphere_mesh(c, r, {cut}, 0.1, 1.5, true, "particles"), sphere);
-  add_piece(s, ring_mesh(f, 0.0, rho, edge, 0.0, true, "particles"), {0, 0, Shape::plane});
+  add_piece(s, ring_mesh(f, 0.0, rho, edge, 0.0, true, "particles"), shaped(Shape::plane));
 }
 
 // Two capped spheres whose disks face each other `gap` apart (negative: crossing).
@@ -212,11 +219,11 @@ namespace {
 Pieces sphere_in_tube(const Eigen::Vector3d& c, bool sphere = true) {
   const double R = 1.0, edge = 0.1;
   Pieces s;
-  add_piece(s, wall_mesh(R, -1.0, 1.0, edge, {}, 1.5, true, "wall").outside, {0, 0, Shape::cylinder, Eigen::Vector3d::Zero(), R});
+  add_piece(s, wall_mesh(R, -1.0, 1.0, edge, {}, 1.5, true, "wall").outside, shaped(Shape::cylinder, Eigen::Vector3d::Zero(), R));
   for (double z : {-1.0, 1.0})
     add_piece(s, ring_mesh(Frame::along({0, 0, z}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, z > 0.0, "end"),
-              {0, 0, Shape::plane});
-  if (sphere) add_piece(s, sphere_mesh(c, 0.3, {}, 0.1, 1.5, true, "particles"), {0, 0, Shape::sphere, c, 0.3});
+              shaped(Shape::plane));
+  if (sphere) add_piece(s, sphere_mesh(c, 0.3, {}, 0.1, 1.5, true, "particles"), shaped(Shape::sphere, c, 0.3));
   s.mesh.weld();
   return s;
 }
@@ -249,7 +256,7 @@ TEST(SurfaceCheck, ByPiecesFindsAPieceReachingPastACutPlaneIntoTheSphere) {
   add_capped_sphere(s, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.3);
   TriangleMesh tip = tetrahedron();
   tip.points = {{0.45, 0.0, 0.2}, {0.6, -0.1, 0.45}, {0.6, 0.1, 0.45}, {0.7, 0.0, 0.35}};
-  add_piece(s, tip, {});
+  add_piece(s, tip, shaped(Shape::other));
   s.mesh.weld();
   EXPECT_TRUE(check_surface(s.mesh, SelfIntersectionTest::all_pairs).self_intersecting);
   EXPECT_TRUE(check_surface(s.mesh, SelfIntersectionTest::by_pieces, s.pieces).self_intersecting);
