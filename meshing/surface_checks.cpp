@@ -47,6 +47,16 @@ bool to_cgal(const TriangleMesh& m, const std::vector<std::size_t>& faces, Mesh&
   return true;
 }
 
+// A box with the index of what it bounds (a face, or a unit of faces) as its id. CGAL sorts
+// boxes in place and breaks ties of their lower corners by id: an id taken from the box's address
+// (ID_FROM_BOX_ADDRESS) changes as the sort moves the box, which leaves the order inconsistent
+// and let std::sort write out of bounds (the flat inlet's faces share their lower z).
+struct IndexedBox : CGAL::Box_intersection_d::Box_d<double, 3, CGAL::Box_intersection_d::ID_NONE> {
+  IndexedBox(const CGAL::Bbox_3& b, std::size_t index) : Box_d(b), index(index) {}
+  std::size_t id() const { return index; }
+  std::size_t index;
+};
+
 // Distance from v to the line through `centre` along the unit `axis`.
 double from_axis(const Eigen::Vector3d& v, const Eigen::Vector3d& centre, const Eigen::Vector3d& axis) {
   return (v - centre - (v - centre).dot(axis) * axis).norm();
@@ -217,20 +227,17 @@ std::vector<std::size_t> faces_left_by_pieces(const TriangleMesh& m, const std::
   if (covered != n) throw std::invalid_argument("check_surface: the pieces do not cover the triangles once, in order");
   // Step 2: the pairs of units of two pieces, one at least of known shape, whose boxes meet (and
   // spheres whose balls meet), by a sweep of the units' boxes.
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::size_t, CGAL::Box_intersection_d::ID_FROM_BOX_ADDRESS>;
-  std::vector<Box> boxes;
+  std::vector<IndexedBox> boxes;
   boxes.reserve(units.size());
   for (std::size_t u = 0; u < units.size(); ++u) boxes.emplace_back(units[u].box, u);
-  std::vector<const Box*> ptr;
-  for (const Box& b : boxes) ptr.push_back(&b);
   std::vector<std::pair<std::size_t, std::size_t>> near;
-  CGAL::box_self_intersection_d(ptr.begin(), ptr.end(), [&](const Box* a, const Box* b) {
-    const Region &ru = region[units[a->info()].piece], &rw = region[units[b->info()].piece];
-    if (units[a->info()].piece == units[b->info()].piece) return;  // a piece's own pairs: its shape, or tested whole
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const IndexedBox& a, const IndexedBox& b) {
+    const Region &ru = region[units[a.index].piece], &rw = region[units[b.index].piece];
+    if (units[a.index].piece == units[b.index].piece) return;  // a piece's own pairs: its shape, or tested whole
     if (ru.shape == Shape::other && rw.shape == Shape::other) return;  // both tested whole
     if (ru.shape == Shape::sphere && rw.shape == Shape::sphere && (ru.centre - rw.centre).norm() > ru.radius + rw.radius) return;
-    const bool larger = units[a->info()].last - units[a->info()].first >= units[b->info()].last - units[b->info()].first;
-    near.emplace_back(larger ? a->info() : b->info(), larger ? b->info() : a->info());
+    const bool larger = units[a.index].last - units[a.index].first >= units[b.index].last - units[b.index].first;
+    near.emplace_back(larger ? a.index : b.index, larger ? b.index : a.index);
   });
   // Grouped by their larger unit (a sphere's faces, with their boxes, are then gathered once for
   // all the units near it).
@@ -244,19 +251,19 @@ std::vector<std::size_t> faces_left_by_pieces(const TriangleMesh& m, const std::
   auto leave = [&left](std::size_t t) { std::atomic_ref<char>(left[t]).store(1, std::memory_order_relaxed); };
 #pragma omp parallel
   {
-    std::vector<Box> a_faces, b_faces, faces_of_u, faces_of_w;
+    std::vector<IndexedBox> a_faces, b_faces, faces_of_u, faces_of_w;
     std::size_t u_gathered = units.size();
     // The faces of a unit with their boxes.
-    auto gather = [&](const Unit& u, std::vector<Box>& out) {
+    auto gather = [&](const Unit& u, std::vector<IndexedBox>& out) {
       out.clear();
       for (std::size_t i = u.first; i < u.last; ++i) out.emplace_back(box_of(members[i]), members[i]);
     };
     // Of `faces`, those that meet w's box and are not outside w's region.
-    auto may_meet = [&](const std::vector<Box>& faces, const Unit& w, std::vector<Box>& out) {
+    auto may_meet = [&](const std::vector<IndexedBox>& faces, const Unit& w, std::vector<IndexedBox>& out) {
       out.clear();
       const Region& r = region[w.piece];
-      for (const Box& b : faces) {
-        const auto& tri = m.triangles[b.info()];
+      for (const IndexedBox& b : faces) {
+        const auto& tri = m.triangles[b.index];
         if (CGAL::do_overlap(b.bbox(), w.box) && !outside(r, m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]))
           out.push_back(b);
       }
@@ -271,7 +278,7 @@ std::vector<std::size_t> faces_left_by_pieces(const TriangleMesh& m, const std::
       may_meet(faces_of_w, u, b_faces);
       if (b_faces.empty()) continue;
       CGAL::box_intersection_d(a_faces.begin(), a_faces.end(), b_faces.begin(), b_faces.end(),
-                               [&](const Box& x, const Box& y) { leave(x.info()), leave(y.info()); });
+                               [&](const IndexedBox& x, const IndexedBox& y) { leave(x.index), leave(y.index); });
     }
   }
   std::vector<std::size_t> out;
