@@ -8,11 +8,13 @@
 #include "core/error.hpp"
 #include "core/progress.hpp"
 #include "core/report.hpp"
+#include "core/thread_governor.hpp"
 
 namespace bedforge::packer {
 
 // Book-keeping shared by the packing modes: the iteration budget, per-stage iterations and
-// time, the convergence history (error measure against elapsed time) and recovery events.
+// time, the convergence history (error measure against elapsed time) and recovery events; and
+// the thread count, which it lowers to one while other processes make that faster.
 class RunLog {
  public:
   RunLog(long max_iterations, Progress& progress)
@@ -26,6 +28,7 @@ class RunLog {
   // where the run was; it is called only then, so the hot loop formats nothing.
   template <class Describe>
   void tick(Describe where_and_state) {
+    governor_.tick();
     if (++iterations_ > max_iterations_)
       throw ConvergenceError(fmt::format("the packer reached packing.soft_sphere.max_iterations = {} in {}; raise "
                                          "it if the bed was still progressing (see the history in the report)",
@@ -69,6 +72,10 @@ class RunLog {
     return {{"iterations", iterations_},
             {"stages", stages_},
             {"recoveries", recoveries_},
+            {"threads",
+             {{"most", governor_.most()},
+              {"load_probes", governor_.probes()},
+              {"iterations_on_one_thread", governor_.iterations_on_one_thread()}}},
             {"history", thin_history(history_, max_points)}};
   }
 
@@ -81,6 +88,7 @@ class RunLog {
   nlohmann::json stages_ = nlohmann::json::object();
   nlohmann::json history_ = nlohmann::json::array();
   nlohmann::json recoveries_ = nlohmann::json::array();
+  ThreadGovernor governor_;
 };
 
 }  // namespace bedforge::packer

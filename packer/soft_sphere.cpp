@@ -127,6 +127,7 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
               {"iterations", run["iterations"]},
               {"stages", run["stages"]},
               {"recoveries", run["recoveries"]},
+              {"threads", run["threads"]},
               {"history", run["history"]},
               {"end_state", end},
               {"max_pair_overlap_d", con.max_pair_overlap / p.d_min},

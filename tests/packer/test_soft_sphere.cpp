@@ -11,6 +11,7 @@
 #include "analysis/bed_analysis.hpp"
 #include "analysis/contact_statistics.hpp"
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 
 using namespace bedforge;
 using packer::SoftSphereParams;
@@ -191,16 +192,20 @@ TEST(SoftSphere, IterationCapStopsWithAMessage) {
   }
 }
 
+// Above bedforge::kParallelMinItems, so that the particle loops do run on two threads (the
+// packer may also change its thread count mid-run, core/thread_governor.hpp).
 TEST(SoftSphere, SameSeedSameBedWhateverTheThreadCount) {
+  constexpr long kSpheres = 600;
+  static_assert(kSpheres >= static_cast<long>(bedforge::kParallelMinItems));
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
-  const auto one = pack(4.0, 150, 9, SoftSphereParams{});
+  const auto one = pack(5.0, kSpheres, 9, SoftSphereParams{});
   omp_set_num_threads(std::max(2, threads));
-  const auto two = pack(4.0, 150, 9, SoftSphereParams{});
+  const auto two = pack(5.0, kSpheres, 9, SoftSphereParams{});
   omp_set_num_threads(threads);
   ASSERT_EQ(one.bed.size(), two.bed.size());
   for (size_t i = 0; i < one.bed.size(); ++i) ASSERT_EQ(one.bed.centres[i], two.bed.centres[i]) << "sphere " << i;
-  const auto other = pack(4.0, 150, 10, SoftSphereParams{});
+  const auto other = pack(5.0, kSpheres, 10, SoftSphereParams{});
   EXPECT_NE(other.bed.centres[0], one.bed.centres[0]);
 }
 
