@@ -57,12 +57,9 @@ void ThreadGovernor::tick() {
     case Phase::steady:
       if (window < kRecheck) return;
       since_ = t, ticks_ = 0;
-      if (probe_.runnable() <= cores_) {  // every runnable task has a core: all threads
-        use(max_);
-        return;
-      }
-      ++probes_;
       use(max_);
+      if (probe_.runnable() <= cores_) return;  // every runnable task has a core: all threads stay
+      ++probes_;
       phase_ = Phase::all;
       return;
     case Phase::all:
