@@ -19,6 +19,14 @@ inline double eisfeld_schnitzlein_f(double reynolds_p, double eps, double aspect
   return 154.0 * a_w * a_w / re_m + a_w / b_w;
 }
 
+// The wall's share of a bed's wetted area, (A_w - 1) / A_w = (4 / D) / (4 / D + 6 (1 - eps) / d):
+// the share of the friction that Eisfeld & Schnitzlein's A_w (Mehta & Hawley's hydraulic radius)
+// gives the wall, which takes the shear as uniform over walls and particles alike.
+inline double wall_wetted_area_share(double eps, double aspect_ratio) {
+  const double a_w = 1.0 + 2.0 / (3.0 * aspect_ratio * (1.0 - eps));
+  return (a_w - 1.0) / a_w;
+}
+
 // Ergun (1952): F = 150 / Re_m + 1.75, for a > 10 and 1 < Re_m < ~700.
 inline double ergun_f(double reynolds_p, double eps) { return 150.0 * (1.0 - eps) / reynolds_p + 1.75; }
 

@@ -138,7 +138,13 @@ nlohmann::json FlowResult::to_json() const {
           {"pressure_gradient_change_last_tenth", pressure_gradient_change_last_tenth},
           {"pressure_drop_inlet_outlet_pa", pressure_drop_inlet_outlet_pa},
           {"flow_rate_m3_s", flow_rate_m3_s},
-          {"flow_rate_relative_error", flow_rate_relative_error}};
+          {"flow_rate_relative_error", flow_rate_relative_error},
+          {"drag",
+           {{"walls_n", drag_walls_n},
+            {"particles_n", drag_particles_n},
+            {"push_inlet_outlet_n", push_inlet_outlet_n},
+            {"wall_share", wall_share_of_drag},
+            {"force_balance_relative_error", force_balance_relative_error}}}};
   if (exact_pa_m) {
     j["exact_pa_m"] = *exact_pa_m;
     j["relative_error_to_exact"] = relative_error_to_exact;
@@ -149,6 +155,7 @@ nlohmann::json FlowResult::to_json() const {
     j["eisfeld_schnitzlein_bed_pa_m"] = eisfeld_schnitzlein_bed_pa_m;
     j["ratio_to_eisfeld_schnitzlein_bed"] = ratio_to_eisfeld_schnitzlein_bed;
     j["void_fraction_section_bed"] = void_fraction_section_bed;
+    j["drag"]["wall_share_eisfeld_schnitzlein"] = wall_share_of_drag_eisfeld_schnitzlein;
   }
   return j;
 }
@@ -181,6 +188,16 @@ std::string surface_value(const std::string& name, const std::string& region, co
                      "        writeInterval   1;\n        log             false;\n        writeFields     false;\n"
                      "{}        operation       {};\n        fields          ({});\n    }}\n",
                      name, region, operation, field);
+}
+
+// OpenFOAM's forces on the patches `patches` matches (a list of names or quoted regular
+// expressions), with the density that turns the kinematic pressure into Pa.
+std::string forces(const std::string& name, const std::string& patches, double density) {
+  return fmt::format("    {}\n    {{\n        type            forces;\n        libs            (\"libforces.so\");\n"
+                     "        writeControl    timeStep;\n        writeInterval   1;\n        log             false;\n"
+                     "        patches         ({});\n        rho             rhoInf;\n        rhoInf          {:.12g};\n"
+                     "        CofR            (0 0 0);\n    }}\n",
+                     name, patches, density);
 }
 
 std::string patch_region(const std::string& patch) {
@@ -317,7 +334,10 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
         surface_value("pOutlet", patch_region("outlet"), "areaAverage", "p") +
         surface_value("pBedBottom", plane_region("bedBottom", section.z_low), "areaAverage", "p") +
         surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p") +
-        surface_value("flowRate", patch_region("outlet"), "sum", "phi");
+        surface_value("flowRate", patch_region("outlet"), "sum", "phi") +
+        forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) +
+        (bed.size() > 0 ? forces("forceParticles", "particles", p.density_kg_m3) : std::string()) +
+        forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3);
     write_text(tmp / "system/controlDict",
                dict("dictionary", "system", "controlDict", note,
                     fmt::format("application     simpleFoam;\nstartFrom       startTime;\nstartTime       0;\n"
@@ -326,7 +346,8 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                 "writeFormat     {};\nwritePrecision  10;\nwriteCompression off;\n"
                                 "timeFormat      general;\ntimePrecision   8;\nrunTimeModifiable false;\n\n"
                                 "// Pressure (kinematic, p/rho) averaged over the inlet, the outlet and the bed section's\n"
-                                "// planes z = {:.6g} and {:.6g} m; flow rate through the outlet (m3/s).\n"
+                                "// planes z = {:.6g} and {:.6g} m; flow rate through the outlet (m3/s); forces (N) on the\n"
+                                "// walls, the particles, the inlet and the outlet.\n"
                                 "functions\n{{\n{}}}\n",
                                 p.iterations, p.iterations, fmt_word, section.z_low, section.z_high, functions)));
     // Tetrahedra in narrow gaps are far from orthogonal: limited corrections, one
@@ -456,6 +477,23 @@ std::vector<double> series(const fs::path& case_dir, const std::string& name) {
   return v;
 }
 
+// The last force along z (N, pressure and viscous) in a forces function object's output; 0
+// when the object was not written (no particles in an empty container).
+double last_force_z(const fs::path& case_dir, const std::string& name) {
+  const fs::path file = case_dir / "postProcessing" / name / "0" / "force.dat";
+  if (!fs::exists(file)) return 0.0;
+  std::ifstream in(file);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty() && line[0] != '#') last = line;
+  std::replace(last.begin(), last.end(), '(', ' ');
+  std::replace(last.begin(), last.end(), ')', ' ');
+  std::istringstream row(last);
+  double t = 0.0, x = 0.0, y = 0.0, z = 0.0;
+  if (!(row >> t >> x >> y >> z)) throw std::runtime_error("no force in " + file.string());
+  return z;
+}
+
 // One SIMPLE iteration of a simpleFoam log: its `Time = N`, the initial residuals (the largest
 // of U's components, p's first solve) and the ExecutionTime at its end.
 struct Iteration {
@@ -579,6 +617,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.pressure_drop_inlet_outlet_pa = overall;
   r.flow_rate_m3_s = flow;
   r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;
+  r.drag_walls_n = last_force_z(case_dir, "forceWalls");
+  r.drag_particles_n = last_force_z(case_dir, "forceParticles");
+  r.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet") + last_force_z(case_dir, "forceOutlet"));
+  const double drag = r.drag_walls_n + r.drag_particles_n;
+  r.wall_share_of_drag = r.drag_walls_n / drag;
+  r.force_balance_relative_error = drag / r.push_inlet_outlet_n - 1.0;
   if (c.exact_pressure_gradient_pa_m) {
     r.exact_pa_m = c.exact_pressure_gradient_pa_m;
     r.relative_error_to_exact = gradient / *r.exact_pa_m - 1.0;
@@ -592,6 +636,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
       analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps_bed, a), eps_bed, rho, u, d);
   r.ratio_to_eisfeld_schnitzlein_bed = gradient / r.eisfeld_schnitzlein_bed_pa_m;
   r.void_fraction_section_bed = eps_bed;
+  r.wall_share_of_drag_eisfeld_schnitzlein = analysis::wall_wetted_area_share(eps_bed, a);
   return r;
 }
 

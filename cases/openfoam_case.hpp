@@ -120,6 +120,15 @@ struct FlowResult {
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
+  // Forces along the flow (N, OpenFOAM's forces function object, pressure and viscous, over the
+  // whole domain): the drag on the walls and on the particles, and the push of the fluid through
+  // the inlet and outlet. Steady flow conserves momentum, so the drag equals the push but for the
+  // momentum flux difference between inlet and outlet (rho u^2 A / 3 from a plug to a parabola),
+  // the solver's convergence and the wall gradient the forces object takes (a discretisation
+  // error, falling as the mesh refines).
+  double drag_walls_n = 0.0, drag_particles_n = 0.0, push_inlet_outlet_n = 0.0;
+  double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
+  double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
   // An empty container (no correlation applies): the exact gradient and the relative error
   // dp/L / exact - 1. For a bed, unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;
@@ -132,6 +141,9 @@ struct FlowResult {
   double eisfeld_schnitzlein_bed_pa_m = 0.0;
   double ratio_to_eisfeld_schnitzlein_bed = 0.0;
   double void_fraction_section_bed = 0.0;
+  // The wall's share of the wetted area at that void fraction: its share of the drag in the
+  // correlation's wall term (analysis::wall_wetted_area_share), to hold the measured share against.
+  double wall_share_of_drag_eisfeld_schnitzlein = 0.0;
   nlohmann::json history;                // per iteration: residuals and the bed's gradient against time
   nlohmann::json to_json() const;        // the case entry's "flow"
 };

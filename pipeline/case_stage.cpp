@@ -30,6 +30,9 @@ CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases:
                                           100.0 * flow.relative_error_to_exact)
                             : fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps ({:.3f} x at the meshed eps)",
                                           flow.ratio_to_eisfeld_schnitzlein_bed, flow.ratio_to_eisfeld_schnitzlein);
+    line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.wall_share_of_drag);
+    if (!flow.exact_pa_m)
+      line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);
   }
   finish_stage(out.report, meter, line, console);
   return out;

@@ -31,6 +31,8 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"cell_size_m", l.cell_size_m},
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged},
+                {"wall_share_of_drag", l.wall_share_of_drag},
+                {"force_balance_relative_error", l.force_balance_relative_error},
                 {"own_time_s", l.own_time_s}});
       if (exact_pa_m) j["relative_error_to_exact"] = l.pressure_gradient_pa_m / *exact_pa_m - 1.0;
     } else {
@@ -56,6 +58,8 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3 / static_cast<double>(l.cells));
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
+  l.wall_share_of_drag = solved.flow->wall_share_of_drag;
+  l.force_balance_relative_error = solved.flow->force_balance_relative_error;
   l.exact_pa_m = solved.flow->exact_pa_m;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
   l.time_s = solved.report["time_s"].get<double>();

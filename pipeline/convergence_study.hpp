@@ -23,6 +23,8 @@ struct StudyLevel {
   double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
+  double wall_share_of_drag = 0.0;            // the walls' share of the drag (cases::FlowResult)
+  double force_balance_relative_error = 0.0;  // drag against the push through inlet and outlet, - 1
   double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one
                               // (every sizing attempt); the flow alone of the finest (its surface and
                               // mesh may be reused)

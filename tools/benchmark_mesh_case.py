@@ -220,7 +220,8 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
             "eps_section_bed": case["flow"]["void_fraction_section_bed"],
-            "solid_volume_change_relative": rep["stages"]["surface"]["solid_volume_change_relative"]}
+            "solid_volume_change_relative": rep["stages"]["surface"]["solid_volume_change_relative"],
+            "wall_share_es": case["flow"]["drag"]["wall_share_eisfeld_schnitzlein"]}
 
 
 # OpenFOAM settings tried against the case as written: (name, [(file, pattern, replacement)]).
@@ -334,8 +335,8 @@ def study_lines(r):
              f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
              f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
              "| level | lengths x | cells | h / d | h / finer h | dp/L (Pa/m) | / E&S at the bed's eps | "
-             "/ E&S at the finest mesh's eps | time (s) |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "/ E&S at the finest mesh's eps | walls' share of the drag | momentum balance | time (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
 
     def bed_ratio(dp):  # runs before the bed's eps was recorded (before a877da4) have none
         return f"{dp / r['es_bed_pa_m']:.3f}" if "es_bed_pa_m" in r else "not recorded"
@@ -343,7 +344,8 @@ def study_lines(r):
     finer = None
     for lv in st["levels"]:
         if "failure" in lv:
-            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | | {lv['time_s']:.0f} |")
+            lines.append(f"| {lv['level']} | {lv['scale']:.3g} | failed: {lv['failure']} | | | | | | | | "
+                         f"{lv['time_s']:.0f} |")
             finer = None
             continue
         step = f"{lv['cell_size_m'] / finer:.3f}" if finer else ""
@@ -351,7 +353,13 @@ def study_lines(r):
         lines.append(f"| {lv['level']} | {lv['scale']:.3g} | {lv['cells']} | {lv['cell_size_m'] / r['d_m']:.4f} | {step} | "
                      f"{lv['pressure_gradient_bed_pa_m']:.4g} | "
                      f"{bed_ratio(lv['pressure_gradient_bed_pa_m'])} | "
-                     f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {lv['time_s']:.0f} |")
+                     f"{lv['pressure_gradient_bed_pa_m'] / r['es_pa_m']:.3f} | {drag_share(lv)} | {drag_balance(lv)} | "
+                     f"{lv['time_s']:.0f} |")
+    if "wall_share_es" in r:
+        lines += ["", f"The walls' share of the drag is OpenFOAM's force on them over the force on walls and particles "
+                      f"(the whole domain); their share of the wetted area at the bed's void fraction, which is what "
+                      f"Eisfeld & Schnitzlein's wall term A_w gives them, is {100 * r['wall_share_es']:.1f} %. The "
+                      f"momentum balance is that drag over the push through inlet and outlet, less 1."]
     lines += ["", f"Verdict: {st['conclusion']}."]
     g = st.get("grid_convergence", {})
     if g.get("extrapolated") is not None and g.get("asymptotic", g.get("apparent_order", 0) >= 1):
@@ -362,6 +370,15 @@ def study_lines(r):
                   f"{g['asymptotic_ratio']:.3f} (1 in the asymptotic range)."]
     lines += [""]
     return lines
+
+
+def drag_share(level):
+    """The walls' share of a level's drag; runs before 2026-11-26 did not record it."""
+    return f"{100 * level['wall_share_of_drag']:.1f} %" if "wall_share_of_drag" in level else "not recorded"
+
+
+def drag_balance(level):
+    return f"{100 * level['force_balance_relative_error']:+.2f} %" if "force_balance_relative_error" in level else ""
 
 
 def study_values(r):

@@ -33,6 +33,15 @@ TEST(PressureDrop, WallCorrectionVanishesInAWideBed) {
   EXPECT_NEAR(f, 154.0 * (1.0 - eps) / re + 1.0 / (0.87 * 0.87), 1e-6 * f);
 }
 
+TEST(PressureDrop, WallWettedAreaShareIsTheWallsShareOfTheSurfacePerBedVolume) {
+  // Per unit bed volume, a tube of diameter D = a d has 4 / D of wall and the spheres
+  // 6 (1 - eps) / d of surface; nothing of A_w enters this count.
+  const double d = 0.003, eps = 0.44, a = 5.0;
+  const double wall = 4.0 / (a * d), particles = 6.0 * (1.0 - eps) / d;
+  EXPECT_NEAR(wall_wetted_area_share(eps, a), wall / (wall + particles), 1e-12);
+  EXPECT_LT(wall_wetted_area_share(eps, 1e9), 1e-8);  // a wide bed: the wall carries nothing (2 / (3 a (1 - eps)))
+}
+
 TEST(PressureDrop, GradientHasTheUnitsOfTheDefinition) {
   // dp/L = f_p rho u^2 / d: doubling the density doubles it, doubling d halves it at fixed f.
   const double g = pressure_gradient(100.0, 0.4, 1000.0, 0.01, 0.003);
