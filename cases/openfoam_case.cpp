@@ -141,7 +141,9 @@ nlohmann::json FlowResult::to_json() const {
           {"flow_rate_relative_error", flow_rate_relative_error},
           {"drag",
            {{"walls_n", drag_walls_n},
+            {"walls_viscous_n", drag_walls_viscous_n},
             {"particles_n", drag_particles_n},
+            {"particles_viscous_n", drag_particles_viscous_n},
             {"push_inlet_outlet_n", push_inlet_outlet_n},
             {"wall_share", wall_share_of_drag},
             {"force_balance_relative_error", force_balance_relative_error}}}};
@@ -191,10 +193,11 @@ std::string surface_value(const std::string& name, const std::string& region, co
 }
 
 // OpenFOAM's forces on the patches `patches` matches (a list of names or quoted regular
-// expressions), with the density that turns the kinematic pressure into Pa.
+// expressions), with the density that turns the kinematic pressure into Pa. Evaluated only
+// when the fields are written (at the end), as each evaluation takes the gradient of U.
 std::string forces(const std::string& name, const std::string& patches, double density) {
   return fmt::format("    {}\n    {{\n        type            forces;\n        libs            (\"libforces.so\");\n"
-                     "        writeControl    timeStep;\n        writeInterval   1;\n        log             false;\n"
+                     "        executeControl  writeTime;\n        writeControl    writeTime;\n        log             false;\n"
                      "        patches         ({});\n        rho             rhoInf;\n        rhoInf          {:.12g};\n"
                      "        CofR            (0 0 0);\n    }}\n",
                      name, patches, density);
@@ -477,21 +480,25 @@ std::vector<double> series(const fs::path& case_dir, const std::string& name) {
   return v;
 }
 
-// The last force along z (N, pressure and viscous) in a forces function object's output; 0
-// when the object was not written (no particles in an empty container).
-double last_force_z(const fs::path& case_dir, const std::string& name) {
+// The last force along z (N) in a forces function object's output, in all and its viscous part.
+struct ForceZ {
+  double total = 0.0, viscous = 0.0;
+};
+ForceZ last_force_z(const fs::path& case_dir, const std::string& name) {
   const fs::path file = case_dir / "postProcessing" / name / "0" / "force.dat";
-  if (!fs::exists(file)) return 0.0;
   std::ifstream in(file);
+  if (!in) throw std::runtime_error("the solver wrote no " + file.string());
   std::string line, last;
   while (std::getline(in, line))
     if (!line.empty() && line[0] != '#') last = line;
   std::replace(last.begin(), last.end(), '(', ' ');
   std::replace(last.begin(), last.end(), ')', ' ');
-  std::istringstream row(last);
-  double t = 0.0, x = 0.0, y = 0.0, z = 0.0;
-  if (!(row >> t >> x >> y >> z)) throw std::runtime_error("no force in " + file.string());
-  return z;
+  std::istringstream row(last);  // time, then total, pressure and viscous vectors
+  double t = 0.0, total[3], pressure[3], viscous[3];
+  if (!(row >> t >> total[0] >> total[1] >> total[2] >> pressure[0] >> pressure[1] >> pressure[2] >> viscous[0] >>
+        viscous[1] >> viscous[2]))
+    throw std::runtime_error("no force in " + file.string());
+  return {total[2], viscous[2]};
 }
 
 // One SIMPLE iteration of a simpleFoam log: its `Time = N`, the initial residuals (the largest
@@ -617,9 +624,11 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.pressure_drop_inlet_outlet_pa = overall;
   r.flow_rate_m3_s = flow;
   r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;
-  r.drag_walls_n = last_force_z(case_dir, "forceWalls");
-  r.drag_particles_n = last_force_z(case_dir, "forceParticles");
-  r.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet") + last_force_z(case_dir, "forceOutlet"));
+  const ForceZ walls = last_force_z(case_dir, "forceWalls");
+  const ForceZ particles = c.exact_pressure_gradient_pa_m ? ForceZ{} : last_force_z(case_dir, "forceParticles");
+  r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
+  r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
+  r.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet").total + last_force_z(case_dir, "forceOutlet").total);
   const double drag = r.drag_walls_n + r.drag_particles_n;
   r.wall_share_of_drag = r.drag_walls_n / drag;
   r.force_balance_relative_error = drag / r.push_inlet_outlet_n - 1.0;

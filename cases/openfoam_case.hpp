@@ -127,6 +127,7 @@ struct FlowResult {
   // the solver's convergence and the wall gradient the forces object takes (a discretisation
   // error, falling as the mesh refines).
   double drag_walls_n = 0.0, drag_particles_n = 0.0, push_inlet_outlet_n = 0.0;
+  double drag_walls_viscous_n = 0.0, drag_particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
   double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
   double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
   // An empty container (no correlation applies): the exact gradient and the relative error

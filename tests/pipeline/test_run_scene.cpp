@@ -285,9 +285,12 @@ TEST(RunScene, TheEmptyTubeExampleMatchesHagenPoiseuille) {
     const double error = level["pressure_gradient_bed_pa_m"].get<double>() / exact - 1.0;
     EXPECT_NEAR(level["relative_error_to_exact"].get<double>(), error, 1e-12);
     EXPECT_LT(std::abs(error), level["level"] == 1 ? 0.01 : kCoarseTubeError) << level.dump();
-    // Momentum: the wall's drag is the push through inlet and outlet (the 2 % of
-    // OpenFoamCase.SmallBedPressureDropAgreesWithEisfeldSchnitzlein, which says why).
-    EXPECT_LT(std::abs(level["force_balance_relative_error"].get<double>()), 0.02) << level.dump();
+    // Momentum: the wall's drag is the push through inlet and outlet, but for the momentum flux
+    // from plug to parabola (-0.32 %) and the forces object's wall gradient, whose error grows on
+    // coarser cells: measured (2026-11-26) -1.5 % at 5 k cells, -1.5 % at 2 k, -1.8 and -2.1 %
+    // at 1 k. Hence 2 % on the finest, 3 % on the others.
+    EXPECT_LT(std::abs(level["force_balance_relative_error"].get<double>()), level["level"] == 1 ? 0.02 : 0.03)
+        << level.dump();
     EXPECT_EQ(level["wall_share_of_drag"].get<double>(), 1.0);  // no particles: no other drag
   }
   EXPECT_FALSE(c["flow"].contains("eisfeld_schnitzlein_pa_m"));  // no correlation for an empty tube
