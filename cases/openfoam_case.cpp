@@ -463,41 +463,45 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
 
 namespace {
 
-// The values (second column) of a function object's output, one per iteration.
-std::vector<double> series(const fs::path& case_dir, const std::string& name) {
-  const fs::path file = case_dir / "postProcessing" / name / "0" / "surfaceFieldValue.dat";
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("the solver wrote no " + file.string());
-  std::vector<double> v;
-  std::string line;
-  while (std::getline(in, line)) {
+// The data rows of a function object's output file `file` (comment lines left out), its
+// vectors' parentheses turned into spaces so that every number reads as a column.
+std::vector<std::string> output_rows(const fs::path& case_dir, const std::string& name, const std::string& file) {
+  const fs::path path = case_dir / "postProcessing" / name / "0" / file;
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("the solver wrote no " + path.string());
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
+    std::replace(line.begin(), line.end(), '(', ' ');
+    std::replace(line.begin(), line.end(), ')', ' ');
+    rows.push_back(std::move(line));
+  }
+  if (rows.empty()) throw std::runtime_error("no value in " + path.string());
+  return rows;
+}
+
+// The values (second column) of a surfaceFieldValue object's output, one per iteration.
+std::vector<double> series(const fs::path& case_dir, const std::string& name) {
+  std::vector<double> v;
+  for (const std::string& line : output_rows(case_dir, name, "surfaceFieldValue.dat")) {
     std::istringstream row(line);
     double t = 0.0, x = 0.0;
     if (row >> t >> x) v.push_back(x);
   }
-  if (v.empty()) throw std::runtime_error("no value in " + file.string());
+  if (v.empty()) throw std::runtime_error(fmt::format("no value in {}'s output", name));
   return v;
 }
 
-// The last force along z (N) in a forces function object's output, in all and its viscous part.
+// The last force along z (N) in a forces object's output, in all and its viscous part.
 struct ForceZ {
   double total = 0.0, viscous = 0.0;
 };
 ForceZ last_force_z(const fs::path& case_dir, const std::string& name) {
-  const fs::path file = case_dir / "postProcessing" / name / "0" / "force.dat";
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error("the solver wrote no " + file.string());
-  std::string line, last;
-  while (std::getline(in, line))
-    if (!line.empty() && line[0] != '#') last = line;
-  std::replace(last.begin(), last.end(), '(', ' ');
-  std::replace(last.begin(), last.end(), ')', ' ');
-  std::istringstream row(last);  // time, then total, pressure and viscous vectors
+  std::istringstream row(output_rows(case_dir, name, "force.dat").back());  // time, total, pressure, viscous
   double t = 0.0, total[3], pressure[3], viscous[3];
   if (!(row >> t >> total[0] >> total[1] >> total[2] >> pressure[0] >> pressure[1] >> pressure[2] >> viscous[0] >>
         viscous[1] >> viscous[2]))
-    throw std::runtime_error("no force in " + file.string());
+    throw std::runtime_error(fmt::format("no force in {}'s output", name));
   return {total[2], viscous[2]};
 }
 
