@@ -95,9 +95,9 @@ int run_command_line(int argc, char** argv) {
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   CLI::App* case_cmd = on_directory("case",
-                                    "write the OpenFOAM case DIR/case from DIR/fluid.msh (simpleFoam, laminar); run it "
-                                    "with DIR/case/Allrun [-np N]",
-                                    "directory holding fluid.msh (as written by mesh)", Command::case_);
+                                    "write the OpenFOAM case DIR/case from DIR/fluid.msh, or with --mesher snappy from "
+                                    "DIR/fluid.stl (simpleFoam, laminar); run it with DIR/case/Allrun [-np N]",
+                                    "directory holding fluid.msh (as written by mesh), or fluid.stl", Command::case_);
   case_cmd->add_flag("--overwrite", overwrite, "replace DIR/case when it exists");
 #endif
 

@@ -110,10 +110,11 @@ const std::vector<Flag>& table() {
       {"--format", {"case.format"}, "polyMesh and field format", static_cast<unsigned>(Command::case_)},
       {"--snappy", {"case.snappy"}, "also write the snappyHexMesh set-up, used by Allrun -snappy",
        static_cast<unsigned>(Command::case_)},
-      {"--run", {"case.run"}, "run Allrun and add the pressure drop to the report",
+      {"--mesher", {"case.mesher"},
+       "what makes the cells solved on: gmsh (the mesh stage) or snappy (snappyHexMesh in Allrun, on every "
+       "process, and no gmsh mesh)",
        static_cast<unsigned>(Command::case_)},
-      {"--run-mesh", {"case.run_mesh"},
-       "the mesh --run solves on: gmsh's, or snappyHexMesh's made first by Allrun -snappy (needs --snappy)",
+      {"--run", {"case.run"}, "run Allrun and add the pressure drop to the report",
        static_cast<unsigned>(Command::case_)},
   };
   return flags;

@@ -10,6 +10,7 @@
 #include <future>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <sstream>
 
@@ -38,15 +39,12 @@ CaseParams read_case_params(SceneSection& s) {
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
   p.polyhedra = s.choice("cells", "polyhedra", {"polyhedra", "tetrahedra"}) == "polyhedra";
-  p.snappy = s.boolean("snappy", p.snappy);
+  p.snappy_cells = s.choice("mesher", "gmsh", {"gmsh", "snappy"}) == "snappy";
+  p.snappy = s.boolean("snappy", p.snappy) || p.snappy_cells;
   p.snappy_cell_d = s.number("snappy_cell_d", p.snappy_cell_d, Range::closed(0.01, 10.0));
   p.snappy_level = static_cast<int>(s.integer("snappy_level", p.snappy_level, 0, 6));
   p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
   p.run = s.boolean("run", p.run);
-  p.run_snappy = s.choice("run_mesh", "gmsh", {"gmsh", "snappy"}) == "snappy";
-  if (p.run_snappy && !p.snappy)
-    throw InputError("case.run_mesh = \"snappy\" without case.snappy = true: there is no snappyHexMesh set-up to "
-                     "run; allowed: run_mesh = \"gmsh\", or snappy = true");
   SceneSection convergence = s.sub("convergence");
   p.convergence.levels = static_cast<int>(convergence.integer("levels", 0, 0, 6));
   p.convergence.ratio = convergence.number("ratio", p.convergence.ratio, Range::closed(1.1, 2.0));
@@ -55,9 +53,9 @@ CaseParams read_case_params(SceneSection& s) {
     throw InputError(fmt::format("case.convergence.levels = {}: an order and an extrapolation need three meshes; "
                                  "allowed: 0 (no study) or 3 to 6",
                                  p.convergence.levels));
-  if (p.convergence.levels > 0 && (!p.run || p.run_snappy))
+  if (p.convergence.levels > 0 && (!p.run || p.snappy_cells))
     throw InputError("case.convergence.levels > 0 needs the flow solved on gmsh's meshes; allowed: case.run = true "
-                     "with case.run_mesh = \"gmsh\"");
+                     "with case.mesher = \"gmsh\"");
   return p;
 }
 
@@ -69,20 +67,21 @@ nlohmann::json to_json(const CaseParams& p) {
           {"format", p.binary ? "binary" : "ascii"}, {"cells", p.polyhedra ? "polyhedra" : "tetrahedra"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
-          {"run", p.run},                   {"run_mesh", p.run_snappy ? "snappy" : "gmsh"},
+          {"run", p.run},                   {"mesher", p.snappy_cells ? "snappy" : "gmsh"},
           {"convergence", {{"levels", p.convergence.levels}, {"ratio", p.convergence.ratio}}}};
 }
 
-BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d) {
+BedSection bed_section(const meshing::CellGeometry* cells, const CaseGeometry& g, double exclude_d) {
   // The bed between its floor and top, or the part of it a clip window kept.
   BedSection s{std::max(g.bed_bottom, g.inlet_z) + exclude_d * g.d_ref,
-               std::min(g.bed_top, g.outlet_z) - exclude_d * g.d_ref, 0.0};
+               std::min(g.bed_top, g.outlet_z) - exclude_d * g.d_ref, std::nullopt};
   if (s.z_high - s.z_low < 0.5 * g.d_ref)
     throw InputError(fmt::format("case.section_exclude_d = {}: leaves a bed section of {:.3g} d (bed height {:.3g} d); "
                                  "the pressure drop needs at least 0.5 d, lower it",
                                  exclude_d, (s.z_high - s.z_low) / g.d_ref, g.bed_top / g.d_ref));
-  const std::vector<Eigen::Vector3d>& c = cells.centres;
-  const std::vector<double>& v = cells.volumes;
+  if (!cells) return s;
+  const std::vector<Eigen::Vector3d>& c = cells->centres;
+  const std::vector<double>& v = cells->volumes;
   double fluid = 0.0;
   for (std::size_t k = 0; k < c.size(); ++k)
     if (c[k].z() > s.z_low && c[k].z() < s.z_high) fluid += v[k];
@@ -90,7 +89,7 @@ BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g
   return s;
 }
 
-CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed) {
+CaseGeometry case_geometry(const std::vector<Eigen::Vector3d>& points, const Bed& bed) {
   CaseGeometry g;
   g.d_ref = reference_diameter(bed);
   const Container& c = *bed.container;
@@ -99,11 +98,51 @@ CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed) {
   g.aspect_ratio = 4.0 * g.cross_section_area / c.wall_perimeter() / g.d_ref;  // hydraulic diameter over d
   g.inlet_z = std::numeric_limits<double>::infinity();
   g.outlet_z = -g.inlet_z;
-  for (const auto& x : mesh.points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
+  for (const auto& x : points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
   const bool empty = bed.size() == 0;
   g.bed_bottom = empty ? g.inlet_z : 0.0;
   g.bed_top = empty ? g.outlet_z : bed_height(bed);
   return g;
+}
+
+Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g) {
+  // At most about 2e5 lattice points at cell centres (none on the inlet, the outlet or a box's
+  // side). From each, the spheres are scanned outwards in height only as far as one could still
+  // come nearer than the nearest found, so a bed of 1e5 spheres takes well under a second.
+  const Eigen::Vector4d& b = g.lateral_bounds;
+  const Eigen::Vector3d lo(b[0], b[1], g.inlet_z), hi(b[2], b[3], g.outlet_z);
+  const double step = std::max(0.25 * g.d_ref, std::cbrt((hi - lo).prod() / 2e5));
+  const Eigen::Array3i n = ((hi - lo) / step).array().floor().cast<int>().max(1);
+  std::vector<std::size_t> order(bed.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return bed.centres[i].z() < bed.centres[j].z(); });
+  std::vector<double> zs(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) zs[k] = bed.centres[order[k]].z();
+  double r_max = 0.0;
+  for (double dia : bed.diameters) r_max = std::max(r_max, 0.5 * dia);
+  const Container& c = *bed.container;
+  const Periodicity per = c.periodicity();
+  Eigen::Vector3d best = 0.5 * (lo + hi);
+  double best_clearance = -HUGE_VAL;
+  for (int k = 0; k < n.z(); ++k)
+    for (int i = 0; i < n.x(); ++i)
+      for (int j = 0; j < n.y(); ++j) {
+        const Eigen::Vector3d q = lo + (Eigen::Array3d(i, j, k) + 0.5).matrix().cwiseProduct(hi - lo).cwiseQuotient(n.cast<double>().matrix());
+        double clearance = std::min(q.z() - g.inlet_z, g.outlet_z - q.z());
+        // The walls: a sphere of radius `clearance` at q overlaps a wall by how much nearer it is.
+        WallContact touch[Container::kMaxWallContacts];
+        for (int w = 0, m = c.wall_contacts(q, clearance, touch); w < m; ++w)
+          clearance = std::min(clearance, clearance - touch[w].overlap);
+        const std::size_t at = std::lower_bound(zs.begin(), zs.end(), q.z()) - zs.begin();
+        for (std::size_t up = at, down = at; clearance > best_clearance && (up < zs.size() || down > 0);) {
+          const bool take_up = down == 0 || (up < zs.size() && zs[up] - q.z() < q.z() - zs[down - 1]);
+          const std::size_t s = take_up ? up++ : --down;
+          if (std::abs(zs[s] - q.z()) - r_max >= clearance) break;
+          clearance = std::min(clearance, per.separation(bed.centres[order[s]], q).norm() - 0.5 * bed.diameters[order[s]]);
+        }
+        if (clearance > best_clearance) best_clearance = clearance, best = q;
+      }
+  return best;
 }
 
 nlohmann::json CaseInfo::to_json() const {
@@ -115,20 +154,23 @@ nlohmann::json CaseInfo::to_json() const {
           {"section",
            {{"z_low_m", section.z_low},
             {"z_high_m", section.z_high},
-            {"void_fraction_mesh", section.void_fraction},
+            {"void_fraction_mesh", section.void_fraction ? nlohmann::json(*section.void_fraction) : nullptr},
             {"void_fraction_bed", section.void_fraction_bed}}},
           {"aspect_ratio", aspect_ratio},
           {"inlet_area_m2", inlet_area_m2},
           {"d_ref_m", d_ref_m},
-          {"fluid_volume_m3", fluid_volume_m3},
+          {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr}};
 }
 
 nlohmann::json FlowResult::to_json() const {
   nlohmann::json mesh = {{"mesher", mesher}};
   if (solved_cells >= 0) mesh["cells"] = solved_cells;
+  nlohmann::json allrun = nlohmann::json::array();
+  for (const Step& s : steps) allrun.push_back({{"step", s.name}, {"time_s", s.time_s}, {"peak_memory_mb", s.peak_memory_mb}});
   nlohmann::json j = {{"time_s", time_s},
           {"solver_peak_memory_mb", solver_peak_memory_mb},
+          {"allrun_steps", allrun},
           {"mesh", mesh},
           {"iterations", iterations},
           {"history", history},
@@ -151,9 +193,10 @@ nlohmann::json FlowResult::to_json() const {
     j["exact_pa_m"] = *exact_pa_m;
     j["relative_error_to_exact"] = relative_error_to_exact;
   } else {
-    j["eisfeld_schnitzlein_pa_m"] = eisfeld_schnitzlein_pa_m;
-    j["ratio_to_eisfeld_schnitzlein"] = ratio_to_eisfeld_schnitzlein;
-    j["void_fraction_section"] = void_fraction_section;
+    auto known = [](const std::optional<double>& x) { return x ? nlohmann::json(*x) : nlohmann::json(); };
+    j["eisfeld_schnitzlein_pa_m"] = known(eisfeld_schnitzlein_pa_m);
+    j["ratio_to_eisfeld_schnitzlein"] = known(ratio_to_eisfeld_schnitzlein);
+    j["void_fraction_section"] = known(void_fraction_section);
     j["eisfeld_schnitzlein_bed_pa_m"] = eisfeld_schnitzlein_bed_pa_m;
     j["ratio_to_eisfeld_schnitzlein_bed"] = ratio_to_eisfeld_schnitzlein_bed;
     j["void_fraction_section_bed"] = void_fraction_section_bed;
@@ -176,9 +219,12 @@ std::string dict(const std::string& cls, const std::string& location, const std:
          "\n// ************************************************************************* //\n";
 }
 
-// Walls and particles take the same conditions; `.*wall` matches wall and inner_wall.
+// Walls and particles take the same conditions; `.*wall` matches wall and inner_wall. The
+// constraint types cover processor patches, so the fields serve snappyHexMesh's cells as they
+// come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls) {
-  return fmt::format("boundaryField\n{{\n    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n"
+  return fmt::format("boundaryField\n{{\n    #includeEtc \"caseDicts/setConstraintTypes\"\n"
+                     "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n"
                      "    \"(.*wall|particles)\"\n    {{\n{}    }}\n}}\n",
                      inlet, outlet, walls);
 }
@@ -216,47 +262,63 @@ std::string plane_region(const std::string& name, double z) {
                      name, z);
 }
 
-std::string allrun(bool snappy, bool polyhedra) {
-  std::string s =
-      "#!/bin/sh\n"
-      "# Runs the case: ./Allrun (serial) or ./Allrun -np N (decomposePar, mpirun, reconstructPar).\n";
-  if (snappy) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh (on N processes with -np N).\n";
+// Allrun: the cells (the gmsh mesh as written, its polyhedral dual, or snappyHexMesh's), then
+// simpleFoam, on N processes with -np N. snappyHexMesh's cells stay decomposed for the solver,
+// and its results with them: gathering them would take one process the whole mesh's memory.
+std::string allrun(const CaseParams& p) {
+  const bool flag = p.snappy && !p.snappy_cells;  // gmsh's cells, snappyHexMesh's on request
+  std::string s = "#!/bin/sh\n";
+  s += p.snappy_cells
+           ? "# Runs the case: snappyHexMesh makes the cells from constant/triSurface/fluid.stl, then simpleFoam\n"
+             "# solves; ./Allrun (serial) or ./Allrun -np N (N processes; the mesh and the results stay in\n"
+             "# processor*/, which ParaView opens as a decomposed case).\n"
+           : "# Runs the case: ./Allrun (serial) or ./Allrun -np N (decomposePar, mpirun, reconstructPar).\n";
+  if (flag) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh (decomposed with -np N).\n";
   s += "cd \"${0%/*}\" || exit 1\n"
        "export WM_PROJECT_DIR=\"${WM_PROJECT_DIR:-/usr/share/openfoam}\"\n"
-       "np=1\nsnappy=0\n"
+       "np=1\n" + std::string(p.snappy_cells ? "snappy=1\n" : "snappy=0\n") +
        "while [ $# -gt 0 ]; do\n"
        "    case \"$1\" in\n"
        "        -np) np=\"$2\"; shift 2 ;;\n";
-  if (snappy) s += "        -snappy) snappy=1; shift ;;\n";
-  s += "        *) echo \"usage: ./Allrun [-np N]" + std::string(snappy ? " [-snappy]" : "") +
+  if (flag) s += "        -snappy) snappy=1; shift ;;\n";
+  s += "        *) echo \"usage: ./Allrun [-np N]" + std::string(flag ? " [-snappy]" : "") +
        "\" >&2; exit 2 ;;\n"
        "    esac\n"
        "done\n"
-       "run() { log=\"log.$1\"; echo \"running $*\"; \"$@\" > \"$log\" 2>&1 || { echo \"$1 failed, see $log\" >&2; exit 1; }; }\n"
+       "# Each step logs to log.<step>; with GNU time its wall time (s) and its largest process's peak\n"
+       "# memory (kB) go to log.time.\n"
+       "rm -f log.time\n"
+       "if [ -x /usr/bin/time ]; then\n"
+       "    step() { name=\"$1\"; shift; /usr/bin/time -a -o log.time -f \"$name %e %M\" \"$@\" > \"log.$name\" 2>&1; }\n"
+       "else\n"
+       "    step() { name=\"$1\"; shift; \"$@\" > \"log.$name\" 2>&1; }\n"
+       "fi\n"
+       "run() { echo \"running $*\"; step \"$1\" \"$@\" || { echo \"$1 failed, see log.$1\" >&2; exit 1; }; }\n"
        "# Open MPI refuses root unless told (containers, CI).\n"
-       "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1\n";
-  s += "decompose() {\n"
+       "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1\n"
+       "parallel() {\n"
+       "    echo \"running $* on $np processes\"\n"
+       "    step \"$1\" mpirun -np \"$np\" \"$@\" -parallel || { echo \"$1 failed, see log.$1\" >&2; exit 1; }\n"
+       "}\n"
+       "decompose() {\n"
        "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
        "        -e \"s/^    n .*/    n               (1 1 $np);/\" system/decomposeParDict\n"
        "    run decomposePar -force \"$@\"\n"
-       "}\n"
-       "# mpirun logs to log.mpirun: give each parallel run its own log.\n"
-       "parallel() { run mpirun -np \"$np\" \"$@\" -parallel; mv log.mpirun \"log.$1\"; }\n";
-  if (snappy)
+       "}\n";
+  if (p.snappy)
     s += "if [ \"$snappy\" = 1 ]; then\n"
          "    run blockMesh\n"
          "    run surfaceFeatureExtract\n"
          "    if [ \"$np\" -gt 1 ]; then\n"
          "        decompose -copyZero  # the background mesh's patches are not the fields' patches\n"
          "        parallel snappyHexMesh -overwrite\n"
-         "        run reconstructParMesh -constant\n"
-         "        rm -rf processor*\n"
+         "        parallel checkMesh\n"
          "    else\n"
          "        run snappyHexMesh -overwrite\n"
+         "        run checkMesh\n"
          "    fi\n"
-         "    run checkMesh\n"
          "fi\n";
-  if (polyhedra)
+  if (p.polyhedra && !p.snappy_cells)
     s += "# gmsh's tetrahedra become their dual polyhedra, once (the tetrahedra are kept in constant/tetrahedra):\n"
          "# an empty tube's pressure drop converges to the exact one on the dual, not on the tetrahedra.\n"
          "# Edges sharper than 80 degrees (inlet and outlet rims) stay edges of the dual.\n"
@@ -268,9 +330,9 @@ std::string allrun(bool snappy, bool polyhedra) {
          "    run checkMesh\n"
          "fi\n";
   s += "if [ \"$np\" -gt 1 ]; then\n"
-       "    decompose\n"
+       "    [ \"$snappy\" = 1 ] || decompose\n"
        "    parallel simpleFoam\n"
-       "    run reconstructPar -latestTime\n"
+       "    [ \"$snappy\" = 1 ] || run reconstructPar -latestTime\n"
        "else\n"
        "    run simpleFoam\n"
        "fi\n";
@@ -290,19 +352,21 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
     throw InputError(fmt::format("{} exists; remove it or pass --overwrite", case_dir.string()));
 }
 
-CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh, const CaseGeometry& g,
-                    const Bed& bed, const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const std::string& fluid_stl) {
+CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
+                    const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed, const CaseParams& p,
+                    const std::string& note, const std::string& scene_toml, const std::string& bed_csv,
+                    const fs::path& fluid_stl) {
   refuse_existing_case(case_dir, overwrite);
   std::random_device rd;
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
-  const meshing::CellGeometry geometry = meshing::cell_geometry(mesh);
-  BedSection section = bed_section(geometry, g, p.section_exclude_d);
+  const std::optional<meshing::CellGeometry> geometry =
+      mesh ? std::optional(meshing::cell_geometry(*mesh)) : std::nullopt;
+  BedSection section = bed_section(geometry ? &*geometry : nullptr, g, p.section_exclude_d);
   section.void_fraction_bed = analysis::void_fraction(bed, section.z_low, section.z_high);
   try {
-    write_poly_mesh(tmp / "constant/polyMesh", mesh, p.binary, note);
+    if (mesh) write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     const std::string fmt_word = p.binary ? "binary" : "ascii";
     auto field_dict = [&](const std::string& cls, const std::string& object, const std::string& body) {
       return foam_header(cls, "0", object, note, false) + body;
@@ -386,20 +450,25 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                 "hierarchicalCoeffs\n{{\n    n               (1 1 {});\n    delta           0.001;\n"
                                 "    order           xyz;\n}}\n",
                                 p.processors, p.decomposition, p.processors)));
-    write_text(tmp / "Allrun", allrun(p.snappy, p.polyhedra), true);
+    write_text(tmp / "Allrun", allrun(p), true);
     write_text(tmp / "Allclean", kAllclean, true);
     write_text(tmp / "case.foam", "");  // for ParaView
     write_text(tmp / "bedforge/scene.toml", scene_toml);
     write_text(tmp / "bedforge/bed.csv", bed_csv);
     if (p.snappy) {
       // Background cells, refined `snappy_level` times at every surface; the fluid is the side
-      // holding the centre of the largest tetrahedron (inside the fluid and away from its
-      // surface, also when a clip window leaves no empty section).
+      // holding the point farthest from the bed's surfaces (also when a clip window leaves no
+      // empty section).
       const double cell = p.snappy_cell_d * g.d_ref, pad = cell;
       const Eigen::Vector4d b = g.lateral_bounds + Eigen::Vector4d(-pad, -pad, pad, pad);
       const double z0 = g.inlet_z - pad, z1 = g.outlet_z + pad;
       auto cells = [&](double length) { return std::max(1, static_cast<int>(std::ceil(length / cell))); };
-      write_text(tmp / "constant/triSurface/fluid.stl", fluid_stl);
+      // A hard link where the file system allows it: a bed's surface can take gigabytes, and a
+      // surface made anew replaces the run's file, not the case's.
+      fs::create_directories(tmp / "constant/triSurface");
+      std::error_code linked;
+      fs::create_hard_link(fluid_stl, tmp / "constant/triSurface/fluid.stl", linked);
+      if (linked) fs::copy_file(fluid_stl, tmp / "constant/triSurface/fluid.stl");
       write_text(tmp / "system/blockMeshDict",
                  dict("dictionary", "system", "blockMeshDict", note,
                       fmt::format("convertToMeters 1;\n\nvertices\n(\n    ({0} {1} {4}) ({2} {1} {4}) ({2} {3} {4}) ({0} {3} {4})\n"
@@ -413,14 +482,13 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                       "fluid.stl\n{\n    extractionMethod    extractFromSurface;\n"
                       "    extractFromSurfaceCoeffs\n    {\n        includedAngle   150;\n    }\n"
                       "    writeObj            no;\n}\n"));
-      const Eigen::Vector3d inside =
-          geometry.centres[std::max_element(geometry.volumes.begin(), geometry.volumes.end()) - geometry.volumes.begin()];
+      const Eigen::Vector3d inside = fluid_point(bed, g);
       std::string regions, levels;
-      for (const auto& patch : mesh.patches) {
-        const bool wall = patch.type == "wall";
-        regions += fmt::format("            {0} {{ name {0}; }}\n", patch.name);
-        levels += fmt::format("                {0} {{ level ({2} {2}); patchInfo {{ type {1}; }} }}\n", patch.name,
-                              patch.type, wall ? p.snappy_level : 0);
+      for (const std::string& name : patches) {
+        const std::string type = meshing::patch_type(name);
+        regions += fmt::format("            {0} {{ name {0}; }}\n", name);
+        levels += fmt::format("                {0} {{ level ({2} {2}); patchInfo {{ type {1}; }} }}\n", name, type,
+                              type == "wall" ? p.snappy_level : 0);
       }
       write_text(tmp / "system/snappyHexMeshDict",
                  dict("dictionary", "system", "snappyHexMeshDict", note,
@@ -453,10 +521,10 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     fs::remove_all(tmp, ec);
     throw;
   }
-  double fluid_volume = 0.0;
-  for (double v : geometry.volumes) fluid_volume += v;
-  CaseInfo info{case_dir, p, u, nu, static_cast<long>(mesh.cells), section, g.aspect_ratio, g.cross_section_area, g.d_ref,
-                fluid_volume, std::nullopt};
+  std::optional<double> fluid_volume;
+  if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
+  CaseInfo info{case_dir, p, u, nu, mesh ? static_cast<long>(mesh->cells) : 0L, section, g.aspect_ratio,
+                g.cross_section_area, g.d_ref, fluid_volume, std::nullopt};
   if (bed.size() == 0) info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   return info;
 }
@@ -549,24 +617,38 @@ Iteration last_iteration(const fs::path& log_path) {
   return {};
 }
 
+// Allrun's steps as GNU time logged them in log.time ("name seconds kB" per step; a failed
+// step's extra line, and a machine without GNU time, give none).
+std::vector<FlowResult::Step> allrun_steps(const fs::path& case_dir) {
+  std::vector<FlowResult::Step> steps;
+  std::ifstream in(case_dir / "log.time");
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream row(line);
+    FlowResult::Step s;
+    double kb = 0.0;
+    std::string rest;
+    if (row >> s.name >> s.time_s >> kb && !(row >> rest)) steps.push_back({s.name, s.time_s, kb / 1024.0});
+  }
+  return steps;
+}
+
 }  // namespace
 
 FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path& case_dir = c.directory;
   const int np = c.params.processors;
-  const bool snappy = c.params.run_snappy;
-  const std::string cmd = fmt::format("'{}/Allrun' -np {}{} > '{}/log.Allrun' 2>&1", case_dir.string(), np,
-                                      snappy ? " -snappy" : "", case_dir.string());
-  // Allrun in the background; meanwhile the solver's log tells how far it is (log.mpirun while a
-  // parallel run lasts). The ETA assumes the residuals keep falling geometrically to their
-  // targets, and follows the one furthest from its target.
+  const bool snappy = c.params.snappy_cells;
+  const std::string cmd = fmt::format("'{}/Allrun' -np {} > '{}/log.Allrun' 2>&1", case_dir.string(), np,
+                                      case_dir.string());
+  // Allrun in the background; meanwhile the solver's log tells how far it is. The ETA assumes
+  // the residuals keep falling geometrically to their targets, and follows the one furthest
+  // from its target.
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
   const double target_p = c.params.residual_p, target_u = c.params.residual_u;
   double start_p = 0.0, start_u = 0.0;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
-    Iteration now = last_iteration(case_dir / "log.simpleFoam");
-    if (now.step == 0) now = last_iteration(case_dir / "log.mpirun");
+    const Iteration now = last_iteration(case_dir / "log.simpleFoam");
     if (now.step == 0 || now.res_p <= 0.0 || now.res_u <= 0.0) {
       progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
       continue;
@@ -591,7 +673,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const long iterations = static_cast<long>(its.size());
   const double res_u = its.back().res_u, res_p = its.back().res_p;
   const double rho = c.params.density_kg_m3, u = c.velocity_m_s, d = c.d_ref_m, a = c.aspect_ratio;
-  const double zl = c.section.z_low, zh = c.section.z_high, eps = c.section.void_fraction, re = c.params.reynolds;
+  const double zl = c.section.z_low, zh = c.section.z_high, re = c.params.reynolds;
   const std::vector<double> bottom = series(case_dir, "pBedBottom"), top = series(case_dir, "pBedTop");
   const std::size_t n = std::min(bottom.size(), top.size());
   auto bed_gradient = [&](std::size_t k) { return rho * (bottom[k] - top[k]) / (zh - zl); };
@@ -603,6 +685,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   FlowResult r;
   r.mesher = snappy ? "snappyHexMesh" : c.params.polyhedra ? "gmsh polyhedral dual" : "gmsh tetrahedra";
   r.solved_cells = snappy || c.params.polyhedra ? -1 : c.cells;
+  r.steps = allrun_steps(case_dir);
   if (snappy || c.params.polyhedra) {  // the cells Allrun made, as its checkMesh counted them
     std::ifstream check(case_dir / "log.checkMesh");
     for (std::string line; std::getline(check, line);)
@@ -641,9 +724,11 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
     r.relative_error_to_exact = gradient / *r.exact_pa_m - 1.0;
     return r;
   }
-  r.eisfeld_schnitzlein_pa_m = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps, a), eps, rho, u, d);
-  r.ratio_to_eisfeld_schnitzlein = gradient / r.eisfeld_schnitzlein_pa_m;
-  r.void_fraction_section = eps;
+  if (const std::optional<double> eps = c.section.void_fraction) {
+    r.eisfeld_schnitzlein_pa_m = analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, *eps, a), *eps, rho, u, d);
+    r.ratio_to_eisfeld_schnitzlein = gradient / *r.eisfeld_schnitzlein_pa_m;
+    r.void_fraction_section = eps;
+  }
   const double eps_bed = c.section.void_fraction_bed;
   r.eisfeld_schnitzlein_bed_pa_m =
       analysis::pressure_gradient(analysis::eisfeld_schnitzlein_f(re, eps_bed, a), eps_bed, rho, u, d);

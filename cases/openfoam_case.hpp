@@ -5,6 +5,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/bed.hpp"
 #include "core/progress.hpp"
@@ -33,12 +34,14 @@ struct CaseParams {
   // (OpenFOAM's polyDualMesh), on which an empty tube's pressure drop converges to the exact one;
   // "tetrahedra" solves on gmsh's cells, where it does not (docs/defaults.md).
   bool polyhedra = true;
-  bool snappy = false;                  // also write the snappyHexMesh set-up (Allrun -snappy)
+  // mesher = "snappy": snappyHexMesh makes the cells in Allrun from the fluid surface, on as
+  // many processes as the run has, and no gmsh mesh is made: the route past one machine's memory.
+  bool snappy_cells = false;
+  bool snappy = false;                  // write the snappyHexMesh set-up (with gmsh's cells: used by Allrun -snappy)
   double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
   int snappy_level = 2;                 // refinement levels at particles and walls
   double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
-  bool run_snappy = false;              // run_mesh = "snappy": the run meshes with snappyHexMesh first (needs snappy)
   // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
   // drop's discretisation error (Richardson extrapolation and the grid convergence index).
   struct Convergence {
@@ -62,19 +65,27 @@ struct CaseGeometry {
   double bed_bottom = 0.0, bed_top = 0.0;  // the floor and the top sphere; an empty container's inlet and outlet
 };
 
-// The case geometry of a bed (m) and the mesh of its fluid domain: the inlet and outlet are the
-// mesh's lowest and highest points, the rest comes from the bed's container and spheres.
-CaseGeometry case_geometry(const meshing::PolyMesh& mesh, const Bed& bed);
+// The case geometry of a bed (m) and the points of its fluid domain (the volume mesh's or the
+// fluid surface's): the inlet and outlet are their lowest and highest, the rest comes from the
+// bed's container and spheres.
+CaseGeometry case_geometry(const std::vector<Eigen::Vector3d>& points, const Bed& bed);
+
+// A point of the fluid domain as far as it can find from every sphere, wall, inlet and outlet
+// (m): snappyHexMesh keeps the cells connected to it. Searched on a lattice over the domain.
+Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g);
 
 // Bed section over which the pressure drop is measured: its planes and its void fraction as
 // meshed (cells with their centre between the planes over the container's volume between them),
 // from the mesh's cell geometry.
 struct BedSection {
   double z_low = 0.0, z_high = 0.0;
-  double void_fraction = 0.0;      // as meshed: the treated contacts and the facets included
+  // As meshed: the treated contacts and the facets included; unknown when snappyHexMesh makes
+  // the cells.
+  std::optional<double> void_fraction;
   double void_fraction_bed = 0.0;  // of the spheres as packed, exact (set by write_case)
 };
-BedSection bed_section(const meshing::CellGeometry& cells, const CaseGeometry& g, double exclude_d);
+// `cells` null: the planes only.
+BedSection bed_section(const meshing::CellGeometry* cells, const CaseGeometry& g, double exclude_d);
 
 // InputError when `case_dir` exists and `overwrite` is false (checked again by write_case;
 // callers check first to refuse before the long stages).
@@ -86,12 +97,12 @@ struct CaseInfo {
   CaseParams params;
   double velocity_m_s = 0.0;             // superficial inlet velocity
   double kinematic_viscosity_m2_s = 0.0;
-  long cells = 0;
+  long cells = 0;                        // written into constant/polyMesh (0 when snappyHexMesh makes them)
   BedSection section;                    // where the pressure drop is measured
   double aspect_ratio = 0.0;             // D_h / d, for the correlation
   double inlet_area_m2 = 0.0;
   double d_ref_m = 0.0;
-  double fluid_volume_m3 = 0.0;          // of the mesh's cells
+  std::optional<double> fluid_volume_m3;  // of the written cells
   // An empty container's known answer, the fully developed laminar gradient (Pa/m): the route's
   // verification. Unset for a bed, which is compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
@@ -100,12 +111,15 @@ struct CaseInfo {
 
 // Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
 // an existing case is replaced (only with `overwrite`) once the new one is complete:
-// constant/polyMesh, 0/U, 0/p, transport and turbulence properties, controlDict with pressure
-// and flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, and the
-// records `bedforge/scene.toml` and `bedforge/bed.csv`.
-CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh& mesh,
-                    const CaseGeometry& g, const Bed& bed, const CaseParams& p, const std::string& note,
-                    const std::string& scene_toml, const std::string& bed_csv, const std::string& fluid_stl);
+// constant/polyMesh (from `mesh`, gmsh's cells; null when p.snappy_cells), 0/U, 0/p, transport
+// and turbulence properties, controlDict with pressure and flow function objects, fvSchemes,
+// fvSolution, decomposeParDict, Allrun, Allclean, the records `bedforge/scene.toml` and
+// `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
+// (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
+CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
+                    const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
+                    const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                    const std::string& bed_csv, const std::filesystem::path& fluid_stl);
 
 // The flow solved in a case: the solver's convergence and the bed's pressure gradient.
 struct FlowResult {
@@ -113,6 +127,13 @@ struct FlowResult {
   double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
   std::string mesher;                    // what made the cells solved on: "gmsh tetrahedra", "gmsh polyhedral dual", "snappyHexMesh"
   long solved_cells = -1;                // the cells solved on, as Allrun's checkMesh counted them (-1: no checkMesh ran)
+  // Allrun's steps, each with its wall time and its largest process's peak memory (from GNU
+  // time when the machine has it: empty otherwise). On N processes that is the largest rank's.
+  struct Step {
+    std::string name;
+    double time_s = 0.0, peak_memory_mb = 0.0;
+  };
+  std::vector<Step> steps;
   long iterations = 0;
   bool converged = false;                // SIMPLE's own verdict at the residual targets
   double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
@@ -134,9 +155,8 @@ struct FlowResult {
   // dp/L / exact - 1. For a bed, unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;
   double relative_error_to_exact = 0.0;
-  double eisfeld_schnitzlein_pa_m = 0.0;      // the correlation at the section's meshed void fraction
-  double ratio_to_eisfeld_schnitzlein = 0.0;
-  double void_fraction_section = 0.0;
+  // The correlation at the section's meshed void fraction, when known (not on snappyHexMesh's cells).
+  std::optional<double> eisfeld_schnitzlein_pa_m, ratio_to_eisfeld_schnitzlein, void_fraction_section;
   // The same at the section's exact void fraction of the spheres as packed: the bed the
   // correlation describes, whatever the contact treatment and the facets did to it.
   double eisfeld_schnitzlein_bed_pa_m = 0.0;

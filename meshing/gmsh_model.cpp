@@ -19,12 +19,6 @@ GmshSession::GmshSession() {
 
 GmshSession::~GmshSession() { gmsh::finalize(); }
 
-namespace {
-
-std::string patch_type(const std::string& name) { return name == "inlet" || name == "outlet" ? "patch" : "wall"; }
-
-}  // namespace
-
 PolyMesh extract_poly_mesh() {
   std::vector<std::size_t> node_tags;
   std::vector<double> xyz, uvw;

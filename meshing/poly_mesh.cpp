@@ -10,6 +10,8 @@
 
 namespace bedforge::meshing {
 
+std::string patch_type(const std::string& name) { return name == "inlet" || name == "outlet" ? "patch" : "wall"; }
+
 Face::Face(std::initializer_list<int> points) : n(static_cast<int>(points.size())) {
   if (n < 3 || n > 4) throw std::invalid_argument("a face has 3 or 4 points");
   std::copy(points.begin(), points.end(), v.begin());

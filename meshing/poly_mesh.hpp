@@ -61,6 +61,9 @@ struct PolyMesh {
 // Cells are numbered bottom to top (by centroid z), which keeps the matrix bandwidth small in a
 // column. std::runtime_error when a cell face is on the boundary but in no patch, or a face is
 // shared by more than two cells, with its location.
+// OpenFOAM's type of a patch bedforge names: "patch" for inlet and outlet, else "wall".
+std::string patch_type(const std::string& name);
+
 PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& cells,
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
                               const std::vector<std::string>& names, const std::vector<std::string>& types);

@@ -4,20 +4,30 @@
 
 namespace bedforge::pipeline {
 
-CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CaseParams& p, const Provenance& prov,
-                     const std::string& scene_toml, const std::string& fluid_stl, const std::filesystem::path& case_dir,
-                     bool overwrite, const Console& console) {
+CaseStage case_stage(const meshing::PolyMesh* mesh, const meshing::TriangleMesh* surface, const Bed& bed,
+                     const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
+                     const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
+                     const Console& console) {
   const StageMeter meter;
   const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
+  // The domain's extent and patches: from gmsh's cells, or from the surface snappyHexMesh meshes.
+  std::vector<std::string> patches;
+  if (mesh)
+    for (const auto& patch : mesh->patches) patches.push_back(patch.name);
+  else
+    patches = surface->patches;
+  const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface->points, bed);
   CaseStage out;
-  out.info = cases::write_case(case_dir, overwrite, mesh, cases::case_geometry(mesh, bed), bed, p, note, scene_toml,
-                               bed_to_csv(bed, prov), fluid_stl);
+  out.info = cases::write_case(case_dir, overwrite, mesh, patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
+                               fluid_stl);
   out.report = out.info.to_json();
-  std::string line = fmt::format("case: {} cells in {}, Re_p {}, u {:.3g} m/s", mesh.cells, case_dir.string(),
-                                 p.reynolds, out.info.velocity_m_s);
-  if (bed.size() > 0)
-    line += fmt::format(", bed section eps {:.4f} (meshed {:.4f})", out.info.section.void_fraction_bed,
-                        out.info.section.void_fraction);
+  std::string line = mesh ? fmt::format("case: {} cells in {}", mesh->cells, case_dir.string())
+                          : fmt::format("case: snappyHexMesh's set-up in {}", case_dir.string());
+  line += fmt::format(", Re_p {}, u {:.3g} m/s", p.reynolds, out.info.velocity_m_s);
+  if (bed.size() > 0) {
+    line += fmt::format(", bed section eps {:.4f}", out.info.section.void_fraction_bed);
+    if (out.info.section.void_fraction) line += fmt::format(" (meshed {:.4f})", *out.info.section.void_fraction);
+  }
   if (p.run) {
     Progress progress("case", console.progress);
     const cases::FlowResult& flow = out.flow.emplace(cases::run_case(out.info, progress));
@@ -26,10 +36,12 @@ CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases:
     line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = ",
                         flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
                         flow.residual_p, flow.pressure_gradient_bed_pa_m);
-    line += flow.exact_pa_m ? fmt::format("exact laminar flow {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m,
-                                          100.0 * flow.relative_error_to_exact)
-                            : fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps ({:.3f} x at the meshed eps)",
-                                          flow.ratio_to_eisfeld_schnitzlein_bed, flow.ratio_to_eisfeld_schnitzlein);
+    if (flow.exact_pa_m)
+      line += fmt::format("exact laminar flow {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
+    else
+      line += fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps", flow.ratio_to_eisfeld_schnitzlein_bed);
+    if (flow.ratio_to_eisfeld_schnitzlein)
+      line += fmt::format(" ({:.3f} x at the meshed eps)", *flow.ratio_to_eisfeld_schnitzlein);
     line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.wall_share_of_drag);
     if (!flow.exact_pa_m)
       line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);

@@ -8,6 +8,7 @@
 #include "core/bed.hpp"
 #include "core/bed_io.hpp"
 #include "meshing/poly_mesh.hpp"
+#include "meshing/triangle_mesh.hpp"
 #include "pipeline/console.hpp"
 
 namespace bedforge::pipeline {
@@ -19,11 +20,13 @@ struct CaseStage {
   nlohmann::json report;                  // stages.case, with "flow" and "summary"
 };
 
-// Writes the case for `mesh` (the fluid domain of `bed`, m) into `case_dir` (replacing one only
-// with `overwrite`), recording `scene_toml`, the bed and `fluid_stl` (the snappyHexMesh route's
-// surface; empty without it), and runs it when params.run.
-CaseStage case_stage(const meshing::PolyMesh& mesh, const Bed& bed, const cases::CaseParams& params,
-                     const Provenance& provenance, const std::string& scene_toml, const std::string& fluid_stl,
-                     const std::filesystem::path& case_dir, bool overwrite, const Console& console);
+// Writes the case of `bed` (m) into `case_dir` (replacing one only with `overwrite`), recording
+// `scene_toml` and the bed, and runs it when params.run. On gmsh's cells `mesh`; or, when
+// params.snappy_cells, with no cells (mesh null) for snappyHexMesh to make from `surface`, the
+// fluid surface whose ASCII STL is `fluid_stl` (also needed, with params.snappy, beside gmsh's).
+CaseStage case_stage(const meshing::PolyMesh* mesh, const meshing::TriangleMesh* surface, const Bed& bed,
+                     const cases::CaseParams& params, const Provenance& provenance, const std::string& scene_toml,
+                     const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
+                     const Console& console);
 
 }  // namespace bedforge::pipeline

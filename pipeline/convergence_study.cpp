@@ -55,7 +55,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.level = level;
   l.scale = scale;
   l.cells = solved.flow->solved_cells >= 0 ? solved.flow->solved_cells : solved.info.cells;  // the cells solved on
-  l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3 / static_cast<double>(l.cells));
+  l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3.value() / static_cast<double>(l.cells));  // gmsh cells: known
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
   l.wall_share_of_drag = solved.flow->wall_share_of_drag;
@@ -126,7 +126,9 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       scale *= std::pow(target_h_m / h, 1.0 / alpha);
     }
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
-    const CaseStage c = case_stage(m->volume->mesh, bed, scene.case_params, prov, scene_to_toml(scene.table), {},
+    cases::CaseParams params = scene.case_params;
+    params.snappy = false;  // a coarser level is solved on its gmsh cells only
+    const CaseStage c = case_stage(&m->volume->mesh, nullptr, bed, params, prov, scene_to_toml(scene.table), {},
                                    case_dir, true, console);
     StudyLevel solved = study_level(c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "core/atomic_file.hpp"
@@ -12,8 +13,8 @@
 #include "core/version.hpp"
 #include "pipeline/analysis_stage.hpp"
 #include "pipeline/output_files.hpp"
-#ifdef BEDFORGE_HAVE_CGAL
 #include "meshing/stl_io.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
 #include "meshing/surface_checks.hpp"
 #include "pipeline/surface_stage.hpp"
 #endif
@@ -126,10 +127,17 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
   if (params.convergence.levels > 0)
     throw InputError("case.convergence needs the surface and mesh stages, which this bedforge was built without");
 #endif
-  const meshing::PolyMesh mesh = meshing::read_msh(dir / "fluid.msh");
+  // gmsh's cells, or for snappyHexMesh's the surface it meshes.
+  const fs::path stl = dir / "fluid.stl";
+  std::optional<meshing::PolyMesh> mesh;
+  std::optional<meshing::TriangleMesh> surface;
+  if (params.snappy_cells)
+    surface = meshing::read_stl_ascii_by_patch(read_file(stl), stl.string());
+  else
+    mesh = meshing::read_msh(dir / "fluid.msh");
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
-  const CaseStage c = case_stage(mesh, d.bed, params, prov, scene_to_toml(d.scene),
-                                 params.snappy ? read_file(dir / "fluid.stl") : std::string(), dir / "case", overwrite,
+  const CaseStage c = case_stage(mesh ? &*mesh : nullptr, surface ? &*surface : nullptr, d.bed, params, prov,
+                                 scene_to_toml(d.scene), params.snappy ? stl : fs::path(), dir / "case", overwrite,
                                  console);
   nlohmann::json entry = c.report;
 #ifdef BEDFORGE_HAVE_VOLUME_MESH

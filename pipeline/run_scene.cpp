@@ -12,6 +12,7 @@
 #include "core/report.hpp"
 #include "core/stage_meter.hpp"
 #include "core/version.hpp"
+#include "meshing/stl_io.hpp"
 #include "pipeline/analysis_stage.hpp"
 #include "pipeline/output_files.hpp"
 #include "pipeline/pack_stage.hpp"
@@ -127,15 +128,22 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
           opt.wants.mesh ? fmt::format("{} (surface and [mesh] unchanged)", (dir / "fluid.msh").string())
                          : std::string("the mesh's record (surface and [mesh] unchanged; its case is reused)"));
   }
-  surface.reset();  // the case needs the volume mesh only
+  // The case needs the volume mesh only, or for snappyHexMesh's cells the surface (read back when
+  // it was not built in this run).
+  std::shared_ptr<const meshing::TriangleMesh> fluid;
+  if (plan.case_.build && scene.case_params.snappy_cells)
+    fluid = surface ? std::shared_ptr<const meshing::TriangleMesh>(surface, &surface->fluid)
+                    : std::make_shared<const meshing::TriangleMesh>(
+                          meshing::read_stl_ascii_by_patch(read_file(dir / "fluid.stl"), (dir / "fluid.stl").string()));
+  surface.reset();
 #endif
   files.write(dir);
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (plan.case_.build) {
-    const CaseStage c = case_stage(*mesh, bed, scene.case_params, prov, read_file(dir / "scene.toml"),
-                                   scene.case_params.snappy ? read_file(dir / "fluid.stl") : std::string(),
-                                   dir / "case", opt.overwrite, console);
+    const CaseStage c = case_stage(mesh.get(), fluid.get(), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
+                                   scene.case_params.snappy ? dir / "fluid.stl" : fs::path(), dir / "case",
+                                   opt.overwrite, console);
     nlohmann::json entry = c.report;
     if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, report, dir, console, entry);
     record("case", std::move(entry), keys.case_);

@@ -31,7 +31,8 @@ std::string downstream_key(const nlohmann::json& scene, const std::string& upstr
 
 Wants run_wants(const Scene& scene) {
   return {scene.wants("positions"), scene.wants("vtp"),  scene.wants("analysis"),
-          scene.wants("stl") || scene.case_params.snappy, scene.wants("mesh"), scene.wants("case")};
+          scene.wants("stl") || scene.case_params.snappy, scene.wants("mesh"), scene.wants("case"),
+          !scene.case_params.snappy_cells};
 }
 
 Wants pack_wants(const Scene& scene) { return {true, scene.wants("vtp"), false, false, false, false}; }
@@ -45,7 +46,7 @@ StageKeys stage_keys(const Scene& scene) {
   k.analysis = downstream_key(sc, k.pack, {"analysis"});
   k.surface = downstream_key(sc, k.pack, {"contacts", "surface"});
   k.mesh = downstream_key(sc, k.surface, {"mesh"});
-  k.case_ = downstream_key(sc, k.mesh, {"case"});
+  k.case_ = downstream_key(sc, scene.case_params.snappy_cells ? k.surface : k.mesh, {"case"});
   return k;
 }
 
@@ -79,9 +80,10 @@ RunPlan plan_run(const Wants& w, const StageKeys& keys, const nlohmann::json& pr
   p.case_.involved = w.case_;
   p.case_.build = w.case_ && (case_.is_null() || !exists("case/Allrun"));
   const bool mesh_on_disk = !mesh.is_null() && exists("fluid.msh");
-  p.mesh.involved = w.mesh || w.case_;
-  p.mesh.build = (w.mesh || p.case_.build) && !mesh_on_disk;
-  p.load_mesh = p.case_.build && !p.mesh.build;
+  const bool case_needs_mesh = p.case_.build && w.case_on_mesh;
+  p.mesh.involved = w.mesh || (w.case_ && w.case_on_mesh);
+  p.mesh.build = (w.mesh || case_needs_mesh) && !mesh_on_disk;
+  p.load_mesh = case_needs_mesh && !p.mesh.build;
   p.surface.involved = w.stl || p.mesh.involved;
   p.surface.build = p.mesh.build || (w.stl && (surface.is_null() || !all_exist(surface_files)));
   p.analysis.involved = w.analysis;

@@ -15,6 +15,7 @@ struct Wants {
   bool stl = false;        // the surface's STL and VTP files (also for the snappyHexMesh route)
   bool mesh = false;       // fluid.msh
   bool case_ = false;      // the OpenFOAM case in case/
+  bool case_on_mesh = true;  // the case solves on the mesh stage's cells (not on snappyHexMesh's)
 };
 // `bedforge run`: the scene's [outputs]. `bedforge pack` and `import`: the bed only.
 Wants run_wants(const Scene& scene);
@@ -22,7 +23,8 @@ Wants pack_wants(const Scene& scene);
 
 // Each stage's cache key (see stage_key): a hash of its own scene sections and of the key of
 // the stage it builds on, so a change upstream reaches every later stage. The pack key covers
-// [container], [particles], [packing], the bedforge version and an imported file's content.
+// [container], [particles], [packing], the bedforge version and an imported file's content; the
+// case's builds on the mesh's, or on the surface's when snappyHexMesh makes its cells.
 struct StageKeys {
   std::string pack, analysis, surface, mesh, case_;
 };
@@ -38,7 +40,8 @@ struct StagePlan {
 // The plan of a run in a directory that may hold an earlier one. Decided from the last stage
 // backwards: a stage whose key matches and whose files are there is reused, and what it was made
 // from is built only when another stage needs it in memory. A mesh is made from the surface in
-// memory, never from its STL read back, so building a mesh builds its surface.
+// memory, never from its STL read back, so building a mesh builds its surface. A case on
+// snappyHexMesh's cells needs no mesh, only the surface's files.
 struct RunPlan {
   StagePlan pack, analysis, surface, mesh, case_;
   bool load_bed = false;       // read the reused bed from bed.csv: a stage built after it needs it

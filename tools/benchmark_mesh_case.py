@@ -19,11 +19,16 @@ gaps:   the same bed, surface edge 0.2 d, refined only where surfaces face each 
 layers: a = 4, N = 40 (seed 1), shrink, surface edge 0.1 d without and with 3 prism layers on the
         particles ([mesh.layers] thickness_d as given), and 0.07 d without, solved the same way;
         then the studies' bridged a = 5, N = 500 bed at 0.15 d without and with 3 layers of 0.02 d.
-snappy: the finest level's bed, meshed by Allrun -snappy (snappyHexMesh on 2 processes) and solved
-        the same way: cells, time, checkMesh, dp/L.
+snappy: the finest level's bed, meshed by snappyHexMesh (case.mesher = "snappy", 2 processes) and
+        solved the same way: cells, time, checkMesh, dp/L.
 scale:  a = 10, N = 4000, the default scene's settings (shrink, 0.1 d), scene to a checkMesh-clean
         case, with the time and peak memory of every stage, bytes per cell.
 scale_1e4: the same at a = 14, N = 1e4 with bridges (0.1 d).
+scale_out: the scale_1e4 scene by the snappyHexMesh route (case.mesher = "snappy": no gmsh mesh;
+        --snappy-cell-d, --snappy-level), meshed and solved on 2 processes, then meshed on 1 (the
+        solver cut to one iteration): each Allrun step's time and its largest process's peak
+        memory, checkMesh, dp/L; beside it the gmsh route on the same bed at a surface edge of
+        --scale-out-gmsh-edge d, solved the same way.
 study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedforge run` with
         [case.convergence] (--levels meshes, --ratio between them): each level's cells, dp/L and
         time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
@@ -68,7 +73,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "study", "study_gaps", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "solver", "verification"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -168,8 +173,8 @@ def snappy(tmp, edge):
     if not os.path.exists(os.path.join(path, "fluid.msh")):
         open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, False))
         timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
-    wall, _ = timed([BEDFORGE, "--quiet", "case", path, "--snappy", "--run", "--run-mesh", "snappy", "--processors",
-                     "2", "--overwrite"])
+    wall, _ = timed([BEDFORGE, "--quiet", "case", path, "--mesher", "snappy", "--run", "--processors", "2",
+                     "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     mb = peak_mb(rep)
     flow = rep["stages"]["case"]["flow"]
@@ -203,6 +208,58 @@ def scale(tmp, a, n, treatment):
                              for attempt in rep["stages"]["mesh"].get("attempts", [])]}
     print(row, flush=True)
     return row
+
+
+def check_mesh_log(log):
+    """Allrun's own checkMesh (decomposed cells are checked in parallel): (Mesh OK?, cells, max
+    non-orthogonality, max skewness)."""
+    cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
+    non_ortho = float(re.search(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log).group(1))
+    skew = float(re.search(r"Max skewness = ([0-9.eE+-]+)", log).group(1))
+    return "Mesh OK." in log, cells, non_ortho, skew
+
+
+def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=10000, treatment="bridge", edge=0.1):
+    rows = []
+    for ranks, its in ((2, iterations), (1, 1)):
+        path = os.path.join(tmp, f"scale_out_{ranks}")
+        text = scene(a, n, treatment, edge, True, iterations=its).replace("processors = 2", f"processors = {ranks}")
+        text = text.replace("[case]\n", f"[case]\nmesher = \"snappy\"\nsnappy_cell_d = {snappy_cell_d}\n"
+                                        f"snappy_level = {snappy_level}\n")
+        text = text.replace('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')
+        open(path + ".toml", "w").write(text)
+        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
+        rep = json.load(open(os.path.join(path, "report.json")))
+        flow = rep["stages"]["case"]["flow"]
+        ok, cells, non_ortho, skew = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+        row = {"route": "snappy", "ranks": ranks, "a": a, "n": n, "treatment": treatment, "edge_d": edge,
+               "snappy_cell_d": snappy_cell_d, "snappy_level": snappy_level, "wall_s": wall,
+               "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
+               "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
+               "cells": cells, "mesh_ok": ok, "max_non_orthogonality": non_ortho, "max_skewness": skew,
+               "iterations": flow["iterations"], "iteration_cap": its, "converged": flow["converged"],
+               "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"],
+               "flow_rate_error": flow["flow_rate_relative_error"]}
+        print(row, flush=True)
+        rows.append(row)
+        shutil.rmtree(path)  # gigabytes of surface and cells
+    path = os.path.join(tmp, "scale_out_gmsh")
+    open(path + ".toml", "w").write(scene(a, n, treatment, gmsh_edge, True, iterations=iterations))
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
+    rep = json.load(open(os.path.join(path, "report.json")))
+    flow = rep["stages"]["case"]["flow"]
+    ok, cells, non_ortho, skew = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+    row = {"route": "gmsh", "ranks": 2, "a": a, "n": n, "treatment": treatment, "edge_d": gmsh_edge, "wall_s": wall,
+           "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
+           "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
+           "tetrahedra": rep["stages"]["mesh"]["cells"], "cells": cells, "mesh_ok": ok,
+           "max_non_orthogonality": non_ortho, "max_skewness": skew, "iterations": flow["iterations"],
+           "iteration_cap": iterations, "converged": flow["converged"], "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"],
+           "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"], "flow_rate_error": flow["flow_rate_relative_error"]}
+    print(row, flush=True)
+    rows.append(row)
+    shutil.rmtree(path)
+    return rows
 
 
 def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0):
@@ -413,6 +470,61 @@ def scale_lines(r):
     return lines
 
 
+def scale_out_lines(rows):
+    snappy = {r["ranks"]: r for r in rows if r["route"] == "snappy"}
+    gmsh = next(r for r in rows if r["route"] == "gmsh")
+    two, one = snappy[2], snappy[1]
+    finest = two["snappy_cell_d"] / 2 ** two["snappy_level"]
+    lines = [f"## Past one machine: a = {two['a']}, N = {two['n']}, {two['treatment']}, by the snappyHexMesh route", "",
+             *stamp(rows),
+             f"The scale_1e4 scene (surface edge {two['edge_d']} d, {two['surface_triangles']} triangles) with "
+             f"`case.mesher = \"snappy\"`: no gmsh mesh is made; snappyHexMesh refines background cells of "
+             f"{two['snappy_cell_d']} d to level {two['snappy_level']} at walls and particles (cells of {finest:.3g} d "
+             "there), then simpleFoam solves on the decomposed cells as they are. Each step of the case's Allrun with "
+             "its wall time and its largest process's peak memory (GNU time: on 2 processes, the larger rank's). "
+             f"The run on 1 process stops simpleFoam after one iteration: it measures the meshing.", "",
+             "| step | 2 processes: s | MB per process | 1 process: s | MB |", "|---|---|---|---|---|"]
+    steps1 = {s["step"]: s for s in one["steps"]}
+    for s2 in two["steps"]:
+        s1 = steps1.get(s2["step"])
+        lines.append(f"| {s2['step']} | {s2['time_s']:.0f} | {s2['peak_memory_mb']:.0f} | "
+                     + (f"{s1['time_s']:.0f} | {s1['peak_memory_mb']:.0f} |" if s1 else "not run | |"))
+    lines += ["", "| route | processes | cells | checkMesh | max non-ortho | max skewness | simpleFoam its | dp/L (Pa/m) | "
+              "/ E&S at the bed's eps | scene to result s |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in (two, one, gmsh):
+        name = (f"snappyHexMesh ({r['snappy_cell_d']} d, level {r['snappy_level']})" if r["route"] == "snappy"
+                else f"gmsh, surface edge {r['edge_d']} d, polyhedral dual of {r['tetrahedra']} tetrahedra")
+        result = (f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es_bed']:.3f}" if r["iteration_cap"] > 1
+                  else "(one iteration) | ")
+        its = f"{r['iterations']}" + ("" if r["converged"] or r["iteration_cap"] == 1 else ", not converged")
+        lines.append(f"| {name} | {r['ranks']} | {r['cells']} | {'OK' if r['mesh_ok'] else 'FAILED'} | "
+                     f"{r['max_non_orthogonality']:.1f} | {r['max_skewness']:.2f} | {its} | {result} | {r['wall_s']:.0f} |")
+    # Memory per process: what every rank holds (the surface and its search tree) and what divides
+    # among the ranks (the cells), from the meshing step's peak on 1 and 2 processes.
+    m1 = next(s["peak_memory_mb"] for s in one["steps"] if s["step"] == "snappyHexMesh")
+    m2 = next(s["peak_memory_mb"] for s in two["steps"] if s["step"] == "snappyHexMesh")
+    divided, held = 2 * (m1 - m2), 2 * m2 - m1
+    sfe = next(s for s in two["steps"] if s["step"] == "surfaceFeatureExtract")
+    split = (f"Read as a part every process holds and a part the processes share, that is {held:.0f} MB held by each "
+             f"({held * 1e6 / two['surface_triangles']:.0f} bytes per surface triangle) and {divided:.0f} MB shared "
+             f"({divided * 1e6 / two['cells']:.0f} bytes per cell): on N processes about {held:.0f} + {divided:.0f} / N MB "
+             "each for this bed, both parts growing in proportion to the bed at the same settings."
+             if divided > 0 and held > 0 else
+             "The two peaks do not split into a part every process holds and a part they share.")
+    lines += ["", f"snappyHexMesh's peak per process: {m1:.0f} MB on 1 process, {m2:.0f} MB on 2. {split} "
+              f"surfaceFeatureExtract runs once, serially, on the whole surface: {sfe['time_s']:.0f} s, {sfe['peak_memory_mb']:.0f} MB. "
+              f"The gmsh route on the same bed took {gmsh['wall_s']:.0f} s scene to result, its stages at a peak of "
+              f"{max(gmsh['stages_peak_mb'].values()):.0f} MB in one process and OpenFOAM's at "
+              f"{max(s['peak_memory_mb'] for s in gmsh['steps']):.0f} MB per process; snappyHexMesh's dp/L is "
+              + (f"{two['dp_dz_pa_m'] / gmsh['dp_dz_pa_m']:.3f} times gmsh's." if two["iteration_cap"] > 1 else "not measured."),
+              "", "For more processes a cluster user sets `case.processors` (or `./Allrun -np N`); the case decomposes "
+              "by `hierarchical` slabs along the column (`decomposeParDict`, n = (1 1 N)); for hundreds of processes "
+              "n = (a b c) with a b c = N keeps the slabs from getting thinner than a few cells, or `scotch` where the "
+              "OpenFOAM build has it (Debian's ships a stub). Each process also holds the whole surface, so the part "
+              "held by each sets the floor of memory per process.", ""]
+    return lines
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -514,6 +626,8 @@ def write(results):
     for key in ("scale", "scale_1e4"):
         if key in results:
             lines += scale_lines(results[key])
+    if "scale_out" in results:
+        lines += scale_out_lines(results["scale_out"])
     for key in ("study", "study_gaps"):
         if key in results:
             lines += study_lines(results[key])
@@ -658,6 +772,10 @@ def main():
     ap.add_argument("--gap-cells", type=float, nargs="+", default=[2, 3])
     ap.add_argument("--layer-thickness", type=float, nargs="+", default=[0.02, 0.05])
     ap.add_argument("--levels", type=int, default=3, help="study: meshes in all")
+    ap.add_argument("--snappy-cell-d", type=float, default=0.25, help="scale_out: snappyHexMesh's background cell (d)")
+    ap.add_argument("--snappy-level", type=int, default=1, help="scale_out: its refinement levels at the surfaces")
+    ap.add_argument("--scale-out-gmsh-edge", type=float, default=0.15, help="scale_out: the gmsh route's surface edge (d)")
+    ap.add_argument("--scale-out-iterations", type=int, default=500, help="scale_out: simpleFoam's iteration cap")
     ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
     ap.add_argument("--study-gap-edge", type=float, default=0.15, help="study_gaps: finest surface edge (d)")
     ap.add_argument("--study-gap-cells", type=float, default=3, help="study_gaps: surface.cells_per_gap")
@@ -689,6 +807,10 @@ def main():
             write(results)
         if "scale" in args.only:
             results["scale"] = {**commit_and_date(), **scale(tmp, 10, 4000, "shrink")}
+            write(results)
+        if "scale_out" in args.only:
+            results["scale_out"] = [{**commit_and_date(), **r} for r in scale_out(
+                tmp, args.snappy_cell_d, args.snappy_level, args.scale_out_gmsh_edge, args.scale_out_iterations)]
             write(results)
         if "scale_1e4" in args.only:
             results["scale_1e4"] = {**commit_and_date(), **scale(tmp, 14, 10000, "bridge")}

@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev libtbb-dev
-          libgoogle-perftools-dev gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib)
+          libgoogle-perftools-dev gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib time)
 # The test suite also builds the fuzz targets: clang, its libFuzzer runtime and its OpenMP.
 if [ "${1:-}" = test ]; then packages+=(clang libclang-rt-14-dev libomp-dev); fi
 missing=()

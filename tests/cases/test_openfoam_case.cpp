@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "support/cli.hpp"
 
@@ -159,10 +160,10 @@ TEST(OpenFoamCase, ACaseWithoutAMeshAndAMeshWithoutAClosedSurfaceAreRefused) {
   EXPECT_EQ(no_mesh.status, 2) << no_mesh.output;
   EXPECT_NE(no_mesh.output.find("fluid.msh"), std::string::npos) << no_mesh.output;
   EXPECT_FALSE(fs::exists(dir / "case"));
-  // Solving on a snappyHexMesh mesh needs its set-up.
-  const Result no_set_up = bedforge("case " + dir.string() + " --run --run-mesh snappy");
-  EXPECT_EQ(no_set_up.status, 2) << no_set_up.output;
-  EXPECT_NE(no_set_up.output.find("case.run_mesh"), std::string::npos) << no_set_up.output;
+  // snappyHexMesh's cells need no gmsh mesh but the surface they are made from.
+  const Result no_surface = bedforge("case " + dir.string() + " --mesher snappy");
+  EXPECT_EQ(no_surface.status, 2) << no_surface.output;
+  EXPECT_NE(no_surface.output.find("fluid.stl"), std::string::npos) << no_surface.output;
   EXPECT_FALSE(fs::exists(dir / "case"));
   // An STL with one facet cut out: the mesh stage names the file and where it is open.
   ASSERT_EQ(bedforge("--quiet surface " + dir.string() + "").status, 0);
@@ -282,26 +283,40 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   EXPECT_LT(ratio, 1.2) << flow.dump();
 }
 
-// The case's own Allrun -snappy -np 2 (snappyHexMesh under MPI, reconstructParMesh) through
-// `case --run --run-mesh snappy`, cut to a few solver iterations: the mesh passes checkMesh,
-// keeps the patch names the 0/ files use, and the report counts its cells.
-TEST(OpenFoamCase, TheSnappyHexMeshRouteGivesAMeshCheckMeshPasses) {
+// snappyHexMesh's cells (case.mesher = "snappy"), the route past one machine: the run makes no
+// gmsh mesh, and the case's Allrun -np 2 meshes under MPI and solves on the decomposed cells as
+// they are, cut to a few solver iterations. The mesh passes checkMesh and keeps the patch names
+// the 0/ files use; the report counts its cells and times Allrun's steps.
+TEST(OpenFoamCase, SnappyHexMeshCellsNeedNoGmshMeshAndPassCheckMesh) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (snappyHexMesh) not on PATH";
-  const fs::path dir = meshed_bed("snappy");
-  const Result r = bedforge("--quiet case " + dir.string() +
-                            " --snappy --run --run-mesh snappy --processors 2 --iterations 5");
+  const fs::path dir = fresh_dir("snappy"), scene = fresh_dir("snappy_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml")
+      << "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n[surface]\nedge_length_d = 0.1\n"
+         "[case]\nmesher = \"snappy\"\nsnappy_level = 1\nrun = true\nprocessors = 2\niterations = 5\n"
+         "[outputs]\nfiles = [\"positions\", \"case\"]\n";
+  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
   ASSERT_EQ(r.status, 0) << r.output << read(dir / "case/log.Allrun");
+  const auto report = nlohmann::json::parse(read(dir / "report.json"));
+  EXPECT_FALSE(report["stages"].contains("mesh")) << report["stages"].dump();
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+  EXPECT_TRUE(fs::exists(dir / "case/constant/triSurface/fluid.stl"));
   const std::string check = read(dir / "case/log.checkMesh");
   EXPECT_NE(check.find("Mesh OK."), std::string::npos) << check;
-  EXPECT_TRUE(fs::exists(dir / "case/log.reconstructParMesh"));
   // The STL's named solids became the patches the 0/ files and function objects refer to.
-  const std::string boundary = read(dir / "case/constant/polyMesh/boundary");
-  for (const char* patch : {"inlet", "outlet", "wall", "particles"})
+  const std::string boundary = read(dir / "case/processor0/constant/polyMesh/boundary");
+  for (const char* patch : {"inlet", "wall", "particles"})
     EXPECT_NE(boundary.find(std::string("    ") + patch + "\n"), std::string::npos) << patch << "\n" << boundary;
-  const auto flow = nlohmann::json::parse(read(dir / "report.json"))["stages"]["case"]["flow"];
+  const auto flow = report["stages"]["case"]["flow"];
   const auto at = check.find("cells:");
   ASSERT_NE(at, std::string::npos);
   EXPECT_EQ(flow["mesh"]["mesher"], "snappyHexMesh");
   EXPECT_EQ(flow["mesh"]["cells"].get<long>(), std::atol(check.c_str() + at + 6));
   EXPECT_EQ(flow["iterations"].get<long>(), 5);
+  EXPECT_TRUE(flow["void_fraction_section"].is_null()) << flow.dump();  // no cells of ours to measure it on
+  // Allrun's steps as GNU time saw them (setup.sh installs it), the meshing among them.
+  std::vector<std::string> steps;
+  for (const auto& step : flow["allrun_steps"]) steps.push_back(step["step"]);
+  EXPECT_EQ(steps, (std::vector<std::string>{"blockMesh", "surfaceFeatureExtract", "decomposePar", "snappyHexMesh",
+                                             "checkMesh", "simpleFoam"}));
 }
