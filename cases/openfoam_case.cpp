@@ -115,7 +115,8 @@ Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g) {
   const Eigen::Array3i n = ((hi - lo) / step).array().floor().cast<int>().max(1);
   std::vector<std::size_t> order(bed.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return bed.centres[i].z() < bed.centres[j].z(); });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t i, std::size_t j) { return bed.centres[i].z() < bed.centres[j].z(); });
   std::vector<double> zs(order.size());
   for (std::size_t k = 0; k < order.size(); ++k) zs[k] = bed.centres[order[k]].z();
   double r_max = 0.0;
@@ -127,18 +128,21 @@ Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g) {
   for (int k = 0; k < n.z(); ++k)
     for (int i = 0; i < n.x(); ++i)
       for (int j = 0; j < n.y(); ++j) {
-        const Eigen::Vector3d q = lo + (Eigen::Array3d(i, j, k) + 0.5).matrix().cwiseProduct(hi - lo).cwiseQuotient(n.cast<double>().matrix());
-        double clearance = std::min(q.z() - g.inlet_z, g.outlet_z - q.z());
-        // The walls: a sphere of radius `clearance` at q overlaps a wall by how much nearer it is.
+        const Eigen::Vector3d q =
+            lo + ((Eigen::Array3d(i, j, k) + 0.5) * (hi - lo).array() / n.cast<double>()).matrix();
+        const double ends = std::min(q.z() - g.inlet_z, g.outlet_z - q.z());
+        double clearance = ends;
+        // The walls: a sphere of that radius at q overlaps a wall by how much nearer the wall is.
         WallContact touch[Container::kMaxWallContacts];
-        for (int w = 0, m = c.wall_contacts(q, clearance, touch); w < m; ++w)
-          clearance = std::min(clearance, clearance - touch[w].overlap);
+        for (int w = 0, m = c.wall_contacts(q, ends, touch); w < m; ++w)
+          clearance = std::min(clearance, ends - touch[w].overlap);
         const std::size_t at = std::lower_bound(zs.begin(), zs.end(), q.z()) - zs.begin();
         for (std::size_t up = at, down = at; clearance > best_clearance && (up < zs.size() || down > 0);) {
           const bool take_up = down == 0 || (up < zs.size() && zs[up] - q.z() < q.z() - zs[down - 1]);
           const std::size_t s = take_up ? up++ : --down;
           if (std::abs(zs[s] - q.z()) - r_max >= clearance) break;
-          clearance = std::min(clearance, per.separation(bed.centres[order[s]], q).norm() - 0.5 * bed.diameters[order[s]]);
+          clearance =
+              std::min(clearance, per.separation(bed.centres[order[s]], q).norm() - 0.5 * bed.diameters[order[s]]);
         }
         if (clearance > best_clearance) best_clearance = clearance, best = q;
       }

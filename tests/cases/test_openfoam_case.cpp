@@ -320,3 +320,4 @@ TEST(OpenFoamCase, SnappyHexMeshCellsNeedNoGmshMeshAndPassCheckMesh) {
   EXPECT_EQ(steps, (std::vector<std::string>{"blockMesh", "surfaceFeatureExtract", "decomposePar", "snappyHexMesh",
                                              "checkMesh", "simpleFoam"}));
 }
+

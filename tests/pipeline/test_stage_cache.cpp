@@ -90,6 +90,24 @@ TEST(StageCache, OnlyTheCaseChangedRebuildsTheCaseOnTheMeshOnDiskElseOnANewMesh)
   EXPECT_FALSE(no_msh.load_mesh || no_msh.write_bed_csv);
 }
 
+// snappyHexMesh's cells (case.mesher = "snappy"): the case needs the surface's files and no mesh.
+TEST(StageCache, ACaseOnSnappyHexMeshCellsBuildsNoMesh) {
+  const Wants snappy{true, false, false, true, false, true, false};
+  const RunPlan first = plan_run(snappy, kKeys, nullptr, Directory{});
+  EXPECT_TRUE(first.surface.build && first.case_.build);
+  EXPECT_FALSE(first.mesh.build || first.mesh.involved || first.load_mesh);
+  // Only the case changed: rebuilt on the surface's files as they are, with no mesh read back.
+  StageKeys changed = kKeys;
+  changed.case_ = "other-case-key";
+  const RunPlan case_only = plan_run(snappy, changed, complete_report(), kEverything);
+  EXPECT_TRUE(case_only.case_.build);
+  EXPECT_FALSE(case_only.surface.build || case_only.mesh.build || case_only.load_mesh || case_only.mesh.involved);
+  // The fluid.msh the user asked for is still made.
+  Wants with_mesh = snappy;
+  with_mesh.mesh = true;
+  EXPECT_TRUE(plan_run(with_mesh, kKeys, nullptr, Directory{}).mesh.build);
+}
+
 TEST(StageCache, OnlyTheMeshChangedRebuildsSurfaceMeshAndCaseOnTheSameBed) {
   StageKeys changed = kKeys;
   changed.mesh = "other-mesh-key";
