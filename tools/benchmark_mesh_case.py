@@ -212,11 +212,12 @@ def scale(tmp, a, n, treatment):
 
 def check_mesh_log(log):
     """Allrun's own checkMesh (decomposed cells are checked in parallel): (Mesh OK?, cells, max
-    non-orthogonality, max skewness)."""
+    non-orthogonality, max skewness, total volume m^3)."""
     cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
     non_ortho = float(re.search(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log).group(1))
     skew = float(re.search(r"Max skewness = ([0-9.eE+-]+)", log).group(1))
-    return "Mesh OK." in log, cells, non_ortho, skew
+    volume = float(re.search(r"Total volume = ([0-9.eE+-]+)", log).group(1))
+    return "Mesh OK." in log, cells, non_ortho, skew, volume
 
 
 def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=10000, treatment="bridge", edge=0.1):
@@ -231,12 +232,13 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
         wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
         rep = json.load(open(os.path.join(path, "report.json")))
         flow = rep["stages"]["case"]["flow"]
-        ok, cells, non_ortho, skew = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+        ok, cells, non_ortho, skew, volume = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
         row = {"route": "snappy", "ranks": ranks, "a": a, "n": n, "treatment": treatment, "edge_d": edge,
                "snappy_cell_d": snappy_cell_d, "snappy_level": snappy_level, "wall_s": wall,
                "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
                "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
                "cells": cells, "mesh_ok": ok, "max_non_orthogonality": non_ortho, "max_skewness": skew,
+               "volume_error": volume / rep["stages"]["surface"]["fluid_volume_exact_m3"] - 1,
                "iterations": flow["iterations"], "iteration_cap": its, "converged": flow["converged"],
                "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"],
                "flow_rate_error": flow["flow_rate_relative_error"]}
@@ -248,12 +250,13 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
     rep = json.load(open(os.path.join(path, "report.json")))
     flow = rep["stages"]["case"]["flow"]
-    ok, cells, non_ortho, skew = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+    ok, cells, non_ortho, skew, volume = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
     row = {"route": "gmsh", "ranks": 2, "a": a, "n": n, "treatment": treatment, "edge_d": gmsh_edge, "wall_s": wall,
            "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
            "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
            "tetrahedra": rep["stages"]["mesh"]["cells"], "cells": cells, "mesh_ok": ok,
-           "max_non_orthogonality": non_ortho, "max_skewness": skew, "iterations": flow["iterations"],
+           "max_non_orthogonality": non_ortho, "max_skewness": skew,
+           "volume_error": volume / rep["stages"]["surface"]["fluid_volume_exact_m3"] - 1, "iterations": flow["iterations"],
            "iteration_cap": iterations, "converged": flow["converged"], "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"],
            "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"], "flow_rate_error": flow["flow_rate_relative_error"]}
     print(row, flush=True)
@@ -489,16 +492,19 @@ def scale_out_lines(rows):
         s1 = steps1.get(s2["step"])
         lines.append(f"| {s2['step']} | {s2['time_s']:.0f} | {s2['peak_memory_mb']:.0f} | "
                      + (f"{s1['time_s']:.0f} | {s1['peak_memory_mb']:.0f} |" if s1 else "not run | |"))
-    lines += ["", "| route | processes | cells | checkMesh | max non-ortho | max skewness | simpleFoam its | dp/L (Pa/m) | "
-              "/ E&S at the bed's eps | scene to result s |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines += ["", "| route | processes | cells | checkMesh | max non-ortho | max skewness | fluid volume against the exact "
+              "| simpleFoam its | dp/L (Pa/m) | / E&S at the bed's eps | scene to result s |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in (two, one, gmsh):
         name = (f"snappyHexMesh ({r['snappy_cell_d']} d, level {r['snappy_level']})" if r["route"] == "snappy"
                 else f"gmsh, surface edge {r['edge_d']} d, polyhedral dual of {r['tetrahedra']} tetrahedra")
         result = (f"{r['dp_dz_pa_m']:.4g} | {r['ratio_es_bed']:.3f}" if r["iteration_cap"] > 1
                   else "(one iteration) | ")
         its = f"{r['iterations']}" + ("" if r["converged"] or r["iteration_cap"] == 1 else ", not converged")
+        volume = f"{100 * r['volume_error']:+.2f} %" if "volume_error" in r else "not recorded"
         lines.append(f"| {name} | {r['ranks']} | {r['cells']} | {'OK' if r['mesh_ok'] else 'FAILED'} | "
-                     f"{r['max_non_orthogonality']:.1f} | {r['max_skewness']:.2f} | {its} | {result} | {r['wall_s']:.0f} |")
+                     f"{r['max_non_orthogonality']:.1f} | {r['max_skewness']:.2f} | {volume} | {its} | {result} | "
+                     f"{r['wall_s']:.0f} |")
     # Memory per process: what every rank holds (the surface and its search tree) and what divides
     # among the ranks (the cells), from the meshing step's peak on 1 and 2 processes.
     m1 = next(s["peak_memory_mb"] for s in one["steps"] if s["step"] == "snappyHexMesh")
