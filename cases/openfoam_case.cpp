@@ -293,16 +293,17 @@ std::string allrun(const CaseParams& p) {
        "# memory (kB) go to log.time.\n"
        "rm -f log.time\n"
        "if [ -x /usr/bin/time ]; then\n"
-       "    step() { name=\"$1\"; shift; /usr/bin/time -a -o log.time -f \"$name %e %M\" \"$@\" > \"log.$name\" 2>&1; }\n"
+       "    timed() { /usr/bin/time -a -o log.time -f \"$name %e %M\" \"$@\"; }\n"
        "else\n"
-       "    step() { name=\"$1\"; shift; \"$@\" > \"log.$name\" 2>&1; }\n"
+       "    timed() { \"$@\"; }\n"
        "fi\n"
-       "run() { echo \"running $*\"; step \"$1\" \"$@\" || { echo \"$1 failed, see log.$1\" >&2; exit 1; }; }\n"
+       "step() { name=\"$1\"; shift; timed \"$@\" > \"log.$name\" 2>&1 || { echo \"$name failed, see log.$name\" >&2; exit 1; }; }\n"
+       "run() { echo \"running $*\"; step \"$1\" \"$@\"; }\n"
        "# Open MPI refuses root unless told (containers, CI).\n"
        "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1\n"
        "parallel() {\n"
        "    echo \"running $* on $np processes\"\n"
-       "    step \"$1\" mpirun -np \"$np\" \"$@\" -parallel || { echo \"$1 failed, see log.$1\" >&2; exit 1; }\n"
+       "    step \"$1\" mpirun -np \"$np\" \"$@\" -parallel\n"
        "}\n"
        "decompose() {\n"
        "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
@@ -631,7 +632,9 @@ std::vector<FlowResult::Step> allrun_steps(const fs::path& case_dir) {
     FlowResult::Step s;
     double kb = 0.0;
     std::string rest;
-    if (row >> s.name >> s.time_s >> kb && !(row >> rest)) steps.push_back({s.name, s.time_s, kb / 1024.0});
+    if (!(row >> s.name >> s.time_s >> kb) || row >> rest) continue;
+    s.peak_memory_mb = kb / 1024.0;
+    steps.push_back(s);
   }
   return steps;
 }

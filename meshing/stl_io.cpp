@@ -8,6 +8,7 @@
 #include <iterator>
 #include <vector>
 
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
 namespace bedforge::meshing {
@@ -145,6 +146,10 @@ TriangleMesh read_stl_ascii_by_patch(const std::string& text, const std::string&
   if (m.triangles.empty()) fail("no triangles");
   m.weld();
   return m;
+}
+
+TriangleMesh read_stl_ascii_by_patch(const std::filesystem::path& file) {
+  return read_stl_ascii_by_patch(read_file(file), file.string());
 }
 
 }  // namespace bedforge::meshing

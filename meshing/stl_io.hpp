@@ -1,4 +1,5 @@
 #pragma once
+#include <filesystem>
 #include <ostream>
 #include <string>
 
@@ -20,6 +21,8 @@ void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& mesh);
 // and joins the vertices with identical coordinates. InputError naming `source` and the line
 // on a malformed file.
 TriangleMesh read_stl_ascii_by_patch(const std::string& text, const std::string& source);
+// The same from a file (InputError naming it when it cannot be read).
+TriangleMesh read_stl_ascii_by_patch(const std::filesystem::path& file);
 
 // Binary STL of the triangles of one patch (all triangles when `patch` < 0); `header` goes
 // into the 80-byte header (truncated).

@@ -97,7 +97,7 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
   Directory d = open_directory(dir, overrides);
   const meshing::VolumeMeshParams params = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const fs::path stl = dir / "fluid.stl";
-  const meshing::TriangleMesh surface = meshing::read_stl_ascii_by_patch(read_file(stl), stl.string());
+  const meshing::TriangleMesh surface = meshing::read_stl_ascii_by_patch(stl);
   // A surface edited or made elsewhere: gmsh needs it closed, so say where it is not.
   const meshing::SurfaceCheck check = meshing::check_surface(surface, meshing::SelfIntersectionTest::skip);
   if (!check.closed || !check.manifold)
@@ -132,7 +132,7 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
   std::optional<meshing::PolyMesh> mesh;
   std::optional<meshing::TriangleMesh> surface;
   if (params.snappy_cells)
-    surface = meshing::read_stl_ascii_by_patch(read_file(stl), stl.string());
+    surface = meshing::read_stl_ascii_by_patch(stl);
   else
     mesh = meshing::read_msh(dir / "fluid.msh");
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};

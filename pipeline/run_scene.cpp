@@ -133,8 +133,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   std::shared_ptr<const meshing::TriangleMesh> fluid;
   if (plan.case_.build && scene.case_params.snappy_cells)
     fluid = surface ? std::shared_ptr<const meshing::TriangleMesh>(surface, &surface->fluid)
-                    : std::make_shared<const meshing::TriangleMesh>(
-                          meshing::read_stl_ascii_by_patch(read_file(dir / "fluid.stl"), (dir / "fluid.stl").string()));
+                    : std::make_shared<const meshing::TriangleMesh>(meshing::read_stl_ascii_by_patch(dir / "fluid.stl"));
   surface.reset();
 #endif
   files.write(dir);
