@@ -23,20 +23,17 @@ bool NeighbourList::update(const std::vector<Eigen::Vector3d>& x, const std::vec
         second = m;
       }
     };
-    double first = 0.0, second = 0.0;  // squared displacements
-#pragma omp parallel if (worth_threads(x.size()))
-    {
-      double mine_first = 0.0, mine_second = 0.0;
-#pragma omp for schedule(static) nowait
-      for (std::size_t i = 0; i < x.size(); ++i)
-        keep_two_largest((x[i] - built_at_[i]).squaredNorm(), mine_first, mine_second);
-#pragma omp critical
-      {
-        keep_two_largest(mine_first, first, second);
-        keep_two_largest(mine_second, first, second);
-      }
-    }
-    stale = std::sqrt(first) + std::sqrt(second) > skin_;
+    struct TwoLargest {
+      double first = 0.0, second = 0.0;  // squared displacements
+    };
+    const TwoLargest moved = parallel_reduce(
+        x.size(), TwoLargest{},
+        [&](TwoLargest& m, std::size_t i) { keep_two_largest((x[i] - built_at_[i]).squaredNorm(), m.first, m.second); },
+        [&](TwoLargest& total, const TwoLargest& m) {
+          keep_two_largest(m.first, total.first, total.second);
+          keep_two_largest(m.second, total.first, total.second);
+        });
+    stale = std::sqrt(moved.first) + std::sqrt(moved.second) > skin_;
   }
   if (stale) build(x, r, container);
   return stale;

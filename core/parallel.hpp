@@ -12,6 +12,41 @@ namespace bedforge {
 constexpr std::size_t kParallelMinItems = 512;
 inline bool worth_threads(std::size_t items) { return items >= kParallelMinItems; }
 
+// f(i) for i in [0, n), split statically over the OpenMP threads when worth_threads(n), else
+// on the calling thread without entering OpenMP: a parallel region whose `if` clause is false
+// still makes a system call on entry, which cost about a third of an iteration of the packers
+// at N = 500 (docs/findings.md, "Per-iteration overheads of small beds").
+template <class F>
+void parallel_for(std::size_t n, F f) {
+  if (!worth_threads(n)) {
+    for (std::size_t i = 0; i < n; ++i) f(i);
+    return;
+  }
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) f(i);
+}
+
+// fold(acc, i) for i in [0, n) into `init`, split like parallel_for: each thread folds its share
+// into its own copy of `init`, then merge(total, copy) combines the copies in no fixed order, so
+// merge must not depend on order (a maximum, a logical or, the two largest values).
+template <class T, class Fold, class Merge>
+T parallel_reduce(std::size_t n, T init, Fold fold, Merge merge) {
+  T total = init;
+  if (!worth_threads(n)) {
+    for (std::size_t i = 0; i < n; ++i) fold(total, i);
+    return total;
+  }
+#pragma omp parallel
+  {
+    T mine = init;
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i) fold(mine, i);
+#pragma omp critical
+    merge(total, mine);
+  }
+  return total;
+}
+
 // Sum of f(i) for i in [0, n), in parallel but in an order fixed by n alone (blocks of a fixed
 // size added in block order), so the result does not depend on the number of threads: stopping
 // tests built on such sums make the same decisions on every machine.
@@ -19,14 +54,16 @@ template <class F>
 double deterministic_sum(std::size_t n, F f) {
   constexpr std::size_t kBlock = 2048;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<double> partial(blocks, 0.0);
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (std::size_t b = 0; b < blocks; ++b) {
+  auto block_sum = [&](std::size_t b) {
     double s = 0.0;
     const std::size_t end = std::min(n, (b + 1) * kBlock);
     for (std::size_t i = b * kBlock; i < end; ++i) s += f(i);
-    partial[b] = s;
-  }
+    return s;
+  };
+  if (blocks <= 1) return blocks ? block_sum(0) : 0.0;  // the same sum without an OpenMP region
+  std::vector<double> partial(blocks, 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::size_t b = 0; b < blocks; ++b) partial[b] = block_sum(b);
   double total = 0.0;
   for (double s : partial) total += s;
   return total;

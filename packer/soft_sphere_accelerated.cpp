@@ -88,8 +88,7 @@ class AcceleratedDescent {
 
       // Descent step from y (Eq. 4 with C_g = C_k / kappa), floor, cap; then momentum.
       const double cg = gravity ? step_ / kappa : 0.0;  // C_g = C_k / kappa
-#pragma omp parallel for schedule(static) if (worth_threads(n))
-      for (std::size_t i = 0; i < n; ++i) {
+      parallel_for(n, [&](std::size_t i) {
         Eigen::Vector3d move = step_ * r.contacts.push[i];
         move.z() -= cg * s_.w[i];
         const double len = move.norm();
@@ -97,18 +96,17 @@ class AcceleratedDescent {
         next[i] = s_.x[i] + move;
         next[i].z() = std::max(next[i].z(), s_.r[i]);
         uphill[i] = move.dot(next[i] - x[i]);
-      }
+      });
       // Restart when the step from y disagrees with the direction travelled (gradient restart).
       if (deterministic_sum(n, [&](std::size_t i) { return uphill[i]; }) < 0.0) t = 1.0;
       const double t_next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t)), beta = (t - 1.0) / t_next;
       t = momentum_bound > 0.0 ? std::min(t_next, momentum_bound) : t_next;
-#pragma omp parallel for schedule(static) if (worth_threads(n))
-      for (std::size_t i = 0; i < n; ++i) {
+      parallel_for(n, [&](std::size_t i) {
         Eigen::Vector3d y = next[i] + beta * (next[i] - x[i]);
         y.z() = std::max(y.z(), s_.r[i]);
         x[i] = next[i];
         s_.x[i] = y;
-      }
+      });
     }
   }
 

@@ -117,13 +117,12 @@ nlohmann::json run_faithful(Spheres& s, const Container& container, const SoftSp
                          con.max_pair_overlap / p.d_min, st.cg);
     });
     const double cg = st.cg;
-#pragma omp parallel for schedule(static) if (worth_threads(n))
-    for (std::size_t i = 0; i < n; ++i) {
+    parallel_for(n, [&](std::size_t i) {
       Eigen::Vector3d& xi = s.x[i];
       xi += ck * con.push[i];
       xi.z() -= cg * s.w[i];
       xi.z() = std::max(xi.z(), s.r[i]);
-    }
+    });
     prev_energy = con.elastic_energy;
     prev_height = height;
     prev_cg = cg;
