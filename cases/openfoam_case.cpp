@@ -336,7 +336,8 @@ std::string allrun(const CaseParams& p) {
          "fi\n";
   s += "# Past about a million cells per process the solver's temporary fields outgrow glibc's 32 MB\n"
        "# limit for heap blocks: each was mapped afresh and cleared page by page on every use, which\n"
-       "# made an iteration ten times slower. Kept in the heap, they are reused (a larger peak).\n"
+       "# made an iteration ten times slower. Kept in the heap, they are reused (a larger peak); the\n"
+       "# setting holds for every step from here on.\n"
        "export MALLOC_MMAP_MAX_=0 MALLOC_TRIM_THRESHOLD_=1000000000000\n"
        "if [ \"$np\" -gt 1 ]; then\n"
        "    [ \"$snappy\" = 1 ] || decompose\n"

@@ -220,6 +220,24 @@ def check_mesh_log(log):
     return "Mesh OK." in log, cells, non_ortho, skew, volume
 
 
+def scale_out_run(path, iterations):
+    """One route of scale_out: `bedforge run` on path.toml, Allrun's own checkMesh, the flow; the
+    fields both routes report."""
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
+    rep = json.load(open(os.path.join(path, "report.json")))
+    flow = rep["stages"]["case"]["flow"]
+    ok, cells, non_ortho, skew, volume = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+    row = {"wall_s": wall, "stages_s": stage_times(rep),
+           "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
+           "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
+           "cells": cells, "mesh_ok": ok, "max_non_orthogonality": non_ortho, "max_skewness": skew,
+           "volume_error": volume / rep["stages"]["surface"]["fluid_volume_exact_m3"] - 1,
+           "iterations": flow["iterations"], "iteration_cap": iterations, "converged": flow["converged"],
+           "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"],
+           "flow_rate_error": flow["flow_rate_relative_error"]}
+    return rep, row
+
+
 def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=10000, treatment="bridge", edge=0.1):
     """Yields each route's row as it is measured: a run of an hour or more keeps what it got."""
     for ranks, its in ((2, iterations), (1, 1)):
@@ -229,36 +247,17 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
                                         f"snappy_level = {snappy_level}\n")
         text = text.replace('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')
         open(path + ".toml", "w").write(text)
-        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
-        rep = json.load(open(os.path.join(path, "report.json")))
-        flow = rep["stages"]["case"]["flow"]
-        ok, cells, non_ortho, skew, volume = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
+        _, measured = scale_out_run(path, its)
         row = {"route": "snappy", "ranks": ranks, "a": a, "n": n, "treatment": treatment, "edge_d": edge,
-               "snappy_cell_d": snappy_cell_d, "snappy_level": snappy_level, "wall_s": wall,
-               "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
-               "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
-               "cells": cells, "mesh_ok": ok, "max_non_orthogonality": non_ortho, "max_skewness": skew,
-               "volume_error": volume / rep["stages"]["surface"]["fluid_volume_exact_m3"] - 1,
-               "iterations": flow["iterations"], "iteration_cap": its, "converged": flow["converged"],
-               "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"], "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"],
-               "flow_rate_error": flow["flow_rate_relative_error"]}
+               "snappy_cell_d": snappy_cell_d, "snappy_level": snappy_level, **measured}
         print(row, flush=True)
         shutil.rmtree(path)  # gigabytes of surface and cells
         yield row
     path = os.path.join(tmp, "scale_out_gmsh")
     open(path + ".toml", "w").write(scene(a, n, treatment, gmsh_edge, True, iterations=iterations))
-    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path])
-    rep = json.load(open(os.path.join(path, "report.json")))
-    flow = rep["stages"]["case"]["flow"]
-    ok, cells, non_ortho, skew, volume = check_mesh_log(open(os.path.join(path, "case", "log.checkMesh")).read())
-    row = {"route": "gmsh", "ranks": 2, "a": a, "n": n, "treatment": treatment, "edge_d": gmsh_edge, "wall_s": wall,
-           "stages_s": stage_times(rep), "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
-           "surface_triangles": rep["stages"]["surface"]["triangles"], "steps": flow["allrun_steps"],
-           "tetrahedra": rep["stages"]["mesh"]["cells"], "cells": cells, "mesh_ok": ok,
-           "max_non_orthogonality": non_ortho, "max_skewness": skew,
-           "volume_error": volume / rep["stages"]["surface"]["fluid_volume_exact_m3"] - 1, "iterations": flow["iterations"],
-           "iteration_cap": iterations, "converged": flow["converged"], "dp_dz_pa_m": flow["pressure_gradient_bed_pa_m"],
-           "ratio_es_bed": flow["ratio_to_eisfeld_schnitzlein_bed"], "flow_rate_error": flow["flow_rate_relative_error"]}
+    rep, measured = scale_out_run(path, iterations)
+    row = {"route": "gmsh", "ranks": 2, "a": a, "n": n, "treatment": treatment, "edge_d": gmsh_edge,
+           "tetrahedra": rep["stages"]["mesh"]["cells"], **measured}
     print(row, flush=True)
     shutil.rmtree(path)
     yield row
@@ -476,7 +475,7 @@ def scale_out_lines(rows):
     snappy = {r["ranks"]: r for r in rows if r["route"] == "snappy"}
     gmsh = next((r for r in rows if r["route"] == "gmsh"), None)
     if len(snappy) < 2 or gmsh is None:
-        return [f"## Past one machine: by the snappyHexMesh route", "", *stamp(rows),
+        return ["## Past one machine: by the snappyHexMesh route", "", *stamp(rows),
                 f"The run did not finish: {len(rows)} of its 3 routes measured (docs/mesh_case_benchmark.json).", ""]
     two, one = snappy[2], snappy[1]
     finest = two["snappy_cell_d"] / 2 ** two["snappy_level"]

@@ -61,8 +61,9 @@ TEST(Parallel, ParallelReduceFindsTheTwoLargestOnAnyThreadCount) {
     else if (v > t.second) t.second = v;
   };
   for (std::size_t n : {std::size_t{10}, std::size_t{100000}}) {
-    // A permutation of 0..n-1 scattered so that the two largest fall in different threads' halves.
-    auto at = [n](std::size_t i) { return static_cast<double>((i * 7919) % n); };
+    // A permutation of 0..n-1 (3 and n coprime) whose two largest sit at n/3 and 2n/3, in
+    // different threads' halves on two threads, so the merge has to combine them.
+    auto at = [n](std::size_t i) { return static_cast<double>((i * 3) % n); };
     for (int threads : {1, 2}) {
       const TwoLargest t = on_threads(threads, [&] {
         return parallel_reduce(
