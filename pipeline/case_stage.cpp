@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include "core/stage_meter.hpp"
+
 namespace bedforge::pipeline {
 
-CaseStage case_stage(const meshing::PolyMesh* mesh, const meshing::TriangleMesh* surface, const Bed& bed,
+CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_ptr<const meshing::TriangleMesh> surface,
+                     const Bed& bed,
                      const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
                      const Console& console) {
@@ -18,11 +21,14 @@ CaseStage case_stage(const meshing::PolyMesh* mesh, const meshing::TriangleMesh*
     patches = surface->patches;
   const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface->points, bed);
   CaseStage out;
-  out.info = cases::write_case(case_dir, overwrite, mesh, patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
+  out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
                                fluid_stl);
   out.report = out.info.to_json();
   std::string line = mesh ? fmt::format("case: {} cells in {}", mesh->cells, case_dir.string())
                           : fmt::format("case: snappyHexMesh's set-up in {}", case_dir.string());
+  mesh.reset();
+  surface.reset();
+  release_free_memory();
   line += fmt::format(", Re_p {}, u {:.3g} m/s", p.reynolds, out.info.velocity_m_s);
   if (bed.size() > 0) {
     line += fmt::format(", bed section eps {:.4f}", out.info.section.void_fraction_bed);

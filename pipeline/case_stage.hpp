@@ -1,5 +1,6 @@
 #pragma once
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -24,7 +25,10 @@ struct CaseStage {
 // `scene_toml` and the bed, and runs it when params.run. On gmsh's cells `mesh`; or, when
 // params.snappy_cells, with no cells (mesh null) for snappyHexMesh to make from `surface`, the
 // fluid surface whose ASCII STL is `fluid_stl` (also needed, with params.snappy, beside gmsh's).
-CaseStage case_stage(const meshing::PolyMesh* mesh, const meshing::TriangleMesh* surface, const Bed& bed,
+// Both are let go of once the case is written and the allocator's free pages handed back, so
+// that OpenFOAM's processes get the memory they held (callers pass their only reference).
+CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_ptr<const meshing::TriangleMesh> surface,
+                     const Bed& bed,
                      const cases::CaseParams& params, const Provenance& provenance, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
                      const Console& console);

@@ -128,7 +128,8 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
     cases::CaseParams params = scene.case_params;
     params.snappy = false;  // a coarser level is solved on its gmsh cells only
-    const CaseStage c = case_stage(&m->volume->mesh, nullptr, bed, params, prov, scene_to_toml(scene.table), {},
+    const meshing::PolyMesh* cells = &m->volume->mesh;
+    const CaseStage c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {},
                                    case_dir, true, console);
     StudyLevel solved = study_level(c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);

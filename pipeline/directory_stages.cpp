@@ -129,14 +129,14 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
 #endif
   // gmsh's cells, or for snappyHexMesh's the surface it meshes.
   const fs::path stl = dir / "fluid.stl";
-  std::optional<meshing::PolyMesh> mesh;
-  std::optional<meshing::TriangleMesh> surface;
+  std::shared_ptr<const meshing::PolyMesh> mesh;
+  std::shared_ptr<const meshing::TriangleMesh> surface;
   if (params.snappy_cells)
-    surface = meshing::read_stl_ascii_by_patch(stl);
+    surface = std::make_shared<const meshing::TriangleMesh>(meshing::read_stl_ascii_by_patch(stl));
   else
-    mesh = meshing::read_msh(dir / "fluid.msh");
+    mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
-  const CaseStage c = case_stage(mesh ? &*mesh : nullptr, surface ? &*surface : nullptr, d.bed, params, prov,
+  const CaseStage c = case_stage(std::move(mesh), std::move(surface), d.bed, params, prov,
                                  scene_to_toml(d.scene), params.snappy ? stl : fs::path(), dir / "case", overwrite,
                                  console);
   nlohmann::json entry = c.report;

@@ -140,7 +140,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (plan.case_.build) {
-    const CaseStage c = case_stage(mesh.get(), fluid.get(), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
+    const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
                                    scene.case_params.snappy ? dir / "fluid.stl" : fs::path(), dir / "case",
                                    opt.overwrite, console);
     nlohmann::json entry = c.report;
