@@ -124,13 +124,24 @@ def peak_mb(report):
                [s.get("flow", {}).get("solver_peak_memory_mb", 0) for s in stages])
 
 
+# A number as OpenFOAM prints it; not a class of digits and dots, which takes the full stop of
+# "Total volume = 8.1e-05." into the number.
+NUMBER = r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)"
+
+
+def check_mesh_log(log):
+    """A checkMesh log: (Mesh OK?, cells, max non-orthogonality, max skewness, total volume m^3)."""
+    cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
+    non_ortho = float(re.search(r"Mesh non-orthogonality Max: " + NUMBER, log).group(1))
+    skew = float(re.search(r"Max skewness = " + NUMBER, log).group(1))
+    volume = float(re.search(r"Total volume = " + NUMBER, log).group(1))
+    return "Mesh OK." in log, cells, non_ortho, skew, volume
+
+
 def check_mesh(case):
     """checkMesh on a case: (Mesh OK?, cells, max non-orthogonality, max skewness, s)."""
     wall, log = timed(["checkMesh", "-case", case])
-    cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
-    non_ortho = float(re.search(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log).group(1))
-    skew = float(re.search(r"Max skewness = ([0-9.eE+-]+)", log).group(1))
-    return "Mesh OK." in log, cells, non_ortho, skew, wall
+    return (*check_mesh_log(log)[:4], wall)
 
 
 def stage_times(report):
@@ -181,7 +192,7 @@ def snappy(tmp, edge):
     case = os.path.join(path, "case")
     ok, cells, non_ortho, skew, _ = check_mesh(case)
     snappy_log = open(os.path.join(case, "log.snappyHexMesh")).read()
-    meshing = float(re.search(r"Finished meshing in = ([0-9.eE+-]+) s", snappy_log).group(1))
+    meshing = float(re.search(r"Finished meshing in = " + NUMBER + " s", snappy_log).group(1))
     row = {"route": "snappy", "cells": cells, "wall_s": wall, "peak_mb": mb, "snappy_s": meshing,
            "solve_s": flow["time_s"] - meshing, "mesh_ok": ok, "max_non_orthogonality": non_ortho,
            "max_skewness": skew, "iterations": flow["iterations"], "converged": flow["converged"],
@@ -208,16 +219,6 @@ def scale(tmp, a, n, treatment):
                              for attempt in rep["stages"]["mesh"].get("attempts", [])]}
     print(row, flush=True)
     return row
-
-
-def check_mesh_log(log):
-    """Allrun's own checkMesh (decomposed cells are checked in parallel): (Mesh OK?, cells, max
-    non-orthogonality, max skewness, total volume m^3)."""
-    cells = int(re.search(r"^\s*cells:\s+(\d+)", log, re.M).group(1))
-    non_ortho = float(re.search(r"Mesh non-orthogonality Max: ([0-9.eE+-]+)", log).group(1))
-    skew = float(re.search(r"Max skewness = ([0-9.eE+-]+)", log).group(1))
-    volume = float(re.search(r"Total volume = ([0-9.eE+-]+)", log).group(1))
-    return "Mesh OK." in log, cells, non_ortho, skew, volume
 
 
 def scale_out_run(path, iterations):
