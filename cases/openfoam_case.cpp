@@ -1,6 +1,7 @@
 #include "cases/openfoam_case.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <future>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -164,12 +166,15 @@ nlohmann::json CaseInfo::to_json() const {
           {"inlet_area_m2", inlet_area_m2},
           {"d_ref_m", d_ref_m},
           {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
+          {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr}};
 }
 
 nlohmann::json FlowResult::to_json() const {
   nlohmann::json mesh = {{"mesher", mesher}};
   if (solved_cells >= 0) mesh["cells"] = solved_cells;
+  if (solved_volume_m3) mesh["volume_m3"] = *solved_volume_m3;
+  if (volume_lost) mesh["volume_lost"] = *volume_lost;
   nlohmann::json allrun = nlohmann::json::array();
   for (const Step& s : steps) allrun.push_back({{"step", s.name}, {"time_s", s.time_s}, {"peak_memory_mb", s.peak_memory_mb}});
   nlohmann::json j = {{"time_s", time_s},
@@ -534,7 +539,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   std::optional<double> fluid_volume;
   if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
   CaseInfo info{case_dir, p, u, nu, mesh ? static_cast<long>(mesh->cells) : 0L, section, g.aspect_ratio,
-                g.cross_section_area, g.d_ref, fluid_volume, std::nullopt};
+                g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   if (bed.size() == 0) info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   return info;
 }
@@ -644,6 +649,65 @@ std::vector<FlowResult::Step> allrun_steps(const fs::path& case_dir) {
   return steps;
 }
 
+// What Allrun's checkMesh printed: the cells, their total volume, and the faces of each patch
+// (a patch left without faces anywhere is not listed). cells < 0: no checkMesh ran.
+struct CheckMeshLog {
+  long cells = -1;
+  std::optional<double> volume_m3;
+  std::map<std::string, long> patch_faces;
+};
+CheckMeshLog read_check_mesh_log(const fs::path& path) {
+  CheckMeshLog out;
+  std::ifstream in(path);
+  bool in_patch_table = false;
+  for (std::string line; std::getline(in, line);) {
+    if (const auto at = line.find("cells:"); at != std::string::npos) out.cells = std::atol(line.c_str() + at + 6);
+    if (const auto at = line.find("Total volume = "); at != std::string::npos) out.volume_m3 = std::atof(line.c_str() + at + 15);
+    if (line.find("Patch") != std::string::npos && line.find("Faces") != std::string::npos) {
+      in_patch_table = true;
+      continue;
+    }
+    std::istringstream row(line);
+    std::string name;
+    long faces = 0;
+    if (in_patch_table && row >> name >> faces)
+      out.patch_faces[name] = faces;
+    else
+      in_patch_table = false;
+  }
+  return out;
+}
+
+// snappyHexMesh keeps the cells connected to the point inside the fluid. Where its cells do not
+// fit the throats between the spheres, that region can miss the inlet or the outlet, and the
+// solver then fails on the patch it lost: say so, and what makes finer cells.
+void refuse_lost_ends(const CheckMeshLog& check, const CaseInfo& c) {
+  std::vector<std::string> lost;
+  for (const char* end : {"inlet", "outlet"})
+    if (const auto it = check.patch_faces.find(end); it == check.patch_faces.end() || it->second == 0) lost.push_back(end);
+  if (check.cells < 0 || lost.empty()) return;
+  const std::string kept = check.volume_m3 && c.surface_volume_m3
+                               ? fmt::format(" and hold {:.1f} % of the surface's fluid volume",
+                                             100.0 * *check.volume_m3 / *c.surface_volume_m3)
+                               : std::string();
+  throw ConvergenceError(fmt::format(
+      "snappyHexMesh's cells have no {0} faces{1}: the region they keep, around the point inside the fluid, does not "
+      "reach the {0}, as happens where cells of {2:.3g} d at the surfaces (case.snappy_cell_d = {3}, "
+      "case.snappy_level = {4}) do not fit the bed's narrowest throats; allowed: a smaller case.snappy_cell_d, a "
+      "larger case.snappy_level, or gmsh's cells (case.mesher = \"gmsh\")",
+      fmt::join(lost, " or "), kept, c.params.snappy_cell_d / std::pow(2.0, c.params.snappy_level),
+      c.params.snappy_cell_d, c.params.snappy_level));
+}
+
+// The last line of a log that is not blank (Allrun's last words: which step failed).
+std::string last_line(const fs::path& path) {
+  std::ifstream in(path);
+  std::string last;
+  for (std::string line; std::getline(in, line);)
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  return last;
+}
+
 }  // namespace
 
 FlowResult run_case(const CaseInfo& c, Progress& progress) {
@@ -673,9 +737,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
                     std::clamp(done, 0.0, 1.0));
   }
   progress.finish();
-  if (run.get() != 0)
-    throw std::runtime_error(fmt::format("the OpenFOAM run failed; see {}/log.Allrun and the logs next to it",
-                                         case_dir.string()));
+  const CheckMeshLog check = read_check_mesh_log(case_dir / "log.checkMesh");
+  if (run.get() != 0) {
+    if (snappy) refuse_lost_ends(check, c);
+    throw std::runtime_error(fmt::format("the OpenFOAM run failed ({}); see {}/log.Allrun and the logs next to it",
+                                         last_line(case_dir / "log.Allrun"), case_dir.string()));
+  }
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // Convergence: SIMPLE's own message and, per iteration, the initial residuals and the time.
   std::ifstream log(case_dir / "log.simpleFoam");
@@ -699,9 +766,9 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.solved_cells = snappy || c.params.polyhedra ? -1 : c.cells;
   r.steps = allrun_steps(case_dir);
   if (snappy || c.params.polyhedra) {  // the cells Allrun made, as its checkMesh counted them
-    std::ifstream check(case_dir / "log.checkMesh");
-    for (std::string line; std::getline(check, line);)
-      if (const auto at = line.find("cells:"); at != std::string::npos) r.solved_cells = std::atol(line.c_str() + at + 6);
+    r.solved_cells = check.cells;
+    r.solved_volume_m3 = check.volume_m3;
+    if (snappy && check.volume_m3 && c.surface_volume_m3) r.volume_lost = 1.0 - *check.volume_m3 / *c.surface_volume_m3;
   }
   // Convergence history: the residuals and the bed's pressure gradient against the solver's time.
   nlohmann::json history = nlohmann::json::array();

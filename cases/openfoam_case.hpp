@@ -103,6 +103,8 @@ struct CaseInfo {
   double inlet_area_m2 = 0.0;
   double d_ref_m = 0.0;
   std::optional<double> fluid_volume_m3;  // of the written cells
+  // snappyHexMesh's cells: the volume the fluid surface encloses, which they should fill.
+  std::optional<double> surface_volume_m3;
   // An empty container's known answer, the fully developed laminar gradient (Pa/m): the route's
   // verification. Unset for a bed, which is compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
@@ -127,6 +129,10 @@ struct FlowResult {
   double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
   std::string mesher;                    // what made the cells solved on: "gmsh tetrahedra", "gmsh polyhedral dual", "snappyHexMesh"
   long solved_cells = -1;                // the cells solved on, as Allrun's checkMesh counted them (-1: no checkMesh ran)
+  std::optional<double> solved_volume_m3;  // their total volume, as that checkMesh summed it
+  // snappyHexMesh's cells: 1 - their volume / the surface's, the fluid they do not fill
+  // (throats and gaps narrower than the cells, dropped).
+  std::optional<double> volume_lost;
   // Allrun's steps, each with its wall time and its largest process's peak memory (from GNU
   // time when the machine has it: empty otherwise). On N processes that is the largest rank's.
   struct Step {
@@ -172,7 +178,9 @@ struct FlowResult {
 // Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
 // reads back the solver's convergence and the pressure drop, compared with Eisfeld &
 // Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
-// while it runs. std::runtime_error naming the log when the solver fails.
+// while it runs. ConvergenceError when snappyHexMesh's cells lost the inlet or the outlet (the
+// fluid they kept does not reach it), naming the settings that make finer cells;
+// std::runtime_error naming the log and Allrun's last words when another step fails.
 FlowResult run_case(const CaseInfo& c, Progress& progress);
 
 }  // namespace bedforge::cases

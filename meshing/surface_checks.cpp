@@ -369,7 +369,7 @@ SurfaceCheck check_surface(const TriangleMesh& m, SelfIntersectionTest test, con
   out.manifold = out.closed && !degenerate && !pinched;
   if (!out.manifold) return out;
   // Step 3: the enclosed volume, by the divergence theorem.
-  for (const auto& t : m.triangles) out.volume += m.points[t[0]].dot(m.points[t[1]].cross(m.points[t[2]])) / 6.0;
+  out.volume = enclosed_volume(m);
   // Step 4: self-intersections, by CGAL's box-intersection test on a CGAL mesh of the triangles
   // to test (all, or those the pieces leave): two of them that share an edge or a vertex in the
   // surface share it there too.

@@ -70,6 +70,12 @@ void TriangleMesh::weld() {
     for (int& v : t) v = to[v];
 }
 
+double enclosed_volume(const TriangleMesh& m) {
+  double v = 0.0;
+  for (const auto& t : m.triangles) v += m.points[t[0]].dot(m.points[t[1]].cross(m.points[t[2]])) / 6.0;
+  return v;
+}
+
 void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& desired) {
   for (auto& t : m.triangles) {
     const Eigen::Vector3d &a = m.points[t[0]], &b = m.points[t[1]], &c = m.points[t[2]];

@@ -28,6 +28,10 @@ struct TriangleMesh {
   void weld();
 };
 
+// Volume the mesh encloses (m^3), by the divergence theorem: positive when its normals point
+// out, meaningful only when it is closed.
+double enclosed_volume(const TriangleMesh& mesh);
+
 // Flips every triangle whose normal disagrees with `desired(centroid)`.
 void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& desired);
 

@@ -23,6 +23,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
   CaseStage out;
   out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
                                fluid_stl);
+  if (!mesh) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
   std::string line = mesh ? fmt::format("case: {} cells in {}", mesh->cells, case_dir.string())
                           : fmt::format("case: snappyHexMesh's set-up in {}", case_dir.string());
@@ -39,6 +40,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
     const cases::FlowResult& flow = out.flow.emplace(cases::run_case(out.info, progress));
     out.report["flow"] = flow.to_json();
     if (flow.solved_cells != out.info.cells) line += fmt::format("; solved on {} cells ({})", flow.solved_cells, flow.mesher);
+    if (flow.volume_lost) line += fmt::format(", {:.1f} % of the surface's fluid volume lost", 100.0 * *flow.volume_lost);
     line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = ",
                         flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
                         flow.residual_p, flow.pressure_gradient_bed_pa_m);

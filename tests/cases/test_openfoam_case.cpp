@@ -319,5 +319,32 @@ TEST(OpenFoamCase, SnappyHexMeshCellsNeedNoGmshMeshAndPassCheckMesh) {
   for (const auto& step : flow["allrun_steps"]) steps.push_back(step["step"]);
   EXPECT_EQ(steps, (std::vector<std::string>{"blockMesh", "surfaceFeatureExtract", "decomposePar", "snappyHexMesh",
                                              "checkMesh", "simpleFoam"}));
+  // The fluid the cells fill: checkMesh's total volume against the volume the surface encloses
+  // (the surface stage's own figure, from the same triangles written at 12 digits).
+  const auto vol = check.find("Total volume = ");
+  ASSERT_NE(vol, std::string::npos);
+  EXPECT_DOUBLE_EQ(flow["mesh"]["volume_m3"].get<double>(), std::atof(check.c_str() + vol + 15));
+  const double surface = report["stages"]["case"]["surface_volume_m3"].get<double>();
+  EXPECT_NEAR(surface, report["stages"]["surface"]["fluid_volume_mesh_m3"].get<double>(), 1e-9 * surface);
+  EXPECT_NEAR(flow["mesh"]["volume_lost"].get<double>(), 1.0 - flow["mesh"]["volume_m3"].get<double>() / surface, 1e-12);
+}
+
+// Background cells too coarse for the bed's throats (case.snappy_cell_d = 1: cells of 0.5 d at
+// the surfaces, against throats of a few tenths of d between touching spheres): snappyHexMesh
+// keeps only the fluid connected to the point inside it, here not the inlet, and the solver
+// cannot start. The run stops with the convergence status and names the settings to change.
+TEST(OpenFoamCase, SnappyHexMeshCellsThatLoseTheInletNameTheSettingsToChange) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (snappyHexMesh) not on PATH";
+  const fs::path dir = fresh_dir("snappy_coarse"), scene = fresh_dir("snappy_coarse_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml")
+      << "[container]\ndiameter_d = 4\n[particles]\ncount = 40\ndiameter_m = 0.003\n[surface]\nedge_length_d = 0.3\n"
+         "[case]\nmesher = \"snappy\"\nsnappy_cell_d = 1.0\nsnappy_level = 1\nrun = true\nprocessors = 1\n"
+         "iterations = 5\n[outputs]\nfiles = [\"positions\", \"case\"]\n";
+  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_NE(r.output.find("no inlet faces"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("case.snappy_cell_d = 1,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("case.snappy_level = 1)"), std::string::npos) << r.output;
 }
 

@@ -16,12 +16,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // Signed volume by the divergence theorem (independent of CGAL).
-double signed_volume(const TriangleMesh& m) {
-  double v = 0.0;
-  for (const auto& t : m.triangles) v += m.points[t[0]].dot(m.points[t[1]].cross(m.points[t[2]])) / 6.0;
-  return v;
-}
-
 // A planar cut of the sphere (c, r) at distance h along the unit axis a, its loop at spacing s.
 SphereCut plane(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, double h, double s, Frame* frame = nullptr) {
   const double rho = std::sqrt(r * r - h * h);
@@ -44,8 +38,8 @@ TEST(Primitives, SphereIsClosedInscribedAndConverges) {
     const TriangleMesh m = sphere_mesh(c, 1.0, {}, edge, 1.3, true, "particles");
     const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
     EXPECT_TRUE(k.manifold && k.closed && k.self_intersection_test != SelfIntersectionTest::skip && !k.self_intersecting);
-    const double exact = 4.0 / 3.0 * kPi, error = (exact - signed_volume(m)) / exact;
-    EXPECT_NEAR(k.volume, signed_volume(m), 1e-12);
+    const double exact = 4.0 / 3.0 * kPi, error = (exact - enclosed_volume(m)) / exact;
+    EXPECT_NEAR(k.volume, enclosed_volume(m), 1e-12);
     EXPECT_GT(error, 0.0);  // inscribed: every facet inside the sphere
     EXPECT_LT(error, previous_error);
     // Volume deficit of a polyhedron inside the sphere within its chordal deviation delta: at
@@ -57,7 +51,7 @@ TEST(Primitives, SphereIsClosedInscribedAndConverges) {
     EXPECT_LE(mesh_quality(m).max_edge, edge * 1.6);
   }
   // Inward orientation encloses a negative volume.
-  EXPECT_LT(signed_volume(sphere_mesh(c, 1.0, {}, 0.3, 1.3, false, "p")), 0.0);
+  EXPECT_LT(enclosed_volume(sphere_mesh(c, 1.0, {}, 0.3, 1.3, false, "p")), 0.0);
 }
 
 TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {

@@ -44,3 +44,18 @@ TEST(TriangleMesh, TrianglesBelowAnAngleKeepTheirVerticesAndPatches) {
   EXPECT_EQ(triangles_below_angle(m, 50.0).triangles.size(), 2u);
   EXPECT_TRUE(triangles_below_angle(m, 1.0).triangles.empty());
 }
+
+// The enclosed volume of a box of sides 1, 2, 3 (12 triangles, normals out): its volume
+// wherever it sits, and negative turned inside out.
+TEST(TriangleMesh, EnclosedVolumeOfABox) {
+  TriangleMesh m;
+  for (int k = 0; k < 8; ++k) m.points.push_back({10.0 + (k & 1), -5.0 + 2.0 * ((k >> 1) & 1), 3.0 * (k >> 2)});
+  // Two triangles per face, each face's corners in order around its outward normal.
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : faces) m.triangles.push_back({f[0], f[1], f[2]}), m.triangles.push_back({f[0], f[2], f[3]});
+  m.patch.assign(m.triangles.size(), 0);
+  m.patches = {"wall"};
+  EXPECT_NEAR(enclosed_volume(m), 6.0, 1e-12);
+  for (auto& t : m.triangles) std::swap(t[1], t[2]);
+  EXPECT_NEAR(enclosed_volume(m), -6.0, 1e-12);
+}
