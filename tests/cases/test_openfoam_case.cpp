@@ -32,6 +32,15 @@ fs::path meshed_bed(const std::string& name) {
   return dir;
 }
 
+// `bedforge run` on a scene given as TOML text, into a fresh directory `name`; returns it.
+fs::path run_scene_text(const std::string& name, const std::string& toml, Result& result) {
+  const fs::path dir = fresh_dir(name), scene = fresh_dir(name + "_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml") << toml;
+  result = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  return dir;
+}
+
 }  // namespace
 
 TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
@@ -289,13 +298,13 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
 // the 0/ files use; the report counts its cells and times Allrun's steps.
 TEST(OpenFoamCase, SnappyHexMeshCellsNeedNoGmshMeshAndPassCheckMesh) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (snappyHexMesh) not on PATH";
-  const fs::path dir = fresh_dir("snappy"), scene = fresh_dir("snappy_scene");
-  fs::create_directories(scene);
-  std::ofstream(scene / "s.toml")
-      << "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n[surface]\nedge_length_d = 0.1\n"
-         "[case]\nmesher = \"snappy\"\nsnappy_level = 1\nrun = true\nprocessors = 2\niterations = 5\n"
-         "[outputs]\nfiles = [\"positions\", \"case\"]\n";
-  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  Result r;
+  const fs::path dir = run_scene_text(
+      "snappy",
+      "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n[surface]\nedge_length_d = 0.1\n"
+      "[case]\nmesher = \"snappy\"\nsnappy_level = 1\nrun = true\nprocessors = 2\niterations = 5\n"
+      "[outputs]\nfiles = [\"positions\", \"case\"]\n",
+      r);
   ASSERT_EQ(r.status, 0) << r.output << read(dir / "case/log.Allrun");
   const auto report = nlohmann::json::parse(read(dir / "report.json"));
   EXPECT_FALSE(report["stages"].contains("mesh")) << report["stages"].dump();
@@ -335,13 +344,12 @@ TEST(OpenFoamCase, SnappyHexMeshCellsNeedNoGmshMeshAndPassCheckMesh) {
 // cannot start. The run stops with the convergence status and names the settings to change.
 TEST(OpenFoamCase, SnappyHexMeshCellsThatLoseTheInletNameTheSettingsToChange) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (snappyHexMesh) not on PATH";
-  const fs::path dir = fresh_dir("snappy_coarse"), scene = fresh_dir("snappy_coarse_scene");
-  fs::create_directories(scene);
-  std::ofstream(scene / "s.toml")
-      << "[container]\ndiameter_d = 4\n[particles]\ncount = 40\ndiameter_m = 0.003\n[surface]\nedge_length_d = 0.3\n"
-         "[case]\nmesher = \"snappy\"\nsnappy_cell_d = 1.0\nsnappy_level = 1\nrun = true\nprocessors = 1\n"
-         "iterations = 5\n[outputs]\nfiles = [\"positions\", \"case\"]\n";
-  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  Result r;
+  run_scene_text("snappy_coarse",
+                 "[container]\ndiameter_d = 4\n[particles]\ncount = 40\ndiameter_m = 0.003\n[surface]\n"
+                 "edge_length_d = 0.3\n[case]\nmesher = \"snappy\"\nsnappy_cell_d = 1.0\nsnappy_level = 1\nrun = true\n"
+                 "processors = 1\niterations = 5\n[outputs]\nfiles = [\"positions\", \"case\"]\n",
+                 r);
   EXPECT_EQ(r.status, 3) << r.output;
   EXPECT_NE(r.output.find("no inlet faces"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("case.snappy_cell_d = 1,"), std::string::npos) << r.output;
