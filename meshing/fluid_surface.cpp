@@ -18,6 +18,7 @@
 #include "core/version.hpp"
 #include "meshing/defect_locations.hpp"
 #include "meshing/contacts.hpp"
+#include "meshing/delaunay_walls.hpp"
 #include "meshing/gap_spacing.hpp"
 #include "meshing/primitives.hpp"
 #include "meshing/stl_io.hpp"
@@ -289,6 +290,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     piece(Shape::plane);
   }
   f.weld();
+  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 2.0 * wall_edge);
   round_to_ascii_stl(f);
   out.bed.weld();
 
@@ -305,6 +307,10 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.report["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
   out.report["wall_sagitta_d"] = wall_sag / d;
   out.report["wall_edge_d"] = wall_edge / d;
+  out.report["wall_delaunay"] = {{"missing_before", splits.missing_before},
+                                 {"missing_after", splits.missing_after},
+                                 {"edges_split", splits.edges_split},
+                                 {"rounds", splits.rounds}};
   out.report["triangles"] = f.triangles.size();
   out.report["min_angle_deg"] = q.min_angle_deg;
   out.report["min_edge_d"] = q.min_edge / d;
