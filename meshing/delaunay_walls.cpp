@@ -14,13 +14,6 @@ namespace bedforge::meshing {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
-using Tds = CGAL::Triangulation_data_structure_3<Vb, CGAL::Delaunay_triangulation_cell_base_3<K>>;
-using Delaunay = CGAL::Delaunay_triangulation_3<K, Tds>;
-
-K::Point_3 to_cgal(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
-
 std::uint64_t edge_key(int a, int b) {
   return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
 }
@@ -28,6 +21,96 @@ std::uint64_t edge_key(int a, int b) {
 double distance_from_axis(const SurfacePiece& w, const Eigen::Vector3d& p) {
   const Eigen::Vector3d q = p - w.centre;
   return (q - q.dot(w.axis) * w.axis).norm();
+}
+
+// The points near the walls by cubic cell of side `side`.
+class PointGrid {
+ public:
+  explicit PointGrid(double side) : side_(side) {}
+  void add(const Eigen::Vector3d& p, int v) { cells_[key(cell(p))].push_back(v); }
+  // Calls visit(v) for every point in the cells the cube of half-side `side` about p meets.
+  template <class Visit>
+  void near(const Eigen::Vector3d& p, const Visit& visit) const {
+    const Eigen::Array3i c = cell(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+          if (const auto it = cells_.find(key(c + Eigen::Array3i(dx, dy, dz))); it != cells_.end())
+            for (int v : it->second) visit(v);
+  }
+
+ private:
+  Eigen::Array3i cell(const Eigen::Vector3d& p) const { return (p.array() / side_).floor().cast<int>(); }
+  static std::uint64_t key(const Eigen::Array3i& c) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x()) & 0x1fffff) << 42) |
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y()) & 0x1fffff) << 21) |
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()) & 0x1fffff));
+  }
+  double side_;
+  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
+};
+
+// Whether some sphere through the corners of triangle t holds none of the points within
+// `reach` of it: then t is a facet of their Delaunay tetrahedra. The spheres through the corners
+// have their centres on the normal through the circumcentre C, at C + s n; a point P lies
+// outside the one at s when 2 s h <= |P - C|^2 - c^2 (h = (P - C) . n, c the circumradius), a
+// bound on s from above or below. Points beyond `reach` (all of them, unseen) leave every s with
+// |s| < (reach^2 - c^2) / (2 reach) free, so the interval is cut to that: a triangle this passes
+// is a facet whatever lies beyond; one it fails may be too (then it is split needlessly), and
+// near-ties fail.
+bool has_empty_circumsphere(const TriangleMesh& f, const std::array<int, 3>& t, const PointGrid& grid, double reach) {
+  const Eigen::Vector3d &p0 = f.points[t[0]], &p1 = f.points[t[1]], &p2 = f.points[t[2]];
+  const Eigen::Vector3d a = p0 - p2, b = p1 - p2, axb = a.cross(b);
+  const double area2 = axb.squaredNorm();
+  if (area2 == 0.0) return false;
+  const Eigen::Vector3d centre = p2 + (a.squaredNorm() * b - b.squaredNorm() * a).cross(axb) / (2.0 * area2);
+  const Eigen::Vector3d n = axb / std::sqrt(area2);
+  const double c2 = (p0 - centre).squaredNorm();
+  if (c2 >= reach * reach) return false;
+  const double free = (reach * reach - c2) / (2.0 * reach);
+  double lo = -free, hi = free;
+  bool inside = false;
+  grid.near(centre, [&](int v) {
+    if (v == t[0] || v == t[1] || v == t[2]) return;
+    const Eigen::Vector3d q = f.points[v] - centre;
+    const double d2 = q.squaredNorm();
+    if (d2 >= reach * reach) return;
+    const double h = q.dot(n), bound = (d2 - c2) / (2.0 * h);
+    if (h > 0.0) hi = std::min(hi, bound);
+    else if (h < 0.0) lo = std::max(lo, bound);
+    else inside |= d2 < c2;
+  });
+  return !inside && lo < hi - 1e-9 * reach;
+}
+
+// Of the triangles `candidates` of f (which failed has_empty_circumsphere), those that are
+// not facets of CGAL's Delaunay tetrahedra of the points within `reach` of one of them: more
+// points only take facets away, so each is certainly missing from gmsh's start too.
+std::vector<std::size_t> certainly_missing(const TriangleMesh& f, const std::vector<std::size_t>& candidates,
+                                           const PointGrid& grid, double reach) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
+  using Delaunay =
+      CGAL::Delaunay_triangulation_3<K, CGAL::Triangulation_data_structure_3<Vb, CGAL::Delaunay_triangulation_cell_base_3<K>>>;
+  std::unordered_map<int, Delaunay::Vertex_handle> handle;
+  std::vector<std::pair<K::Point_3, int>> near;
+  for (std::size_t t : candidates) {
+    const Eigen::Vector3d centroid = (f.points[f.triangles[t][0]] + f.points[f.triangles[t][1]] + f.points[f.triangles[t][2]]) / 3.0;
+    grid.near(centroid, [&](int v) {
+      if ((f.points[v] - centroid).squaredNorm() < reach * reach && handle.emplace(v, Delaunay::Vertex_handle()).second)
+        near.emplace_back(K::Point_3(f.points[v].x(), f.points[v].y(), f.points[v].z()), v);
+    });
+  }
+  const Delaunay dt(near.begin(), near.end());
+  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
+  std::vector<std::size_t> missing;
+  for (std::size_t t : candidates) {
+    const auto& tri = f.triangles[t];
+    Delaunay::Cell_handle c;
+    int i, j, k;
+    if (!dt.is_facet(handle.at(tri[0]), handle.at(tri[1]), handle.at(tri[2]), c, i, j, k)) missing.push_back(t);
+  }
+  return missing;
 }
 
 }  // namespace
@@ -40,57 +123,54 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
     if (pieces[k].shape == SurfacePiece::Shape::cylinder) walls.push_back(k);
   if (walls.empty()) return out;
 
-  // 1. The Delaunay tetrahedra of the points near a wall.
-  Delaunay dt;
-  std::vector<Delaunay::Vertex_handle> handle(f.points.size());
-  {
-    std::vector<std::pair<K::Point_3, int>> near;
-    for (std::size_t v = 0; v < f.points.size(); ++v)
-      for (std::size_t w : walls)
-        if (std::abs(distance_from_axis(pieces[w], f.points[v]) - pieces[w].radius) < band) {
-          near.emplace_back(to_cgal(f.points[v]), static_cast<int>(v));
-          break;
-        }
-    dt.insert(near.begin(), near.end());
-    for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
-  }
-  auto missing = [&](const std::array<int, 3>& t) {
-    Delaunay::Cell_handle c;
-    int i, j, k;
-    return !dt.is_facet(handle[t[0]], handle[t[1]], handle[t[2]], c, i, j, k);
-  };
+  // 1. The points within `band` of a wall, by cell.
+  PointGrid grid(band);
+  for (std::size_t v = 0; v < f.points.size(); ++v)
+    for (std::size_t w : walls)
+      if (std::abs(distance_from_axis(pieces[w], f.points[v]) - pieces[w].radius) < band) {
+        grid.add(f.points[v], static_cast<int>(v));
+        break;
+      }
 
   for (;; ++out.rounds) {
-    // 2. The missing wall triangles, and the longest of each one's edges shared with another
-    // wall triangle (a hole's loop or the strip's end row is left as it is).
-    std::unordered_map<std::uint64_t, std::vector<std::size_t>> edge_triangles;
+    // 2. The wall triangles with no empty circumsphere, and the longest of each one's edges
+    // shared with another wall triangle (a hole's loop or the strip's end row is left as it is).
+    std::vector<std::size_t> wall_triangles;
     for (std::size_t w : walls)
-      for (std::size_t t = pieces[w].first; t < pieces[w].last; ++t)
-        for (int k = 0; k < 3; ++k) edge_triangles[edge_key(f.triangles[t][k], f.triangles[t][(k + 1) % 3])].push_back(t);
-    std::vector<std::pair<int, int>> split;
-    std::unordered_set<std::size_t> touched;
-    std::size_t n_missing = 0;
-    for (std::size_t w : walls)
-      for (std::size_t t = pieces[w].first; t < pieces[w].last; ++t) {
-        if (!missing(f.triangles[t])) continue;
-        ++n_missing;
-        if (touched.count(t)) continue;
-        std::array<int, 3> order{0, 1, 2};
-        const auto& tri = f.triangles[t];
-        auto length = [&](int k) { return (f.points[tri[k]] - f.points[tri[(k + 1) % 3]]).squaredNorm(); };
-        std::sort(order.begin(), order.end(), [&](int a, int b) { return length(a) > length(b); });
-        for (int k : order) {
-          const auto& shared = edge_triangles.at(edge_key(tri[k], tri[(k + 1) % 3]));
-          if (shared.size() != 2 || touched.count(shared[0]) || touched.count(shared[1])) continue;
-          touched.insert(shared.begin(), shared.end());
-          split.emplace_back(tri[k], tri[(k + 1) % 3]);
-          break;
-        }
-      }
+      for (std::size_t t = pieces[w].first; t < pieces[w].last; ++t) wall_triangles.push_back(t);
+    std::vector<char> failed(wall_triangles.size());
+#pragma omp parallel for schedule(dynamic, 4096)
+    for (std::size_t k = 0; k < wall_triangles.size(); ++k)
+      failed[k] = !has_empty_circumsphere(f, f.triangles[wall_triangles[k]], grid, band);
+    std::vector<std::size_t> candidates;
+    for (std::size_t k = 0; k < wall_triangles.size(); ++k)
+      if (failed[k]) candidates.push_back(wall_triangles[k]);
+    const std::vector<std::size_t> missing =
+        candidates.empty() ? candidates : certainly_missing(f, candidates, grid, band);
+    const std::size_t n_missing = missing.size();
     if (out.rounds == 0) out.missing_before = n_missing;
     out.missing_after = n_missing;
-    if (n_missing == 0 || split.empty() || out.rounds == max_rounds) break;
-
+    if (n_missing == 0 || out.rounds == max_rounds) break;
+    std::unordered_map<std::uint64_t, std::vector<std::size_t>> edge_triangles;
+    for (std::size_t t : wall_triangles)
+      for (int k = 0; k < 3; ++k) edge_triangles[edge_key(f.triangles[t][k], f.triangles[t][(k + 1) % 3])].push_back(t);
+    std::vector<std::pair<int, int>> split;
+    std::unordered_set<std::size_t> touched;
+    for (std::size_t t : missing) {
+      if (touched.count(t)) continue;
+      const auto& tri = f.triangles[t];
+      std::array<int, 3> order{0, 1, 2};
+      auto length = [&](int e) { return (f.points[tri[e]] - f.points[tri[(e + 1) % 3]]).squaredNorm(); };
+      std::sort(order.begin(), order.end(), [&](int a, int b) { return length(a) > length(b); });
+      for (int e : order) {
+        const auto& shared = edge_triangles.at(edge_key(tri[e], tri[(e + 1) % 3]));
+        if (shared.size() != 2 || touched.count(shared[0]) || touched.count(shared[1])) continue;
+        touched.insert(shared.begin(), shared.end());
+        split.emplace_back(tri[e], tri[(e + 1) % 3]);
+        break;
+      }
+    }
+    if (split.empty()) break;
     // 3. Each edge split at its midpoint on the wall; each of its two triangles becomes two, the
     // second appended to its wall's range.
     std::vector<std::vector<std::array<int, 3>>> added(pieces.size());
@@ -107,8 +187,7 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
       const Eigen::Vector3d on_wall = wall.centre + along + radial * (wall.radius / radial.norm());
       const int m = static_cast<int>(f.points.size());
       f.points.push_back(on_wall);
-      handle.push_back(dt.insert(to_cgal(on_wall)));
-      handle.back()->info() = m;
+      grid.add(on_wall, m);
       for (std::size_t t : edge_triangles.at(edge_key(a, b))) {
         std::array<int, 3> first = f.triangles[t], second = f.triangles[t];
         for (int k = 0; k < 3; ++k) {

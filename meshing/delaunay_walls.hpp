@@ -20,16 +20,22 @@ struct WallDelaunaySplits {
 // holds the whole mesh a second time: about three times the memory and the time of a mesh
 // that needs none (docs/findings.md, 2026-11-26). Wall triangles miss where the vertices of a
 // sphere near the wall come inside every sphere through their corners. This splits the longest
-// wall edge of each missing triangle at its midpoint, laid on the cylinder, round by round
-// until none is missing or `max_rounds` have run. The shape is unchanged but for the split
-// edges' sagitta (the new vertices lie on the wall, as the mesher's own do).
+// wall edge of each triangle with no empty sphere through its corners at its midpoint, laid on
+// the cylinder, round by round until none is left or `max_rounds` have run. The shape is
+// unchanged but for the split edges' sagitta (the new vertices lie on the wall, as the
+// mesher's own do).
+//
+// Each wall triangle is first tested on the points within `band` of it, on the safe side: the
+// spheres through its corners have their centres on one line, each point rules out a half-line
+// of them, and one that passes keeps an interval whatever lies farther. The few that fail are
+// then looked up in CGAL's Delaunay tetrahedra of the points near them, and only those missing
+// there (certainly missing from gmsh's too) are split: a split vertex can itself spoil a
+// neighbouring flat face, so none is made needlessly.
 //
 // Inputs: `f`, a welded surface (m); `pieces`, f's triangle ranges as build_fluid_surface makes
-// them (those of Shape::cylinder are the walls); `band` (m): only the points within it of a
-// wall are triangulated, to keep the triangulation small (a triangle passed could still be
-// missing through a sphere deeper than the band, holding no point of it and one beyond).
-// Output: f with new points at its end and each wall's triangles still one range; `pieces`'
-// ranges moved to match.
+// them (those of Shape::cylinder are the walls); `band` (m), larger than the wall triangles'
+// circumradii. Output: f with new points at its end and each wall's triangles still one range;
+// `pieces`' ranges moved to match.
 WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vector<SurfacePiece>& pieces, double band,
                                                      int max_rounds = 8);
 

@@ -290,7 +290,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     piece(Shape::plane);
   }
   f.weld();
-  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 2.0 * wall_edge);
+  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 4.0 * wall_edge);
   round_to_ascii_stl(f);
   out.bed.weld();
 

@@ -1,40 +1,17 @@
 // Wall triangles split until each is a facet of the Delaunay tetrahedra of the surface's
 // points, which gmsh's tetrahedra start from: counted here by CGAL's triangulation of all of
-// them, independently of the function's own (near-wall) triangulation.
+// them, independently of the function's own test of each triangle's circumspheres.
 #include "meshing/delaunay_walls.hpp"
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <gtest/gtest.h>
 
 #include "meshing/primitives.hpp"
 #include "meshing/wall_mesh.hpp"
+#include "support/delaunay_facets.hpp"
 
 using namespace bedforge::meshing;
 
 namespace {
-
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
-using Delaunay = CGAL::Delaunay_triangulation_3<K, CGAL::Triangulation_data_structure_3<Vb, CGAL::Delaunay_triangulation_cell_base_3<K>>>;
-
-// Triangles [first, last) of m that are not facets of the Delaunay tetrahedra of all its points.
-std::size_t not_delaunay(const TriangleMesh& m, std::size_t first, std::size_t last) {
-  std::vector<std::pair<K::Point_3, int>> points;
-  for (std::size_t v = 0; v < m.points.size(); ++v)
-    points.emplace_back(K::Point_3(m.points[v].x(), m.points[v].y(), m.points[v].z()), static_cast<int>(v));
-  const Delaunay dt(points.begin(), points.end());
-  std::vector<Delaunay::Vertex_handle> handle(m.points.size());
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
-  std::size_t n = 0;
-  for (std::size_t t = first; t < last; ++t) {
-    Delaunay::Cell_handle c;
-    int i, j, k;
-    n += !dt.is_facet(handle[m.triangles[t][0]], handle[m.triangles[t][1]], handle[m.triangles[t][2]], c, i, j, k);
-  }
-  return n;
-}
 
 // A tube of radius R = d (d = 3 mm) closed at both ends, its wall meshed at 0.5 d, and one
 // sphere (0.1 d edges) `gap` from its wall: the pieces as build_fluid_surface makes them, the
@@ -65,15 +42,15 @@ Scene tube_with_sphere(double gap) {
 TEST(DelaunayWalls, WallTrianglesFacingASphereNearTheWallBecomeDelaunayFacets) {
   const double d = 0.003, R = d;
   Scene s = tube_with_sphere(0.01 * d);
-  const std::size_t before = not_delaunay(s.f, s.pieces[0].first, s.pieces[0].last);
-  ASSERT_GT(before, 0u) << "the scene no longer has wall triangles off the Delaunay tetrahedra; it tests nothing";
+  const long before = test_support::triangles_gmsh_must_recover(s.f, s.pieces[0].first, s.pieces[0].last);
+  ASSERT_GT(before, 0) << "the scene no longer has wall triangles off the Delaunay tetrahedra; it tests nothing";
   const std::size_t points = s.f.points.size(), others = s.pieces[1].last - s.pieces[1].first;
 
   const WallDelaunaySplits r = split_wall_triangles_off_delaunay(s.f, s.pieces, 1.0 * d);
 
-  EXPECT_EQ(r.missing_before, before);
+  EXPECT_EQ(static_cast<long>(r.missing_before), before);
   EXPECT_EQ(r.missing_after, 0u);
-  EXPECT_EQ(not_delaunay(s.f, s.pieces[0].first, s.pieces[0].last), 0u);
+  EXPECT_EQ(test_support::triangles_gmsh_must_recover(s.f, s.pieces[0].first, s.pieces[0].last), 0);
   // Every split adds one point and two triangles, all to the wall, whose range stays first.
   EXPECT_EQ(s.f.points.size(), points + r.edges_split);
   EXPECT_EQ(s.pieces[0].first, 0u);
@@ -92,7 +69,7 @@ TEST(DelaunayWalls, WallTrianglesFacingASphereNearTheWallBecomeDelaunayFacets) {
 
 TEST(DelaunayWalls, LeavesAWallThatIsAlreadyDelaunayAsItIs) {
   Scene s = tube_with_sphere(0.3 * 0.003);
-  ASSERT_EQ(not_delaunay(s.f, s.pieces[0].first, s.pieces[0].last), 0u);
+  ASSERT_EQ(test_support::triangles_gmsh_must_recover(s.f, s.pieces[0].first, s.pieces[0].last), 0);
   const TriangleMesh before = s.f;
   const WallDelaunaySplits r = split_wall_triangles_off_delaunay(s.f, s.pieces, 0.003);
   EXPECT_EQ(r.missing_before, 0u);
