@@ -2,9 +2,6 @@
 // cannot open the contacts.
 #include "meshing/fluid_surface.hpp"
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,10 +15,10 @@
 #include "meshing/primitives.hpp"
 #include "meshing/stl_io.hpp"
 #include "meshing/surface_checks.hpp"
+#include "support/delaunay_facets.hpp"
 
 using namespace bedforge;
 using namespace bedforge::meshing;
-
 
 TEST(FluidSurface, ShrinkOpensTouchingContactsInACylinder) {
   // A column of three touching spheres on the axis of a tube of a = 3, the bottom one on the
@@ -387,30 +384,6 @@ TEST(FluidSurface, BoxWallsTakeEveryTreatment) {
               4.0 * (2.0 + 2.0) - 8 * 4.0 / 3.0 * std::numbers::pi * std::pow(0.495, 3), 1e-12);
 }
 
-namespace {
-
-// Surface triangles that are no face of the Delaunay tetrahedralisation of the surface's
-// points. gmsh's tetrahedra start from that tetrahedralisation and recover each such face over
-// the whole mesh, at several times the memory and time of the tetrahedra (docs/findings.md).
-long triangles_gmsh_must_recover(const TriangleMesh& m) {
-  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-  using Dt = CGAL::Delaunay_triangulation_3<
-      K, CGAL::Triangulation_data_structure_3<CGAL::Triangulation_vertex_base_with_info_3<int, K>>>;
-  std::vector<std::pair<K::Point_3, int>> points;
-  for (std::size_t k = 0; k < m.points.size(); ++k)
-    points.emplace_back(K::Point_3(m.points[k].x(), m.points[k].y(), m.points[k].z()), static_cast<int>(k));
-  const Dt dt(points.begin(), points.end());
-  std::vector<Dt::Vertex_handle> handle(m.points.size());
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
-  long missing = 0;
-  Dt::Cell_handle c;
-  int i, j, k;
-  for (const auto& t : m.triangles) missing += !dt.is_facet(handle[t[0]], handle[t[1]], handle[t[2]], c, i, j, k);
-  return missing;
-}
-
-}  // namespace
-
 // The flat faces (inlet, outlet, the box's sides) are Delaunay with no four sites on a circle,
 // and the spheres and the cylinder convex: no face is left to recover under shrink and bridge,
 // in a tube, a box and a clipped section. Caps are not: a cap's rim lies in a thin wedge
@@ -442,7 +415,7 @@ TEST(FluidSurface, GmshHasNoFaceToRecoverUnderShrinkAndBridge) {
       SurfaceParams p = params;
       p.treatment = p.wall_treatment = t;
       const FluidSurface fs = build_fluid_surface(bed, p);
-      EXPECT_EQ(triangles_gmsh_must_recover(fs.fluid), 0) << name << ", " << treatment;
+      EXPECT_EQ(test_support::triangles_gmsh_must_recover(fs.fluid), 0) << name << ", " << treatment;
     }
 }
 
