@@ -10,7 +10,7 @@ namespace bedforge::meshing {
 // What split_wall_triangles_off_delaunay did.
 struct WallDelaunaySplits {
   std::size_t missing_before = 0;  // wall triangles not in the Delaunay tetrahedra of the points, at first
-  std::size_t missing_after = 0;   // the same when it stopped (0 unless `max_rounds` ran out)
+  std::size_t missing_after = 0;   // the same when it stopped: gmsh recovers these
   std::size_t edges_split = 0;
   int rounds = 0;
 };
@@ -21,9 +21,11 @@ struct WallDelaunaySplits {
 // that needs none (docs/findings.md, 2026-11-26). Wall triangles miss where the vertices of a
 // sphere near the wall come inside every sphere through their corners. This splits the longest
 // wall edge of each triangle with no empty sphere through its corners at its midpoint, laid on
-// the cylinder, round by round until none is left or `max_rounds` have run. The shape is
-// unchanged but for the split edges' sagitta (the new vertices lie on the wall, as the
-// mesher's own do).
+// the cylinder, round by round until none is left or `max_rounds` have run. A split that would
+// make a triangle with an angle under 10 degrees is not made (along a hole's loop, whose edges
+// cannot be split, triangles would thin round by round): such a triangle is left to gmsh. The
+// shape is unchanged but for the split edges' sagitta (the new vertices lie on the wall, as
+// the mesher's own do).
 //
 // Each wall triangle is first tested on the points within `band` of it, on the safe side: the
 // spheres through its corners have their centres on one line, each point rules out a half-line
@@ -37,6 +39,6 @@ struct WallDelaunaySplits {
 // circumradii. Output: f with new points at its end and each wall's triangles still one range;
 // `pieces`' ranges moved to match.
 WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vector<SurfacePiece>& pieces, double band,
-                                                     int max_rounds = 8);
+                                                     int max_rounds = 2);
 
 }  // namespace bedforge::meshing
