@@ -6,11 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstdint>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+
+#include "meshing/spaced_points.hpp"
 
 namespace bedforge::meshing {
 
@@ -20,38 +21,6 @@ std::uint64_t edge_key(int a, int b) {
   return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
 }
 
-double distance_from_axis(const SurfacePiece& w, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d q = p - w.centre;
-  return (q - q.dot(w.axis) * w.axis).norm();
-}
-
-// The points near the walls by cubic cell of side `side`.
-class PointGrid {
- public:
-  explicit PointGrid(double side) : side_(side) {}
-  void add(const Eigen::Vector3d& p, int v) { cells_[key(cell(p))].push_back(v); }
-  // Calls visit(v) for every point in the cells the cube of half-side `side` about p meets.
-  template <class Visit>
-  void near(const Eigen::Vector3d& p, const Visit& visit) const {
-    const Eigen::Array3i c = cell(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz)
-          if (const auto it = cells_.find(key(c + Eigen::Array3i(dx, dy, dz))); it != cells_.end())
-            for (int v : it->second) visit(v);
-  }
-
- private:
-  Eigen::Array3i cell(const Eigen::Vector3d& p) const { return (p.array() / side_).floor().cast<int>(); }
-  static std::uint64_t key(const Eigen::Array3i& c) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x()) & 0x1fffff) << 42) |
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y()) & 0x1fffff) << 21) |
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()) & 0x1fffff));
-  }
-  double side_;
-  std::unordered_map<std::uint64_t, std::vector<int>> cells_;
-};
-
 // Whether some sphere through the corners of triangle t holds none of the points within
 // `reach` of it: then t is a facet of their Delaunay tetrahedra. The spheres through the corners
 // have their centres on the normal through the circumcentre C, at C + s n; a point P lies
@@ -60,7 +29,7 @@ class PointGrid {
 // |s| < (reach^2 - c^2) / (2 reach) free, so the interval is cut to that: a triangle this passes
 // is a facet whatever lies beyond; one it fails may be too (then it is split needlessly), and
 // near-ties fail.
-bool has_empty_circumsphere(const TriangleMesh& f, const std::array<int, 3>& t, const PointGrid& grid, double reach) {
+bool has_empty_circumsphere(const TriangleMesh& f, const std::array<int, 3>& t, const PointsByCell& grid, double reach) {
   const Eigen::Vector3d &p0 = f.points[t[0]], &p1 = f.points[t[1]], &p2 = f.points[t[2]];
   const Eigen::Vector3d a = p0 - p2, b = p1 - p2, axb = a.cross(b);
   const double area2 = axb.squaredNorm();
@@ -89,7 +58,7 @@ bool has_empty_circumsphere(const TriangleMesh& f, const std::array<int, 3>& t, 
 // not facets of CGAL's Delaunay tetrahedra of the points within `reach` of one of them: more
 // points only take facets away, so each is certainly missing from gmsh's start too.
 std::vector<std::size_t> certainly_missing(const TriangleMesh& f, const std::vector<std::size_t>& candidates,
-                                           const PointGrid& grid, double reach) {
+                                           const PointsByCell& grid, double reach) {
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
   using Delaunay =
@@ -129,14 +98,6 @@ Eigen::Vector3d midpoint_on_wall(const SurfacePiece& wall, const Eigen::Vector3d
   return wall.centre + along + radial * (wall.radius / radial.norm());
 }
 
-// Smallest interior angle of the triangle (p, q, r), degrees.
-double smallest_angle_deg(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
-  auto angle = [](const Eigen::Vector3d& at, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-    return std::atan2((u - at).cross(v - at).norm(), (u - at).dot(v - at));
-  };
-  return std::min({angle(p, q, r), angle(q, r, p), angle(r, p, q)}) * 180.0 / std::numbers::pi;
-}
-
 // A split must not leave slivers: each of the four new triangles keeps at least this angle.
 // Triangles along a hole's loop, whose loop edge cannot be split, would otherwise thin round by
 // round (0.47 degrees on the a = 5, N = 1e4 enlarge surface); such a triangle is left to gmsh.
@@ -153,10 +114,10 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
   if (walls.empty()) return out;
 
   // 1. The points within `band` of a wall, by cell.
-  PointGrid grid(band);
+  PointsByCell grid(band);
   for (std::size_t v = 0; v < f.points.size(); ++v)
     for (std::size_t w : walls)
-      if (std::abs(distance_from_axis(pieces[w], f.points[v]) - pieces[w].radius) < band) {
+      if (std::abs(from_axis(f.points[v], pieces[w].centre, pieces[w].axis) - pieces[w].radius) < band) {
         grid.add(f.points[v], static_cast<int>(v));
         break;
       }
@@ -204,11 +165,11 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
         double smallest = 180.0;
         for (std::size_t s : shared) {
           const Eigen::Vector3d& c = f.points[opposite(f.triangles[s], a, b)];
-          smallest = std::min({smallest, smallest_angle_deg(f.points[a], m, c), smallest_angle_deg(m, f.points[b], c)});
+          smallest = std::min({smallest, min_angle_deg(f.points[a], m, c), min_angle_deg(m, f.points[b], c)});
         }
         if (smallest < kSmallestNewAngleDeg) continue;
         touched.insert(shared.begin(), shared.end());
-        split.emplace_back(tri[e], tri[(e + 1) % 3]);
+        split.emplace_back(a, b);
         break;
       }
     }

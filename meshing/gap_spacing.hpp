@@ -1,10 +1,10 @@
 #pragma once
 #include <Eigen/Core>
 
-#include <unordered_map>
 #include <vector>
 
 #include "core/container.hpp"
+#include "meshing/spaced_points.hpp"
 
 namespace bedforge::meshing {
 
@@ -30,8 +30,8 @@ class GapSpacing {
   const std::vector<Eigen::Vector3d>& centres_;
   const std::vector<double>& radii_;
   const Container& container_;
-  double cells_, finest_, coarsest_, cell_;
-  std::unordered_map<long, std::vector<int>> grid_;  // kept spheres by the cell of their centre
+  double cells_, finest_, coarsest_;
+  PointsByCell grid_;  // kept spheres by the cell of their centre
 };
 
 }  // namespace bedforge::meshing

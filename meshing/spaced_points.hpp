@@ -10,30 +10,49 @@
 
 namespace bedforge::meshing {
 
-// Hash key of the grid cell (x, y, z), for grids kept in a hash map.
-inline long grid_cell_key(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
+// Indices of points by the cubic cell of side `cell` that holds each (a hash grid): near(p, visit)
+// visits every index in the 27 cells about p's, which hold every point within `cell` of p (and
+// some farther, which callers filter by distance).
+class PointsByCell {
+ public:
+  explicit PointsByCell(double cell) : cell_(cell) {}
+  void add(const Eigen::Vector3d& p, int index) {
+    const auto k = cell_of(p);
+    cells_[key(k[0], k[1], k[2])].push_back(index);
+  }
+  template <class Visit>
+  void near(const Eigen::Vector3d& p, const Visit& visit) const {
+    const auto k = cell_of(p);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz)
+          if (const auto it = cells_.find(key(k[0] + dx, k[1] + dy, k[2] + dz)); it != cells_.end())
+            for (int index : it->second) visit(index);
+  }
+
+ private:
+  std::array<long, 3> cell_of(const Eigen::Vector3d& p) const {
+    return {static_cast<long>(std::floor(p.x() / cell_)), static_cast<long>(std::floor(p.y() / cell_)),
+            static_cast<long>(std::floor(p.z() / cell_))};
+  }
+  static long key(long x, long y, long z) { return (x * 73856093L) ^ (y * 19349663L) ^ (z * 83492791L); }
+  double cell_;
+  std::unordered_map<long, std::vector<int>> cells_;
+};
 
 // Candidate mesh vertices (spheres, walls), accepted in order when no accepted vertex lies closer
 // than 0.8 x the mean of their spacings (a Poisson-disk rule with local sizes): a uniform grid
 // of cell `cell` >= every spacing keeps the test to the 27 neighbouring cells.
 class SpacedPoints {
  public:
-  explicit SpacedPoints(double cell) : cell_(cell) {}
+  explicit SpacedPoints(double cell) : grid_(cell) {}
   bool fits(const Eigen::Vector3d& p, double spacing) const {
-    const auto k = key(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = grid_.find(grid_cell_key(k[0] + dx, k[1] + dy, k[2] + dz));
-          if (it == grid_.end()) continue;
-          for (int q : it->second)
-            if ((points[q] - p).norm() < 0.4 * (spacing + spacing_[q])) return false;
-        }
-    return true;
+    bool fits = true;
+    grid_.near(p, [&](int q) { fits = fits && (points[q] - p).norm() >= 0.4 * (spacing + spacing_[q]); });
+    return fits;
   }
   void add(const Eigen::Vector3d& p, double spacing) {
-    const auto k = key(p);
-    grid_[grid_cell_key(k[0], k[1], k[2])].push_back(static_cast<int>(points.size()));
+    grid_.add(p, static_cast<int>(points.size()));
     points.push_back(p);
     spacing_.push_back(spacing);
   }
@@ -41,12 +60,7 @@ class SpacedPoints {
   std::vector<Eigen::Vector3d> points;
 
  private:
-  std::array<long, 3> key(const Eigen::Vector3d& p) const {
-    return {static_cast<long>(std::floor(p.x() / cell_)), static_cast<long>(std::floor(p.y() / cell_)),
-            static_cast<long>(std::floor(p.z() / cell_))};
-  }
-  double cell_;
-  std::unordered_map<long, std::vector<int>> grid_;
+  PointsByCell grid_;
   std::vector<double> spacing_;
 };
 

@@ -57,11 +57,6 @@ struct IndexedBox : CGAL::Box_intersection_d::Box_d<double, 3, CGAL::Box_interse
   std::size_t index;
 };
 
-// Distance from v to the line through `centre` along the unit `axis`.
-double from_axis(const Eigen::Vector3d& v, const Eigen::Vector3d& centre, const Eigen::Vector3d& axis) {
-  return (v - centre - (v - centre).dot(axis) * axis).norm();
-}
-
 // The indices 0 .. n-1 of n triangles.
 std::vector<std::size_t> all_of(std::size_t n) {
   std::vector<std::size_t> all(n);

@@ -9,6 +9,12 @@
 
 namespace bedforge::meshing {
 
+// Distance from p to the line through `centre` along the unit `axis` (m).
+inline double from_axis(const Eigen::Vector3d& p, const Eigen::Vector3d& centre, const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d q = p - centre;
+  return (q - q.dot(axis) * axis).norm();
+}
+
 // A part of a surface meshed on its own: triangles [first, last) of the mesh, and what is known
 // of them by how they were made (lengths in m). The test by pieces checks each shape's premise
 // on the vertices (every vertex on the sphere, the plane or the cylinder, up to 1e-9 of its size

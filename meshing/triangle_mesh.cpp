@@ -83,16 +83,21 @@ void orient_by(TriangleMesh& m, const std::function<Eigen::Vector3d(const Eigen:
   }
 }
 
-double min_angle_deg(const TriangleMesh& m, std::size_t t) {
+double min_angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const std::array<const Eigen::Vector3d*, 3> corner{&a, &b, &c};
   double smallest = 180.0;
-  const auto& tri = m.triangles[t];
   for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d& a = m.points[tri[k]];
-    const Eigen::Vector3d u = m.points[tri[(k + 1) % 3]] - a, v = m.points[tri[(k + 2) % 3]] - a;
-    const double c = u.dot(v) / std::max(u.norm() * v.norm(), 1e-300);
-    smallest = std::min(smallest, std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+    const Eigen::Vector3d& at = *corner[k];
+    const Eigen::Vector3d u = *corner[(k + 1) % 3] - at, v = *corner[(k + 2) % 3] - at;
+    const double cosine = u.dot(v) / std::max(u.norm() * v.norm(), 1e-300);
+    smallest = std::min(smallest, std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / std::numbers::pi);
   }
   return smallest;
+}
+
+double min_angle_deg(const TriangleMesh& m, std::size_t t) {
+  const auto& tri = m.triangles[t];
+  return min_angle_deg(m.points[tri[0]], m.points[tri[1]], m.points[tri[2]]);
 }
 
 TriangleMesh triangles_below_angle(const TriangleMesh& m, double limit_deg) {

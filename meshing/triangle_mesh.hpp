@@ -40,7 +40,8 @@ struct MeshQuality {
   double min_angle_deg = 180.0, min_edge = 0.0, max_edge = 0.0;
 };
 MeshQuality mesh_quality(const TriangleMesh& mesh);
-// Smallest interior angle of triangle t of `mesh` (degrees).
+// Smallest interior angle of the triangle (a, b, c), and of triangle t of `mesh` (degrees).
+double min_angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 double min_angle_deg(const TriangleMesh& mesh, std::size_t t);
 // The triangles of `mesh` with an angle below `limit_deg`, each with its own three vertices,
 // patches and labels kept (for a diagnostic file).
