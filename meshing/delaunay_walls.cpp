@@ -122,6 +122,11 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
         break;
       }
 
+  // The surface as it was, to go back to when the splits cannot finish.
+  std::vector<std::array<int, 3>> triangles_before;
+  std::vector<int> patch_before;
+  std::vector<SurfacePiece> pieces_before;
+  const std::size_t points_before = f.points.size();
   for (;; ++out.rounds) {
     // 2. The wall triangles with no empty circumsphere, and the longest of each one's edges
     // shared with another wall triangle (a hole's loop or the strip's end row is left as it is).
@@ -174,6 +179,7 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
       }
     }
     if (split.empty()) break;
+    if (out.edges_split == 0) triangles_before = f.triangles, patch_before = f.patch, pieces_before = pieces;
     // 3. Each edge split at its midpoint on the wall; each of its two triangles becomes two, the
     // second appended to its wall's range.
     std::vector<std::vector<std::array<int, 3>>> added(pieces.size());
@@ -212,6 +218,13 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
     for (std::size_t t = next; t < f.triangles.size(); ++t) triangles.push_back(f.triangles[t]), patch.push_back(f.patch[t]);
     f.triangles = std::move(triangles);
     f.patch = std::move(patch);
+  }
+  if (out.missing_after > 0 && out.edges_split > 0) {
+    f.points.resize(points_before);
+    f.triangles = std::move(triangles_before);
+    f.patch = std::move(patch_before);
+    pieces = std::move(pieces_before);
+    out.kept = false;
   }
   return out;
 }

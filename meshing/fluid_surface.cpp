@@ -310,7 +310,8 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.report["wall_delaunay"] = {{"missing_before", splits.missing_before},
                                  {"missing_after", splits.missing_after},
                                  {"edges_split", splits.edges_split},
-                                 {"rounds", splits.rounds}};
+                                 {"rounds", splits.rounds},
+                                 {"kept", splits.kept}};
   out.report["triangles"] = f.triangles.size();
   out.report["min_angle_deg"] = q.min_angle_deg;
   out.report["min_edge_d"] = q.min_edge / d;

@@ -50,6 +50,7 @@ TEST(DelaunayWalls, WallTrianglesFacingASphereNearTheWallBecomeDelaunayFacets) {
 
   EXPECT_EQ(static_cast<long>(r.missing_before), before);
   EXPECT_EQ(r.missing_after, 0u);
+  EXPECT_TRUE(r.kept);
   EXPECT_EQ(test_support::triangles_gmsh_must_recover(s.f, s.pieces[0].first, s.pieces[0].last), 0);
   // Every split adds one point and two triangles, all to the wall, whose range stays first.
   EXPECT_EQ(s.f.points.size(), points + r.edges_split);
@@ -76,4 +77,28 @@ TEST(DelaunayWalls, LeavesAWallThatIsAlreadyDelaunayAsItIs) {
   EXPECT_EQ(r.edges_split, 0u);
   EXPECT_EQ(s.f.triangles, before.triangles);
   EXPECT_EQ(s.f.points, before.points);
+}
+
+// A sphere 0.002 d off the wall: each split brings new wall triangles inside its vertices'
+// reach (2 missing, then 6 after two rounds, as measured when this test was written).
+TEST(DelaunayWalls, UndoesSplitsThatCannotFinish) {
+  Scene s = tube_with_sphere(0.002 * 0.003);
+  const long before = test_support::triangles_gmsh_must_recover(s.f, s.pieces[0].first, s.pieces[0].last);
+  const TriangleMesh surface = s.f;
+  const std::vector<SurfacePiece> pieces = s.pieces;
+
+  const WallDelaunaySplits r = split_wall_triangles_off_delaunay(s.f, s.pieces, 0.003);
+
+  ASSERT_GT(r.edges_split, 0u) << "no split was tried; the test tests nothing";
+  ASSERT_GT(r.missing_after, 0u) << "the splits finished here; the test tests nothing";
+  EXPECT_FALSE(r.kept);
+  EXPECT_EQ(s.f.points, surface.points);
+  EXPECT_EQ(s.f.triangles, surface.triangles);
+  EXPECT_EQ(s.f.patch, surface.patch);
+  ASSERT_EQ(s.pieces.size(), pieces.size());
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    EXPECT_EQ(s.pieces[k].first, pieces[k].first);
+    EXPECT_EQ(s.pieces[k].last, pieces[k].last);
+  }
+  EXPECT_EQ(static_cast<long>(r.missing_before), before);
 }
