@@ -235,6 +235,29 @@ TEST(FluidSurface, EnlargeGrowsSpheresLeftNearerThanTheJoinGapUntilNoneIs) {
   EXPECT_NEAR(sliver.report["smallest_gap_d"]["particle_particle"].get<double>(), 0.005, 1e-9);
 }
 
+TEST(FluidSurface, EnlargeGrowsAJointTooThinToMesh) {
+  // Two spheres 0.0099 d apart in a tube a = 4: enlarging by 1.01 leaves them overlapping by
+  // only 0.0001 d, a neck around which the fluid is a wedge of 1.6 degrees. Being under half
+  // the 0.01 d that touching spheres get, both grow by (0.01 - 0.0001) / 2 to overlap by
+  // 0.01 d; the wedge at their joint circle (radius rho) is then 2 asin(rho / r).
+  const double x = 0.50495;
+  const Bed pair = column(std::make_shared<Cylinder>(2.0), {{-x, 0, 0.6}, {x, 0, 0.6}});
+  const FluidSurface fs = valid_surface(pair, Treatment::enlarge, "thin joint");
+  EXPECT_EQ(fs.report["contacts_treated"]["grown_to_meet_a_sphere"].get<long>(), 1);
+  const double r = 0.505 + 0.5 * (0.01 - 0.0001), rho = std::sqrt(r * r - x * x);
+  EXPECT_NEAR(fs.report["smallest_fluid_wedge_angle_deg"].get<double>(), 2.0 * std::asin(rho / r) * 180.0 / std::numbers::pi,
+              1e-6);
+  // Overlapping by 0.006 d after enlarging (0.004 d apart before), more than half: left as it is.
+  const Bed near = column(std::make_shared<Cylinder>(2.0), {{-0.502, 0, 0.6}, {0.502, 0, 0.6}});
+  EXPECT_EQ(valid_surface(near, Treatment::enlarge, "joint kept").report["contacts_treated"]["grown_to_meet_a_sphere"].get<long>(),
+            0);
+  // A sphere 0.0049 d from the wall of a tube a = 3 crosses it by 0.0001 d once enlarged, under
+  // half the 0.005 d that a sphere touching the wall gets: grown to cross it by that.
+  const Bed wall = column(std::make_shared<Cylinder>(1.5), {{0.9951, 0, 0.6}});
+  EXPECT_EQ(valid_surface(wall, Treatment::enlarge, "thin wall joint").report["contacts_treated"]["grown_to_meet_the_wall"].get<long>(),
+            1);
+}
+
 TEST(FluidSurface, ThreeMutuallyTouchingSpheresInAnAnnulus) {
   // Three spheres touching each other (bridges meeting on one sphere), the outer one tangent
   // to the outer wall, one tangent to the inner wall.
