@@ -20,7 +20,7 @@ struct SurfaceParams {
   Treatment wall_treatment = Treatment::shrink;  // bridge, cap or none; shrink and enlarge act on the walls' contacts too
   double shrink_factor = 0.99;
   double enlarge_factor = 1.01;
-  double enlarge_join_gap_d = 0.01;     // enlarge: spheres left nearer than this to a sphere or wall are grown to join it
+  double enlarge_join_gap_d = 0.01;     // enlarge: spheres left nearer than this to a sphere or wall are grown to join it (thin joints are, whatever it is)
   double bridge_diameter_d = 0.2;
   double bridge_gap_d = 0.01;           // pairs closer than this get a bridge
   double cap_gap_d = 0.02;              // pairs closer than this are capped, leaving this gap
