@@ -154,7 +154,12 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
         if (t >= pieces[w].first && t < pieces[w].last) return w;
       return walls[0];
     };
-    std::vector<std::pair<int, int>> split;
+    // A split: edge (a, b) and its new vertex, chosen by the angle guard.
+    struct Split {
+      int a, b;
+      Eigen::Vector3d point;
+    };
+    std::vector<Split> split;
     std::unordered_set<std::size_t> touched;
     for (std::size_t t : missing) {
       if (touched.count(t)) continue;
@@ -174,7 +179,7 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
         }
         if (smallest < kSmallestNewAngleDeg) continue;
         touched.insert(shared.begin(), shared.end());
-        split.emplace_back(a, b);
+        split.push_back({a, b, m});
         break;
       }
     }
@@ -183,12 +188,10 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
     // 3. Each edge split at its midpoint on the wall; each of its two triangles becomes two, the
     // second appended to its wall's range.
     std::vector<std::vector<std::array<int, 3>>> added(pieces.size());
-    for (const auto& [a, b] : split) {
-      const Eigen::Vector3d on_wall =
-          midpoint_on_wall(pieces[wall_of(edge_triangles.at(edge_key(a, b))[0])], f.points[a], f.points[b]);
-      const int m = static_cast<int>(f.points.size());
-      f.points.push_back(on_wall);
-      grid.add(on_wall, m);
+    for (const Split& e : split) {
+      const int a = e.a, b = e.b, m = static_cast<int>(f.points.size());
+      f.points.push_back(e.point);
+      grid.add(e.point, m);
       for (std::size_t t : edge_triangles.at(edge_key(a, b))) {
         std::array<int, 3> first = f.triangles[t], second = f.triangles[t];
         for (int k = 0; k < 3; ++k) {
