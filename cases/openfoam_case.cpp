@@ -36,7 +36,7 @@ CaseParams read_case_params(SceneSection& s) {
   p.viscosity_pa_s = s.number("viscosity_pa_s", p.viscosity_pa_s, Range::positive());
   p.iterations = static_cast<int>(s.integer("iterations", p.iterations, 1, 1'000'000));
   p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
-  p.residual_u = s.number("residual_u", p.residual_u, Range::open(0.0, 1.0));
+  if (s.has("residual_u")) p.residual_u = s.number("residual_u", 1.0e-4, Range::open(0.0, 1.0));
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
@@ -64,7 +64,7 @@ CaseParams read_case_params(SceneSection& s) {
 nlohmann::json to_json(const CaseParams& p) {
   return {{"reynolds", p.reynolds},         {"density_kg_m3", p.density_kg_m3},
           {"viscosity_pa_s", p.viscosity_pa_s}, {"iterations", p.iterations},
-          {"residual_p", p.residual_p},     {"residual_u", p.residual_u},
+          {"residual_p", p.residual_p},     {"residual_u", p.residual_u ? nlohmann::json(*p.residual_u) : nlohmann::json()},
           {"processors", p.processors},     {"decomposition", p.decomposition},
           {"format", p.binary ? "binary" : "ascii"}, {"cells", p.polyhedra ? "polyhedra" : "tetrahedra"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
@@ -368,10 +368,14 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
 }
 
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
-                    const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed, const CaseParams& p,
-                    const std::string& note, const std::string& scene_toml, const std::string& bed_csv,
-                    const fs::path& fluid_stl) {
+                    const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
+                    const CaseParams& given, const std::string& note, const std::string& scene_toml,
+                    const std::string& bed_csv, const fs::path& fluid_stl) {
   refuse_existing_case(case_dir, overwrite);
+  CaseParams p = given;
+  const bool prism_layers =
+      mesh && std::any_of(mesh->faces.begin(), mesh->faces.end(), [](const meshing::Face& f) { return f.size() == 4; });
+  if (!p.residual_u) p.residual_u = prism_layers ? 1.0e-2 : 1.0e-4;
   std::random_device rd;
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
@@ -458,7 +462,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                 "    residualControl\n    {{\n        p               {};\n        U               {};\n    }}\n}}\n\n"
                                 "relaxationFactors\n{{\n    equations\n    {{\n        U               0.9;\n    }}\n"
                                 "    fields\n    {{\n        p               1;\n    }}\n}}\n",
-                                p.residual_p, p.residual_u)));
+                                p.residual_p, *p.residual_u)));
     write_text(tmp / "system/decomposeParDict",
                dict("dictionary", "system", "decomposeParDict", note,
                     fmt::format("numberOfSubdomains {};\n\nmethod          {};\n\n"
@@ -721,7 +725,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   // the residuals keep falling geometrically to their targets, and follows the one furthest
   // from its target.
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
-  const double target_p = c.params.residual_p, target_u = c.params.residual_u;
+  const double target_p = c.params.residual_p, target_u = c.params.residual_u.value();
   double start_p = 0.0, start_u = 0.0;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");

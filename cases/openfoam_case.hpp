@@ -24,7 +24,10 @@ struct CaseParams {
   int iterations = 3000;                // simpleFoam iteration cap (endTime)
   double residual_p = 1.0e-4;           // SIMPLE stops when the initial residuals fall below these (on
                                         // these tetrahedral meshes p plateaus near 5e-5 once dp has 4 digits)
-  double residual_u = 1.0e-4;
+  // Unset: 1e-4, or 1e-2 on cells with prism layers (quadrilateral faces), where U's residual
+  // stalls near 3e-3 while the pressure drop has settled (docs/findings.md, 2026-11-26, night);
+  // write_case sets it.
+  std::optional<double> residual_u;
   int processors = 1;                   // subdomains in decomposeParDict; Allrun -np N overrides
   // hierarchical: slabs along the column (n = 1 1 N), few interface faces in a column; scotch:
   // graph partitioning, for OpenFOAM builds that have it (Debian's v1912 ships only a stub).
