@@ -50,6 +50,15 @@ nlohmann::json ConvergenceStudy::to_json() const {
   return out;
 }
 
+LevelLengths level_lengths(const Scene& scene, double scale) {
+  LevelLengths l{scene.surface, scene.mesh};
+  l.surface.edge_length_d *= scale;
+  l.surface.contact_edge_length_d *= scale;
+  l.surface.cells_per_gap /= scale;
+  l.mesh.max_size_d *= scale;
+  return l;
+}
+
 StudyLevel study_level(const CaseStage& solved, int level, double scale, double surface_mesh_s) {
   StudyLevel l;
   l.level = level;
@@ -85,8 +94,8 @@ struct Sized {
 };
 
 // Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
-// do not set the cell size in proportion (points per sphere and per contact loop, gap and
-// wall rules stay), so the scale is searched in log-log secant steps, starting from `finer`
+// do not set the cell size in proportion (points per sphere and per contact loop and the wall
+// rules stay), so the scale is searched in log-log secant steps, starting from `finer`
 // (the finer level's scale and size; the next level's on return) and an exponent `alpha` of
 // h ~ scale^alpha, updated with what was measured.
 StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_h_m, Sized& finer, double& alpha,
@@ -100,11 +109,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     double surface_mesh_s = 0.0;  // of the last attempt, the mesh solved on
     double last_scale = finer.scale, last_h = finer.h;
     for (int attempt = 1;; ++attempt) {
-      meshing::SurfaceParams surface = scene.surface;
-      surface.edge_length_d *= scale;
-      surface.contact_edge_length_d *= scale;
-      meshing::VolumeMeshParams mesh = scene.mesh;
-      mesh.max_size_d *= scale;
+      const auto [surface, mesh] = level_lengths(scene, scale);
       const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
       m.reset();  // the previous attempt's mesh is not needed any more
       m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, mesh, {}, case_dir.parent_path() / "bad_cells.vtk",

@@ -52,14 +52,24 @@ struct ConvergenceStudy {
   nlohmann::json to_json() const;
 };
 
+// The surface and mesh settings of a level whose lengths are `scale` times the scene's: the
+// surface's edge and contact edge, the mesh's largest cell, and the edge across narrow gaps
+// (gap / cells_per_gap: cells_per_gap is divided by `scale`, and the gaps it refines stay the
+// same). Celik et al.'s procedure needs meshes refined alike everywhere; with cells_per_gap
+// kept, the gaps' cells were the same on every level.
+struct LevelLengths {
+  meshing::SurfaceParams surface;
+  meshing::VolumeMeshParams mesh;
+};
+LevelLengths level_lengths(const Scene& scene, double scale);
+
 // Level `level` (lengths x `scale`) from its solved case, its time the flow's; `surface_mesh_s`
 // the time its surface and mesh took to make.
 StudyLevel study_level(const CaseStage& solved, int level, double scale, double surface_mesh_s);
 
 // The study of [case.convergence] on `bed` (m): `finest` is the scene's own level, already
-// solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's
-// surface.edge_length_d, surface.contact_edge_length_d and mesh.max_size_d by the factor that
-// makes its cells ratio^(k - 1) times the size of the finest's (searched: up to 4 surfaces and
+// solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's lengths
+// (level_lengths) by the factor that makes its cells ratio^(k - 1) times the size of the finest's (searched: up to 4 surfaces and
 // meshes, to within 3 %), builds its surface and mesh in memory and solves its case in
 // `dir`/level_k. A level that fails (a gate, the solver) is reported with its reason, and the
 // others go on.
