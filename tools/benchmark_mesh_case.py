@@ -34,7 +34,7 @@ study:  a = 5, N = 500, bridges, the finest surface edge of --edges, one `bedfor
         time, the apparent order, the extrapolated dp/L and the GCI of the finest mesh, and the
         run's wall time from scene to that result. The section records the commit and date.
 study_gaps: the same study with surface.cells_per_gap = --study-gap-cells from a finest edge of
-        --study-gap-edge d (the gaps' refinement scales with the levels, through the contact edge).
+        --study-gap-edge d (each coarser level divides cells_per_gap by its scale, so the gaps coarsen with the rest).
 study_reynolds: the study_gaps run at each Re_p of --reynolds (laminar), with a table of the
         extrapolated dp/L against Eisfeld & Schnitzlein's across Re_p = 1 (study_gaps) and these.
 study_treatments: the study_gaps run with each contact treatment of --treatments (bridge is study_gaps),
@@ -383,6 +383,24 @@ def stamp(rows):
                             "since."), ""]
 
 
+# From this commit on, a study's coarser levels divide surface.cells_per_gap by their scale.
+GAPS_COARSENED_FROM = "ac6e6bc"
+
+
+def gaps_not_coarsened(r):
+    """Whether a gap-refined study was made before its coarser levels coarsened the gaps' cells."""
+    if not r.get("cells_per_gap"):
+        return False
+    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, r["commit"]],
+                           cwd=os.path.dirname(os.path.abspath(__file__)), capture_output=True)
+    return known.returncode != 0
+
+
+def made(r):
+    """A study row's commit and date, marked when its levels were not refined alike."""
+    return f"{r['commit']} {r['date']}" + (" (gaps not coarsened)" if gaps_not_coarsened(r) else "")
+
+
 def study_lines(r):
     """A convergence study's section: its levels against E&S, the verdict, and the extrapolation
     when the levels are in the asymptotic range."""
@@ -392,7 +410,10 @@ def study_lines(r):
              + f", Re_p = {r.get('reynolds', 1.0):g}: mesh-convergence study ([case.convergence])", "",
              f"Made at commit {r['commit']} on {r['date']}: one `bedforge run` whose finest mesh has a surface "
              f"edge of {r['edge_d']} d, {len(st['levels'])} levels, ratio {r['ratio']}; scene to extrapolated "
-             f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB.", "",
+             f"pressure drop in {r['wall_s'] / 60:.1f} min wall, peak {r['peak_mb'] / 1024:.1f} GB."
+             + (f" Made before {GAPS_COARSENED_FROM}: its coarser levels kept cells_per_gap, so the gaps' cells were "
+                "the same on every level, the levels were not refined alike, and the order, extrapolation and GCI "
+                "below rest on the rest of the mesh alone." if gaps_not_coarsened(r) else ""), "",
              "| level | lengths x | cells | h / d | h / finer h | dp/L (Pa/m) | / E&S at the bed's eps | "
              "/ E&S at the finest mesh's eps | walls' share of the drag | momentum balance | time (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -650,7 +671,7 @@ def write(results):
                   "|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in runs:
             g, finest, ext = study_values(r)
-            lines.append(f"| {r.get('reynolds', 1.0):g} | {r['commit']} {r['date']} | "
+            lines.append(f"| {r.get('reynolds', 1.0):g} | {made(r)} | "
                          + (f"{finest:.4g}" if finest else "failed") + " | "
                          + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} % | "
                             f"{'yes' if g.get('asymptotic') else 'no'}" if ext is not None else "none | | | no")
@@ -690,7 +711,7 @@ def write(results):
             if change is not None and r["eps_section"] != r["eps_section_bed"]:
                 slope = math.log(r["es_pa_m"] / r["es_bed_pa_m"]) / (r["eps_section"] - r["eps_section_bed"])
                 treated = r["es_bed_pa_m"] * math.exp(slope * -change * (1 - r["eps_section_bed"]))
-            lines.append(f"| {r['treatment']} | {r['commit']} {r['date']} | "
+            lines.append(f"| {r['treatment']} | {made(r)} | "
                          + (f"{100 * change:+.2f} %" if change is not None else "not recorded") + " | "
                          + (f"{finest:.4g}" if finest else "failed") + f" | {against_bridge(r)} | "
                          + (f"{ext:.4g} | {g['apparent_order']:.2f} | {100 * g['gci_fine']:.1f} %" if ext else
