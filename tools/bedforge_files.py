@@ -39,6 +39,20 @@ def made_line(result, unstamped=UNSTAMPED):
     return unstamped
 
 
+# From this commit on, a convergence study's coarser levels divide surface.cells_per_gap by their
+# scale; before it the gaps' cells were the same on every level.
+GAPS_COARSENED_FROM = "ac6e6bc"
+
+
+def gaps_not_coarsened(study):
+    """Whether a gap-refined study's result was made before its coarser levels coarsened the gaps."""
+    if not study.get("cells_per_gap"):
+        return False
+    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, study["commit"]],
+                           cwd=ROOT, capture_output=True)
+    return known.returncode != 0
+
+
 def read_bed(path):
     """bed.csv: (centres (n, 3) m, diameters (n,) m, container dict in metres from its header)."""
     container = {}

@@ -32,7 +32,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line, read_csv  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line, read_csv  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "error_vs_time.json")
 SECTIONS = ["packer", "surface", "mesh"]
@@ -124,10 +124,11 @@ def mesh_section():
     for r in [src["study_gaps"]] + src.get("study_reynolds", []):
         g = r["study"].get("grid_convergence", {})
         levels = [lv for lv in r["study"]["levels"] if "failure" not in lv]
-        if not g.get("asymptotic") or any("own_time_s" not in lv for lv in levels):
-            left_out.append({"reynolds": r["reynolds"], "commit": r["commit"],
-                             "why": "not in the asymptotic range" if not g.get("asymptotic") else
-                             "made before levels recorded their own time"})
+        why = ("its levels not refined alike (made before " + GAPS_COARSENED_FROM + ", the gaps not coarsened)"
+               if gaps_not_coarsened(r) else "not in the asymptotic range" if not g.get("asymptotic") else
+               "made before levels recorded their own time" if any("own_time_s" not in lv for lv in levels) else None)
+        if why:
+            left_out.append({"reynolds": r["reynolds"], "commit": r["commit"], "why": why})
             continue
         ext = g["extrapolated"]
         studies.append({"commit": r["commit"], "date": r["date"], "reynolds": r["reynolds"], "edge_d": r["edge_d"],
@@ -173,7 +174,7 @@ def plots(R):
         ax.set_xlabel("surface stage time (s)"), ax.grid(alpha=0.3, which="both"), ax.legend(fontsize=7)
         ax.set_title("surface, a = 5, N = 500, shrink (labels: edge length)", fontsize=9)
         fig.tight_layout(), fig.savefig(os.path.join(DOCS, "pareto_surface.png"), dpi=110), plt.close(fig)
-    if "mesh" in R:
+    if "mesh" in R and R["mesh"]["studies"]:
         fig, ax = plt.subplots(figsize=(6, 4))
         for st, marker in zip(R["mesh"]["studies"], "osd^"):
             pts = st["points"]
@@ -241,7 +242,10 @@ def write_report(R):
             L += [""]
         for lo in R["mesh"]["left_out"]:
             L += [f"Left out: the study at Re_p = {lo['reynolds']:g} (made at {lo['commit']}), {lo['why']}.", ""]
-        L += ["![mesh and CFD](pareto_mesh_case.png)", ""]
+        if R["mesh"]["studies"]:
+            L += ["![mesh and CFD](pareto_mesh_case.png)", ""]
+        else:
+            L += ["No study gives a reference: none is in the asymptotic range with its levels refined alike.", ""]
     L += ["Why the defaults are what they are, read from these curves: [defaults.md](defaults.md).", ""]
     open(os.path.join(DOCS, "error_vs_time.md"), "w").write("\n".join(L))
 

@@ -70,7 +70,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS, commit_and_date, made_line  # noqa: E402
+from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
@@ -383,19 +383,6 @@ def stamp(rows):
                             "since."), ""]
 
 
-# From this commit on, a study's coarser levels divide surface.cells_per_gap by their scale.
-GAPS_COARSENED_FROM = "ac6e6bc"
-
-
-def gaps_not_coarsened(r):
-    """Whether a gap-refined study was made before its coarser levels coarsened the gaps' cells."""
-    if not r.get("cells_per_gap"):
-        return False
-    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, r["commit"]],
-                           cwd=os.path.dirname(os.path.abspath(__file__)), capture_output=True)
-    return known.returncode != 0
-
-
 def made(r):
     """A study row's commit and date, marked when its levels were not refined alike."""
     return f"{r['commit']} {r['date']}" + (" (gaps not coarsened)" if gaps_not_coarsened(r) else "")
@@ -691,7 +678,7 @@ def write(results):
                   "*E&S treated*: E&S at the bed's void fraction less that change spread evenly over the height "
                   "(interpolated log-linearly between bedforge's two E&S values of the run, at the bed's and at the "
                   "meshed void fraction): how far the treatment's volume alone moves the correlation.", "",
-                  "| treatment | made | solid change | finest dp/L (Pa/m) | level 1, 2 / bridge's | extrapolated (Pa/m) | "
+                  "| treatment | made | solid change | finest dp/L (Pa/m) | level 1, 2 / bridge's (level 2 when sized alike) | extrapolated (Pa/m) | "
                   "order | GCI fine | E&S (Pa/m) | extrapolated / E&S | E&S treated (Pa/m) | extrapolated / E&S treated | "
                   "wall (min) |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -700,8 +687,10 @@ def write(results):
         def against_bridge(r):  # level by level at the same settings: what the treatment alone changes
             if not bridge:
                 return ""
+            # Level 2's gaps are sized alike only when both studies coarsened them alike.
+            same = 2 if gaps_not_coarsened(r) == gaps_not_coarsened(bridge) else 1
             return ", ".join(f"{lv['pressure_gradient_bed_pa_m'] / b['pressure_gradient_bed_pa_m']:.3f}"
-                             for lv, b in zip(r["study"]["levels"][:2], bridge["study"]["levels"][:2])
+                             for lv, b in zip(r["study"]["levels"][:same], bridge["study"]["levels"][:same])
                              if "failure" not in lv and "failure" not in b)
         for r in runs:
             g, finest, ext = study_values(r)
