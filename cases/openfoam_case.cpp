@@ -36,7 +36,7 @@ CaseParams read_case_params(SceneSection& s) {
   p.viscosity_pa_s = s.number("viscosity_pa_s", p.viscosity_pa_s, Range::positive());
   p.iterations = static_cast<int>(s.integer("iterations", p.iterations, 1, 1'000'000));
   p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
-  if (s.has("residual_u")) p.residual_u = s.number("residual_u", 1.0e-4, Range::open(0.0, 1.0));
+  p.residual_u = s.optional_number("residual_u", Range::open(0.0, 1.0), "1e-4; 1e-2 on cells with prism layers");
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
