@@ -36,7 +36,8 @@ CaseParams read_case_params(SceneSection& s) {
   p.viscosity_pa_s = s.number("viscosity_pa_s", p.viscosity_pa_s, Range::positive());
   p.iterations = static_cast<int>(s.integer("iterations", p.iterations, 1, 1'000'000));
   p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
-  p.residual_u = s.optional_number("residual_u", Range::open(0.0, 1.0), "1e-4; 1e-2 on cells with prism layers");
+  p.residual_u = s.optional_number("residual_u", Range::open(0.0, 1.0),
+                                  fmt::format("{}; {} on cells with prism layers", kResidualU, kResidualULayered));
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
@@ -373,9 +374,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                     const std::string& bed_csv, const fs::path& fluid_stl) {
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
-  const bool prism_layers =
-      mesh && std::any_of(mesh->faces.begin(), mesh->faces.end(), [](const meshing::Face& f) { return f.size() == 4; });
-  if (!p.residual_u) p.residual_u = prism_layers ? 1.0e-2 : 1.0e-4;
+  if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
   std::random_device rd;
   const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;

@@ -15,6 +15,10 @@
 
 namespace bedforge::cases {
 
+// SIMPLE's target for U's initial residual when [case] residual_u is unset.
+inline constexpr double kResidualU = 1.0e-4;
+inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism layers
+
 // The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
 // through the bed, inlet at the bottom.
 struct CaseParams {
@@ -24,7 +28,7 @@ struct CaseParams {
   int iterations = 3000;                // simpleFoam iteration cap (endTime)
   double residual_p = 1.0e-4;           // SIMPLE stops when the initial residuals fall below these (on
                                         // these tetrahedral meshes p plateaus near 5e-5 once dp has 4 digits)
-  // Unset: 1e-4, or 1e-2 on cells with prism layers (quadrilateral faces), where U's residual
+  // Unset: kResidualU, or kResidualULayered on cells with prism layers, where U's residual
   // stalls near 3e-3 while the pressure drop has settled (docs/findings.md, 2026-11-26, night);
   // write_case sets it.
   std::optional<double> residual_u;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <numeric>
 #include <stdexcept>
@@ -236,5 +237,18 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
   return m;
 }
 
+
+bool has_prisms(const PolyMesh& mesh) {
+  std::vector<std::array<int, 2>> sides(mesh.cells);  // per cell: triangles, quadrilaterals
+  auto count = [&](int cell, std::size_t n) {
+    if (n == 3) ++sides[cell][0];
+    if (n == 4) ++sides[cell][1];
+  };
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    count(mesh.owner[f], mesh.faces[f].size());
+    if (f < mesh.neighbour.size()) count(mesh.neighbour[f], mesh.faces[f].size());
+  }
+  return std::any_of(sides.begin(), sides.end(), [](const std::array<int, 2>& s) { return s[0] == 2 && s[1] == 3; });
+}
 
 }  // namespace bedforge::meshing

@@ -86,4 +86,8 @@ CellGeometry cell_geometry(const PolyMesh& mesh);
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);
 std::vector<double> cell_volumes(const PolyMesh& mesh);
 
+// Whether any cell is a prism (two triangular and three quadrilateral faces): gmsh's cells have
+// them only in prism layers; a hexahedron (six quadrilaterals) is not one.
+bool has_prisms(const PolyMesh& mesh);
+
 }  // namespace bedforge::meshing

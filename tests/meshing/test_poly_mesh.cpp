@@ -133,6 +133,23 @@ TEST(PolyMesh, ABoundaryFaceInNoPatchIsNamedWithItsPlace) {
   EXPECT_THROW(poly_mesh_from_tets(g.points, g.tets, g.boundary, g.patch, kNames, kTypes), std::runtime_error);
 }
 
+// One cell's faces, all on the boundary (owned by cell 0); the points do not matter here.
+PolyMesh one_cell(std::vector<Face> faces) {
+  PolyMesh m;
+  m.cells = 1;
+  m.owner.assign(faces.size(), 0);
+  m.faces = std::move(faces);
+  return m;
+}
+
+TEST(PolyMesh, APrismIsFoundAndAHexahedronOrTetrahedraAreNot) {
+  EXPECT_TRUE(has_prisms(one_cell({{0, 1, 2}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}})));
+  EXPECT_FALSE(has_prisms(
+      one_cell({{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}})));
+  const Grid g = kuhn_grid(2);
+  EXPECT_FALSE(has_prisms(poly_mesh_from_tets(g.points, g.tets, g.boundary, g.patch, kNames, kTypes)));
+}
+
 TEST(CellQuality, ARegularTetHasOpenFoamsIdealFigures) {
   // One regular tetrahedron: no internal faces; aspect ratio from projected areas and area/volume.
   const double s = 1.0;
