@@ -130,6 +130,14 @@ std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>&
 
 }  // namespace
 
+std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                      const std::vector<double>& radii, const std::vector<char>& kept,
+                                      const Container& container) {
+  if (p.cells_per_gap <= 0.0) return std::nullopt;
+  const double edge = p.edge_length_d * d;
+  return GapSpacing(centres, radii, kept, container, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
+}
+
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   const double d = reference_diameter(bed), edge = p.edge_length_d * d;
   const double top = bed_height(bed);
@@ -163,9 +171,7 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   const double wall_sag = box ? 0.0 : ring_sagitta(R, wall_edge);
 
   // Edges shortened where the surface faces another across a narrow gap.
-  std::optional<GapSpacing> gaps;
-  if (p.cells_per_gap > 0.0)
-    gaps.emplace(bed.centres, tb.radius, tb.kept, c, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
+  const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
   auto field = [&](int self) {
     return gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
                 : SpacingField{};

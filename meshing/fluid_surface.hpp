@@ -1,9 +1,11 @@
 #pragma once
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "core/bed.hpp"
 #include "core/scene_section.hpp"
+#include "meshing/gap_spacing.hpp"
 #include "meshing/surface_checks.hpp"
 #include "meshing/triangle_mesh.hpp"
 
@@ -46,6 +48,13 @@ struct SurfaceParams {
 const char* treatment_name(SurfaceParams::Treatment t);
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);
 nlohmann::json to_json(const SurfaceParams& p);
+
+// The rule for edges across narrow gaps as the surface stage applies it, from `p`'s
+// cells_per_gap, contact and surface edges (d the reference diameter, m); unset when
+// p.cells_per_gap is 0. The other inputs are GapSpacing's, kept by reference.
+std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                      const std::vector<double>& radii, const std::vector<char>& kept,
+                                      const Container& container);
 
 struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)

@@ -3,16 +3,14 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-
-#include "meshing/gap_spacing.hpp"
+#include "meshing/fluid_surface.hpp"
 
 using namespace bedforge;
 using namespace bedforge::pipeline;
 
 // Celik et al.'s procedure needs meshes refined alike everywhere: every edge the surface rules
 // ask for, the edge across narrow gaps included, is `scale` times the finest level's. Checked on
-// the gap rule itself (meshing::GapSpacing, built as the surface stage builds it, lengths in d)
+// the gap rule itself (meshing::gap_spacing, as the surface stage applies it, lengths in d)
 // at points facing gaps from under the finest edge to past the coarsest.
 TEST(ConvergenceStudy, ACoarserLevelScalesEveryLengthTheSurfaceAsksFor) {
   const Scene scene = read_scene(toml::parse("[container]\ndiameter_d = 5\n[particles]\ncount = 2\ndiameter_m = 0.003\n"
@@ -32,9 +30,7 @@ TEST(ConvergenceStudy, ACoarserLevelScalesEveryLengthTheSurfaceAsksFor) {
     const std::vector<double> radii{0.5, 0.5};
     const std::vector<char> kept{1, 1};
     const Cylinder tube{20.0};
-    const meshing::GapSpacing g(centres, radii, kept, tube, p.cells_per_gap,
-                                std::min(p.contact_edge_length_d, p.edge_length_d), p.edge_length_d);
-    return g.at({0.0, 0.0, 0.0}, 0);
+    return meshing::gap_spacing(p, 1.0, centres, radii, kept, tube)->at({0.0, 0.0, 0.0}, 0);
   };
   int between_bounds = 0;
   for (double gap : {0.05, 0.1, 0.2, 0.3, 0.4, 0.6, 1.0}) {
