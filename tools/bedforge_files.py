@@ -49,8 +49,12 @@ def gaps_not_coarsened(study):
     if not study.get("cells_per_gap"):
         return False
     known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, study["commit"]],
-                           cwd=ROOT, capture_output=True)
-    return known.returncode != 0
+                           cwd=ROOT, capture_output=True, text=True)
+    if known.returncode not in (0, 1):  # 1: not an ancestor; anything else: git could not tell
+        raise SystemExit(f"cannot tell whether the study made at {study['commit']} coarsened its gaps (after "
+                         f"{GAPS_COARSENED_FROM}): {known.stderr.strip()}; a shallow clone lacks the commits: "
+                         "git fetch --unshallow")
+    return known.returncode == 1
 
 
 def read_bed(path):
