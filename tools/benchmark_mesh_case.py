@@ -687,6 +687,8 @@ def write(results):
         def against_bridge(r):  # level by level at the same settings: what the treatment alone changes
             if not bridge:
                 return ""
+            if (r.get("cells_per_gap"), r["edge_d"]) != (bridge.get("cells_per_gap"), bridge["edge_d"]):
+                return f"not compared: {r.get('cells_per_gap', 0):g} per gap from {r['edge_d']} d"
             # Level 2's gaps are sized alike only when both studies coarsened them alike.
             same = 2 if gaps_not_coarsened(r) == gaps_not_coarsened(bridge) else 1
             return ", ".join(f"{lv['pressure_gradient_bed_pa_m'] / b['pressure_gradient_bed_pa_m']:.3f}"
@@ -796,7 +798,7 @@ def main():
     ap.add_argument("--scale-out-iterations", type=int, default=500, help="scale_out: simpleFoam's iteration cap")
     ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
     ap.add_argument("--study-gap-edge", type=float, default=0.15, help="study_gaps: finest surface edge (d)")
-    ap.add_argument("--study-gap-cells", type=float, default=3, help="study_gaps: surface.cells_per_gap")
+    ap.add_argument("--study-gap-cells", type=float, default=4, help="study_gaps: surface.cells_per_gap")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
     ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
     ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
