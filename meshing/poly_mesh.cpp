@@ -237,7 +237,6 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
   return m;
 }
 
-
 bool has_prisms(const PolyMesh& mesh) {
   std::vector<std::array<int, 2>> sides(mesh.cells);  // per cell: triangles, quadrilaterals
   auto count = [&](int cell, std::size_t n) {
