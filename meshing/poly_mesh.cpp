@@ -239,7 +239,7 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
 
 bool has_prisms(const PolyMesh& mesh) {
   std::vector<std::array<int, 2>> sides(mesh.cells);  // per cell: triangles, quadrilaterals
-  auto count = [&](int cell, std::size_t n) {
+  auto count = [&](int cell, int n) {
     if (n == 3) ++sides[cell][0];
     if (n == 4) ++sides[cell][1];
   };

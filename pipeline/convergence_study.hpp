@@ -71,9 +71,8 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
 // solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's lengths
 // (level_lengths) by the factor that makes its cells ratio^(k - 1) times the size of the
 // finest's (searched: up to 4 surfaces and meshes, to within 3 %), builds its surface and mesh
-// in memory and solves its case in
-// `dir`/level_k. A level that fails (a gate, the solver) is reported with its reason, and the
-// others go on.
+// in memory and solves its case in `dir`/level_k. A level that fails (a gate, the solver) is
+// reported with its reason, and the others go on.
 ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest,
                                    const std::filesystem::path& dir, const Console& console);
 
