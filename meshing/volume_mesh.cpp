@@ -287,10 +287,20 @@ void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress) {
-  std::vector<VolumeMeshParams::Algorithm> tries{p.algorithm};
-  if (p.fallback)
-    tries.push_back(p.algorithm == VolumeMeshParams::Algorithm::hxt ? VolumeMeshParams::Algorithm::delaunay
-                                                                     : VolumeMeshParams::Algorithm::hxt);
+  using Algorithm = VolumeMeshParams::Algorithm;
+  // HXT's own optimisation (in gmsh 4.8 it runs only inside generate, not through optimize)
+  // takes about five times gmsh's pass, so it is the retry, not the first try.
+  struct Attempt {
+    Algorithm algorithm;
+    bool hxt_optimiser;
+  };
+  std::vector<Attempt> tries;
+  auto add = [&](Algorithm a) {
+    tries.push_back({a, false});
+    if (a == Algorithm::hxt && p.optimize) tries.push_back({a, true});
+  };
+  add(p.algorithm);
+  if (p.fallback) add(p.algorithm == Algorithm::hxt ? Algorithm::delaunay : Algorithm::hxt);
   // The prism layers do not depend on the algorithm: built once, the tetrahedra fill what is
   // left above them.
   std::optional<PrismLayers> layers;
@@ -301,24 +311,30 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
   const TriangleMesh& boundary = layers ? layers->top : surface;
   nlohmann::json attempts = nlohmann::json::array();
   std::string failure;  // one sentence per attempt
-  for (const auto algorithm : tries) {
+  for (const auto& [algorithm, hxt_optimiser] : tries) {
     const auto t0 = std::chrono::steady_clock::now();
-    progress.update(fmt::format("{}: loading {} surface triangles", algorithm_name(algorithm), boundary.triangles.size()));
+    const std::string name = fmt::format("{}{}", algorithm_name(algorithm), hxt_optimiser ? " (its own optimiser)" : "");
+    const char* optimiser = hxt_optimiser ? "hxt" : "gmsh";
+    progress.update(fmt::format("{}: loading {} surface triangles", name, boundary.triangles.size()));
     GmshSession session;
     auto failed = [&](const std::string& why) {
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", why}});
-      failure += fmt::format("{} failed: {}. ", algorithm_name(algorithm), why);
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"optimiser", optimiser}, {"error", why}});
+      failure += fmt::format("{} failed: {}. ", name, why);
     };
     int tetrahedra = 0;
     try {
       gmsh::model::add("bedforge");
       tetrahedra = load_surface(boundary);
       gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == VolumeMeshParams::Algorithm::hxt ? 10 : 1);
-      gmsh::option::setNumber("General.NumThreads",
-                              p.threads > 0 ? p.threads : std::max(1u, std::thread::hardware_concurrency()));
+      // HXT's optimisation on two threads once left a boundary face that is no surface triangle
+      // (a = 5, N = 300, enlarge); on one thread it did not.
+      gmsh::option::setNumber("General.NumThreads", hxt_optimiser ? 1
+                                                    : p.threads > 0 ? p.threads
+                                                                    : std::max(1u, std::thread::hardware_concurrency()));
       gmsh::option::setNumber("Mesh.MeshSizeMax", p.max_size_d * d_ref);
-      gmsh::option::setNumber("Mesh.Optimize", 0);  // optimised below, pass by pass, each pass measured
-      progress.update(fmt::format("{}: tetrahedra", algorithm_name(algorithm)));
+      // gmsh's optimiser runs below, pass by pass, each pass measured; HXT's own inside generate.
+      gmsh::option::setNumber("Mesh.Optimize", hxt_optimiser ? 1 : 0);
+      progress.update(fmt::format("{}: tetrahedra", name));
       gmsh::model::mesh::generate(3);
       if (layers) insert_layers(*layers);
     } catch (const std::string& e) {  // gmsh's API throws its last error message
@@ -341,11 +357,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
         if (pass > 0) {
           out = VolumeMesh();  // the pass remakes them; both at once would double the peak
           release_free_memory();
-          progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", algorithm_name(algorithm), pass,
-                                      bad.size()));
+          progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", name, pass, bad.size()));
           gmsh::model::mesh::optimize("", true, 1, {{3, tetrahedra}});  // the layers are left as built
         }
-        progress.update(fmt::format("{}: checking cells", algorithm_name(algorithm)));
+        progress.update(fmt::format("{}: checking cells", name));
         release_free_memory();  // what gmsh's tetrahedra or optimiser freed
         out.mesh = extract_poly_mesh();
         release_free_memory();  // the extraction's face table
@@ -365,14 +380,16 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                          {"max_aspect_ratio", out.quality.max_aspect_ratio},
                          {"cells_failing_gate", bad.size()}});
       const int passes = p.optimize ? p.max_optimize_passes : 0;
-      if (pass >= passes || (pass >= 1 && bad.empty())) break;
+      // After HXT's own optimisation gmsh's pass is needed only for what it left.
+      if (pass >= passes || (bad.empty() && (pass >= 1 || hxt_optimiser))) break;
     }
     if (!broken.empty()) {
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"error", broken}});
-      failure += fmt::format("{} gave an invalid mesh: {}. ", algorithm_name(algorithm), broken);
+      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"optimiser", optimiser}, {"error", broken}});
+      failure += fmt::format("{} gave an invalid mesh: {}. ", name, broken);
       continue;
     }
     nlohmann::json attempt = {{"algorithm", algorithm_name(algorithm)},
+                              {"optimiser", optimiser},
                               {"cells", out.mesh.cells},
                               {"time_generate_s", generated_at},
                               {"optimiser_passes", history.size() - 1},
@@ -381,6 +398,8 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                               {"cells_failing_gate", bad.size()}};
     attempts.push_back(attempt);
     if (bad.empty()) {
+      // An earlier attempt's bad cells, or an earlier run's, no longer describe the mesh written.
+      if (!bad_cells_path.empty()) std::filesystem::remove(bad_cells_path);
       if (!msh_path.empty()) {
         try {
           gmsh::option::setNumber("Mesh.Binary", 1);
@@ -403,7 +422,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
                           "most near {}; cells written to {}",
-                          algorithm_name(algorithm), bad.size(), out.mesh.cells, out.quality.max_non_orthogonality_deg,
+                          name, bad.size(), out.mesh.cells, out.quality.max_non_orthogonality_deg,
                           p.gate.max_non_orthogonality_deg, out.quality.max_skewness, p.gate.max_skewness,
                           out.quality.max_aspect_ratio, p.gate.max_aspect_ratio,
                           out.quality.min_volume / (d_ref * d_ref * d_ref), p.gate.min_volume_d3, where.summary,

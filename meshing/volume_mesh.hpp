@@ -24,7 +24,10 @@ struct VolumeMeshParams {
   Algorithm algorithm = Algorithm::hxt;  // the first tried; the other is the fallback
   bool fallback = true;                  // retry with the other algorithm when the gate fails
   double max_size_d = 0.25;              // largest cell edge, away from every surface
-  bool optimize = true;                  // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio)
+  // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio); when its passes leave
+  // cells failing the gate, HXT meshes again with its own optimisation, on one thread and
+  // several times slower, which clears the slivers in the narrow wedges of enlarged contacts.
+  bool optimize = true;
   int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
   int threads = 0;                       // 0: every core
   QualityGate gate;
@@ -46,7 +49,9 @@ struct VolumeMesh {
 // (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty. Tries the
 // algorithms in turn; when none passes the gate, throws std::runtime_error saying how many
 // cells fail which limit and near which particles, after writing them as a legacy VTK file to
-// `bad_cells_path` (open it in ParaView).
+// `bad_cells_path` (open it in ParaView). Tries, in turn: `algorithm`; HXT with its own
+// optimisation when `algorithm` is hxt and `optimize`; then, with `fallback`, the other
+// algorithm (and HXT's own optimisation after it when that is hxt).
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& params,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress);

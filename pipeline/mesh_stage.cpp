@@ -26,9 +26,9 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   j["fluid_volume_exact_m3"] = exact_volume_m3;
   j["fluid_volume_relative_error"] = volume_error;
   std::string line = fmt::format(
-      "mesh ({}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
+      "mesh ({}{}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
       "max aspect ratio {:.1f}, volume error {:.2e}",
-      j["algorithm"].get<std::string>(), vm->mesh.cells, q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg,
+      j["algorithm"].get<std::string>(), j["optimiser"] == "hxt" ? ", its own optimiser" : "", vm->mesh.cells, q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg,
       q.faces_over_70_deg, q.max_skewness, q.max_aspect_ratio, volume_error);
   if (j.contains("layers")) {
     const auto& l = j["layers"];

@@ -214,8 +214,8 @@ def scale(tmp, a, n, treatment):
            "self_intersections": rep["stages"]["surface"]["check"]["self_intersections"],
            "check_mesh_s": check_s, "max_non_orthogonality": non_ortho, "max_skewness": skew,
            "stages_peak_mb": {k: v.get("peak_memory_mb", 0) for k, v in rep["stages"].items()},
-           "mesh_attempts": [{k: attempt.get(k) for k in ("algorithm", "cells", "time_generate_s", "optimiser_passes",
-                                                           "cells_failing_gate", "error")}
+           "mesh_attempts": [{k: attempt.get(k) for k in ("algorithm", "optimiser", "cells", "time_generate_s",
+                                                           "optimiser_passes", "cells_failing_gate", "error")}
                              for attempt in rep["stages"]["mesh"].get("attempts", [])]}
     print(row, flush=True)
     return row

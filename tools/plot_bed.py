@@ -242,7 +242,8 @@ def plot_convergence(report, path):
         panels.append(("pack", pack))
     for attempt in stages.get("mesh", {}).get("attempts", []):
         if attempt.get("history"):
-            panels.append((f"mesh optimiser ({attempt['algorithm']})", attempt["history"]))
+            panels.append((f"mesh optimiser ({attempt['algorithm']}, {attempt.get('optimiser', 'gmsh')}'s)",
+                           attempt["history"]))
     flow = stages.get("case", {}).get("flow", {}).get("history", [])
     if flow:
         panels.append(("flow solve (simpleFoam)", flow))
