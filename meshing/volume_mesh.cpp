@@ -313,7 +313,8 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
   std::string failure;  // one sentence per attempt
   for (const auto& [algorithm, hxt_optimiser] : tries) {
     const auto t0 = std::chrono::steady_clock::now();
-    const std::string name = fmt::format("{}{}", algorithm_name(algorithm), hxt_optimiser ? " (its own optimiser)" : "");
+    const std::string name =
+        fmt::format("{}{}", algorithm_name(algorithm), hxt_optimiser ? " (its own optimiser)" : "");
     const char* optimiser = hxt_optimiser ? "hxt" : "gmsh";
     progress.update(fmt::format("{}: loading {} surface triangles", name, boundary.triangles.size()));
     GmshSession session;
@@ -325,12 +326,12 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     try {
       gmsh::model::add("bedforge");
       tetrahedra = load_surface(boundary);
-      gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == VolumeMeshParams::Algorithm::hxt ? 10 : 1);
+      gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == Algorithm::hxt ? 10 : 1);
       // HXT's optimisation on two threads once left a boundary face that is no surface triangle
       // (a = 5, N = 300, enlarge); on one thread it did not.
-      gmsh::option::setNumber("General.NumThreads", hxt_optimiser ? 1
-                                                    : p.threads > 0 ? p.threads
-                                                                    : std::max(1u, std::thread::hardware_concurrency()));
+      const int threads =
+          p.threads > 0 ? p.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+      gmsh::option::setNumber("General.NumThreads", hxt_optimiser ? 1 : threads);
       gmsh::option::setNumber("Mesh.MeshSizeMax", p.max_size_d * d_ref);
       // gmsh's optimiser runs below, pass by pass, each pass measured; HXT's own inside generate.
       gmsh::option::setNumber("Mesh.Optimize", hxt_optimiser ? 1 : 0);

@@ -46,12 +46,12 @@ struct VolumeMesh {
 // Meshes the inside of `surface` (closed, labelled by patch; the fluid surface of the surface
 // stage), with prism layers on the particles first when params.layers.count > 0. `bed` names
 // the particles near bad cells; `d_ref` (m) scales the parameters. Writes the gmsh mesh
-// (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty. Tries the
-// algorithms in turn; when none passes the gate, throws std::runtime_error saying how many
-// cells fail which limit and near which particles, after writing them as a legacy VTK file to
-// `bad_cells_path` (open it in ParaView). Tries, in turn: `algorithm`; HXT with its own
-// optimisation when `algorithm` is hxt and `optimize`; then, with `fallback`, the other
-// algorithm (and HXT's own optimisation after it when that is hxt).
+// (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty. Tries, in
+// turn: `algorithm`; HXT with its own optimisation when `algorithm` is hxt and `optimize`;
+// then, with `fallback`, the other algorithm (and HXT's own optimisation after it when that is
+// hxt). When none passes the gate, throws std::runtime_error saying how many cells fail which
+// limit and near which particles, after writing them as a legacy VTK file to `bad_cells_path`
+// (open it in ParaView).
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& params,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress);

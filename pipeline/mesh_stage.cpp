@@ -28,8 +28,9 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   std::string line = fmt::format(
       "mesh ({}{}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
       "max aspect ratio {:.1f}, volume error {:.2e}",
-      j["algorithm"].get<std::string>(), j["optimiser"] == "hxt" ? ", its own optimiser" : "", vm->mesh.cells, q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg,
-      q.faces_over_70_deg, q.max_skewness, q.max_aspect_ratio, volume_error);
+      j["algorithm"].get<std::string>(), j["optimiser"] == "hxt" ? ", its own optimiser" : "", vm->mesh.cells,
+      q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg, q.faces_over_70_deg, q.max_skewness,
+      q.max_aspect_ratio, volume_error);
   if (j.contains("layers")) {
     const auto& l = j["layers"];
     line += fmt::format("; {} prism layers, mean thickness {:.3g} d, {} of {} stacks at full thickness",

@@ -131,9 +131,9 @@ TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
 }
 
 // Enlarged contacts leave fluid wedges of about 16 degrees around each neck, where gmsh's
-// optimiser passes left a few slivers on every enlarged bed tried (this one: 7 of 360 k cells
-// over the aspect-ratio limit of 1000, at 89f157a); HXT's own optimisation, the retry, clears
-// them.
+// optimiser passes left a few slivers on every enlarged bed tried (this packing at d = 3 mm:
+// 7 of 360 k cells over the aspect-ratio limit of 1000, at 89f157a); HXT's own optimisation,
+// the retry, clears them.
 TEST(VolumeMesh, AnEnlargedBedPassesTheGateWithHxtsOwnOptimiser) {
   SizeDistribution spheres;
   spheres.diameters_m = {1.0};
