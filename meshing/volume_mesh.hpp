@@ -26,7 +26,8 @@ struct VolumeMeshParams {
   double max_size_d = 0.25;              // largest cell edge, away from every surface
   // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio); when its passes leave
   // cells failing the gate, HXT meshes again with its own optimisation, on one thread and
-  // several times slower, which clears the slivers in the narrow wedges of enlarged contacts.
+  // several times slower, which clears the slivers in the narrow wedges of enlarged contacts
+  // (skipped when its memory, estimated from the cells before it, exceeds what is available).
   bool optimize = true;
   int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
   int threads = 0;                       // 0: every core
