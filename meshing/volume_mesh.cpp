@@ -321,7 +321,14 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     const auto t0 = std::chrono::steady_clock::now();
     const std::string name =
         fmt::format("{}{}", algorithm_name(algorithm), hxt_optimiser ? " (its own optimiser)" : "");
-    const char* optimiser = hxt_optimiser ? "hxt" : "gmsh";
+    // What every entry of the report's attempts starts with.
+    const nlohmann::json tried = {{"algorithm", algorithm_name(algorithm)},
+                                  {"optimiser", hxt_optimiser ? "hxt" : "gmsh"}};
+    auto record = [&](const char* key, const std::string& why) {
+      nlohmann::json entry = tried;
+      entry[key] = why;
+      attempts.push_back(entry);
+    };
     if (hxt_optimiser) {
       // Skipped, not crashed, when it will not fit: about three cells per surface triangle when
       // no attempt before it gave cells.
@@ -331,7 +338,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       if (need > available) {
         const std::string why = fmt::format("it would need about {:.1f} GB and {:.1f} GB are available", need / 1e9,
                                             available / 1e9);
-        attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"optimiser", optimiser}, {"skipped", why}});
+        record("skipped", why);
         failure += fmt::format("{} skipped: {}. ", name, why);
         continue;
       }
@@ -339,7 +346,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     progress.update(fmt::format("{}: loading {} surface triangles", name, boundary.triangles.size()));
     GmshSession session;
     auto failed = [&](const std::string& why) {
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"optimiser", optimiser}, {"error", why}});
+      record("error", why);
       failure += fmt::format("{} failed: {}. ", name, why);
     };
     int tetrahedra = 0;
@@ -405,19 +412,18 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       if (pass >= passes || (bad.empty() && (pass >= 1 || hxt_optimiser))) break;
     }
     if (!broken.empty()) {
-      attempts.push_back({{"algorithm", algorithm_name(algorithm)}, {"optimiser", optimiser}, {"error", broken}});
+      record("error", broken);
       failure += fmt::format("{} gave an invalid mesh: {}. ", name, broken);
       continue;
     }
     previous_cells = static_cast<double>(out.mesh.cells);
-    nlohmann::json attempt = {{"algorithm", algorithm_name(algorithm)},
-                              {"optimiser", optimiser},
-                              {"cells", out.mesh.cells},
-                              {"time_generate_s", generated_at},
-                              {"optimiser_passes", history.size() - 1},
-                              {"history", history},
-                              {"quality", out.quality.to_json(d_ref)},
-                              {"cells_failing_gate", bad.size()}};
+    nlohmann::json attempt = tried;
+    attempt.update({{"cells", out.mesh.cells},
+                    {"time_generate_s", generated_at},
+                    {"optimiser_passes", history.size() - 1},
+                    {"history", history},
+                    {"quality", out.quality.to_json(d_ref)},
+                    {"cells_failing_gate", bad.size()}});
     attempts.push_back(attempt);
     if (bad.empty()) {
       // An earlier attempt's bad cells, or an earlier run's, no longer describe the mesh written.
