@@ -37,6 +37,7 @@ VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
   p.optimize = s.boolean("optimize", p.optimize);
   p.max_optimize_passes = static_cast<int>(s.integer("max_optimize_passes", p.max_optimize_passes, 1, 20));
   p.threads = static_cast<int>(s.integer("threads", p.threads, 0, 1024));
+  p.slabs = static_cast<int>(s.integer("slabs", p.slabs, 0, 64));
   SceneSection g = s.sub("gate");
   p.gate.max_non_orthogonality_deg =
       g.number("max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg, Range::open(0.0, 90.0));
@@ -56,6 +57,7 @@ nlohmann::json to_json(const VolumeMeshParams& p) {
           {"optimize", p.optimize},
           {"max_optimize_passes", p.max_optimize_passes},
           {"threads", p.threads},
+          {"slabs", p.slabs},
           {"gate",
            {{"max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg},
             {"max_skewness", p.gate.max_skewness},
@@ -243,8 +245,8 @@ void insert_layers(const PrismLayers& layers) {
   gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, fluid_entities), "fluid");
 }
 
-// Legacy VTK of the given cells as the polygons of their faces (any cell type), each carrying
-// its cell's quality and nearest particle, for ParaView.
+}  // namespace
+
 void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
                      const std::vector<int>& bad, const std::vector<int>& nearest) {
   std::unordered_map<int, int> rank;  // cell -> position in `bad`
@@ -281,8 +283,6 @@ void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const
   field("volume_m3", [&](int k) { return q.volume[bad[k]]; });
   field("nearest_particle", [&](int k) { return nearest[k]; });
 }
-
-}  // namespace
 
 // Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
 // mesh before it: measured 1360 (a = 10, N = 4000, enlarge: 14.2 GB, 10.4 M cells) and 1230

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/bed.hpp"
+#include "meshing/slab_mesh.hpp"
 #include "meshing/volume_mesh.hpp"
 #include "pipeline/console.hpp"
 #include "pipeline/scene.hpp"
@@ -20,8 +21,11 @@ struct MeshStage {
 // compared with `exact_volume_m3`, the volume of the geometry the surface approximates. Writes
 // the gmsh mesh to `msh_path` when not empty, the cells failing the gate to `bad_cells_path`
 // when it fails.
+// With more than one slab (meshing::slab_count), the domain is meshed in slabs instead, each
+// slab's surface built again from `bed` and `surface_params`.
 MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m3, const Bed& bed,
-                     const meshing::VolumeMeshParams& params, const std::filesystem::path& msh_path,
+                     const meshing::SurfaceParams& surface_params, const meshing::VolumeMeshParams& params,
+                     const std::filesystem::path& msh_path,
                      const std::filesystem::path& bad_cells_path, const Console& console);
 
 // The volume mesh a scene asks for, estimated from the scene alone before anything runs, low
