@@ -291,7 +291,10 @@ constexpr double kHxtOptimiserBytesPerCell = 1500.0;
 
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
-                             Progress& progress) {
+                             Progress& progress, bool release_memory) {
+  auto release = [release_memory] {
+    if (release_memory) release_free_memory();
+  };
   using Algorithm = VolumeMeshParams::Algorithm;
   // HXT's own optimisation (in gmsh 4.8 it runs only inside generate, not through optimize)
   // takes about five times gmsh's pass, so it is the retry, not the first try.
@@ -384,14 +387,14 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       try {
         if (pass > 0) {
           out = VolumeMesh();  // the pass remakes them; both at once would double the peak
-          release_free_memory();
+          release();
           progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", name, pass, bad.size()));
           gmsh::model::mesh::optimize("", true, 1, {{3, tetrahedra}});  // the layers are left as built
         }
         progress.update(fmt::format("{}: checking cells", name));
-        release_free_memory();  // what gmsh's tetrahedra or optimiser freed
+        release();  // what gmsh's tetrahedra or optimiser freed
         out.mesh = extract_poly_mesh();
-        release_free_memory();  // the extraction's face table
+        release();  // the extraction's face table
       } catch (const std::string& e) {
         broken = e;
       } catch (const std::exception& e) {
@@ -399,7 +402,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       }
       if (!broken.empty()) break;
       out.quality = cell_quality(out.mesh);
-      release_free_memory();
+      release();
       bad = out.quality.bad_cells(p.gate, d_ref);
       history.push_back({{"pass", pass},
                          {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
