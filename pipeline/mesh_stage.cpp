@@ -49,7 +49,8 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 }
 
 MeshEstimate estimate_mesh(const Scene& scene) {
-  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24, kBytesPerCell = 460.0;
+  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
+  const double kBytesPerCell = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
   const double pi = std::acos(-1.0);
   double d = 0.0, solid = 0.0;
   if (scene.import.bed) {
