@@ -348,7 +348,9 @@ class ContactTreatment {
     const double r = out_.radius[i];
     const Frame f = Frame::along(at.value_or(c + h * a), a);
     SphereCut cut;
-    cut.loop = circle_loop(f, rho, n);
+    // A clip plane's loop (`at` given) runs counterclockwise seen from above whichever side is
+    // removed: the slabs on either side of a plane (meshing/slab_mesh.hpp) share it bit for bit.
+    cut.loop = circle_loop(at ? Frame::along(*at, Eigen::Vector3d::UnitZ()) : f, rho, n);
     cut.spacing = 2.0 * kPi * rho / n;
     cut.jitter = jitter;
     cut.axis = a;

@@ -294,7 +294,11 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     // adapter reads each point through the map), so its vertices come out as indices into
     // pts.points; CGAL 5.5 declares a template parameter of this overload that no argument
     // deduces, hence the explicit `void`.
-    if (round == 0 || !insert_into_hull(faces, kp, added_from, seeds, Kernel::Point_3(c.x(), c.y(), c.z()))) {
+    // The point inside the hull is its points' mean, not the sphere's centre: a clip plane may
+    // keep less than half the sphere, whose centre then lies outside.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::size_t v = 0; v < added_from; ++v) mean += pts.points[v] / static_cast<double>(added_from);
+    if (round == 0 || !insert_into_hull(faces, kp, added_from, seeds, Kernel::Point_3(mean.x(), mean.y(), mean.z()))) {
       index.resize(kp.size());
       std::iota(index.begin(), index.end(), std::size_t{0});
       hull_vertices.clear();

@@ -37,6 +37,7 @@ VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
   p.optimize = s.boolean("optimize", p.optimize);
   p.max_optimize_passes = static_cast<int>(s.integer("max_optimize_passes", p.max_optimize_passes, 1, 20));
   p.threads = static_cast<int>(s.integer("threads", p.threads, 0, 1024));
+  p.slabs = static_cast<int>(s.integer("slabs", p.slabs, 0, 64));
   SceneSection g = s.sub("gate");
   p.gate.max_non_orthogonality_deg =
       g.number("max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg, Range::open(0.0, 90.0));
@@ -56,6 +57,7 @@ nlohmann::json to_json(const VolumeMeshParams& p) {
           {"optimize", p.optimize},
           {"max_optimize_passes", p.max_optimize_passes},
           {"threads", p.threads},
+          {"slabs", p.slabs},
           {"gate",
            {{"max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg},
             {"max_skewness", p.gate.max_skewness},
@@ -243,8 +245,8 @@ void insert_layers(const PrismLayers& layers) {
   gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, fluid_entities), "fluid");
 }
 
-// Legacy VTK of the given cells as the polygons of their faces (any cell type), each carrying
-// its cell's quality and nearest particle, for ParaView.
+}  // namespace
+
 void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
                      const std::vector<int>& bad, const std::vector<int>& nearest) {
   std::unordered_map<int, int> rank;  // cell -> position in `bad`
@@ -282,8 +284,6 @@ void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const
   field("nearest_particle", [&](int k) { return nearest[k]; });
 }
 
-}  // namespace
-
 // Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
 // mesh before it: measured 1360 (a = 10, N = 4000, enlarge: 14.2 GB, 10.4 M cells) and 1230
 // (a = 5, N = 300, enlarge); 1500 leaves a margin.
@@ -291,7 +291,10 @@ constexpr double kHxtOptimiserBytesPerCell = 1500.0;
 
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
-                             Progress& progress) {
+                             Progress& progress, bool release_memory) {
+  auto release = [release_memory] {
+    if (release_memory) release_free_memory();
+  };
   using Algorithm = VolumeMeshParams::Algorithm;
   // HXT's own optimisation (in gmsh 4.8 it runs only inside generate, not through optimize)
   // takes about five times gmsh's pass, so it is the retry, not the first try.
@@ -384,14 +387,14 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       try {
         if (pass > 0) {
           out = VolumeMesh();  // the pass remakes them; both at once would double the peak
-          release_free_memory();
+          release();
           progress.update(fmt::format("{}: optimiser pass {} ({} cells fail the gate)", name, pass, bad.size()));
           gmsh::model::mesh::optimize("", true, 1, {{3, tetrahedra}});  // the layers are left as built
         }
         progress.update(fmt::format("{}: checking cells", name));
-        release_free_memory();  // what gmsh's tetrahedra or optimiser freed
+        release();  // what gmsh's tetrahedra or optimiser freed
         out.mesh = extract_poly_mesh();
-        release_free_memory();  // the extraction's face table
+        release();  // the extraction's face table
       } catch (const std::string& e) {
         broken = e;
       } catch (const std::exception& e) {
@@ -399,7 +402,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       }
       if (!broken.empty()) break;
       out.quality = cell_quality(out.mesh);
-      release_free_memory();
+      release();
       bad = out.quality.bad_cells(p.gate, d_ref);
       history.push_back({{"pass", pass},
                          {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},

@@ -112,7 +112,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       const auto [surface, mesh] = level_lengths(scene, scale);
       const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
       m.reset();  // the previous attempt's mesh is not needed any more
-      m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, mesh, {}, case_dir.parent_path() / "bad_cells.vtk",
+      m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, surface, mesh, {}, case_dir.parent_path() / "bad_cells.vtk",
                      console);
       surface_mesh_s = s.report["time_s"].get<double>() + m->report["time_s"].get<double>();
       const double h = std::cbrt(m->volume->quality.total_volume /

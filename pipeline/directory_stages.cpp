@@ -95,7 +95,13 @@ void surface_directory(const fs::path& dir, const std::vector<Override>& overrid
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
   Directory d = open_directory(dir, overrides);
-  const meshing::VolumeMeshParams params = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
+  meshing::VolumeMeshParams params = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
+  // Slabs are surfaces built again from the bed; here the surface is fluid.stl as it is.
+  if (params.slabs > 1)
+    throw InputError(fmt::format("mesh.slabs = {}: `bedforge mesh DIR` meshes DIR/fluid.stl as it is, in one piece; "
+                                 "allowed: 0 or 1 here, or slabs through `bedforge run`",
+                                 params.slabs));
+  params.slabs = 1;
   const fs::path stl = dir / "fluid.stl";
   const meshing::TriangleMesh surface = meshing::read_stl_ascii_by_patch(stl);
   // A surface edited or made elsewhere: gmsh needs it closed, so say where it is not.
@@ -112,7 +118,7 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
   OutputFiles files;
   const fs::path msh = dir / ".fluid.partial.msh";  // gmsh picks the format by extension
   files.add_made("fluid.msh", msh);
-  MeshStage m = mesh_stage(surface, exact, d.bed, params, msh, dir / "bad_cells.vtk", console);
+  MeshStage m = mesh_stage(surface, exact, d.bed, meshing::SurfaceParams{}, params, msh, dir / "bad_cells.vtk", console);
   d.report.set_stage("mesh", std::move(m.report));
   files.write(dir);
   d.report.save(dir);

@@ -10,13 +10,17 @@
 namespace bedforge::pipeline {
 
 MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m3, const Bed& bed,
-                     const meshing::VolumeMeshParams& p, const std::filesystem::path& msh_path,
+                     const meshing::SurfaceParams& surface_params, const meshing::VolumeMeshParams& p,
+                     const std::filesystem::path& msh_path,
                      const std::filesystem::path& bad_cells_path, const Console& console) {
   const StageMeter meter;
   std::filesystem::create_directories(bad_cells_path.parent_path());
   Progress progress("mesh", console.progress);
+  const int slabs = meshing::slab_count(surface.triangles.size(), surface_params, p);
   auto vm = std::make_shared<meshing::VolumeMesh>(
-      meshing::build_volume_mesh(surface, bed, reference_diameter(bed), p, msh_path, bad_cells_path, progress));
+      slabs > 1 ? meshing::build_slabbed_volume_mesh(bed, surface_params, slabs, reference_diameter(bed), p, msh_path,
+                                                     bad_cells_path, progress)
+                : meshing::build_volume_mesh(surface, bed, reference_diameter(bed), p, msh_path, bad_cells_path, progress));
   progress.finish();
   MeshStage out{vm, std::move(vm->report)};
   nlohmann::json& j = out.report;
@@ -28,7 +32,10 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   std::string line = fmt::format(
       "mesh ({}{}): {} cells, max non-orthogonality {:.1f} deg (mean {:.1f}, {} faces > 70), max skewness {:.2f}, "
       "max aspect ratio {:.1f}, volume error {:.2e}",
-      j["algorithm"].get<std::string>(), j["optimiser"] == "hxt" ? ", its own optimiser" : "", vm->mesh.cells,
+      j["algorithm"].get<std::string>(),
+      std::string(j["optimiser"] == "hxt" ? ", its own optimiser" : "") +
+          (slabs > 1 ? fmt::format(", {} slabs", slabs) : std::string()),
+      vm->mesh.cells,
       q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg, q.faces_over_70_deg, q.max_skewness,
       q.max_aspect_ratio, volume_error);
   if (j.contains("layers")) {
@@ -42,7 +49,8 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 }
 
 MeshEstimate estimate_mesh(const Scene& scene) {
-  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24, kBytesPerCell = 460.0;
+  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
+  const double kBytesPerCell = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
   const double pi = std::acos(-1.0);
   double d = 0.0, solid = 0.0;
   if (scene.import.bed) {

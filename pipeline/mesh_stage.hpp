@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/bed.hpp"
+#include "meshing/slab_mesh.hpp"
 #include "meshing/volume_mesh.hpp"
 #include "pipeline/console.hpp"
 #include "pipeline/scene.hpp"
@@ -20,8 +21,11 @@ struct MeshStage {
 // compared with `exact_volume_m3`, the volume of the geometry the surface approximates. Writes
 // the gmsh mesh to `msh_path` when not empty, the cells failing the gate to `bad_cells_path`
 // when it fails.
+// With more than one slab (meshing::slab_count), the domain is meshed in slabs instead, each
+// slab's surface built again from `bed` and `surface_params`.
 MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m3, const Bed& bed,
-                     const meshing::VolumeMeshParams& params, const std::filesystem::path& msh_path,
+                     const meshing::SurfaceParams& surface_params, const meshing::VolumeMeshParams& params,
+                     const std::filesystem::path& msh_path,
                      const std::filesystem::path& bad_cells_path, const Console& console);
 
 // The volume mesh a scene asks for, estimated from the scene alone before anything runs, low
@@ -32,9 +36,11 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 per cell of the empty tube's meshes, 0.20-0.24 h^3 from 0.2 d to 0.07 d; beds
 //                 have more, being refined at contacts: a = 10, N = 4000 at 0.1 d made 8.65 M
 //                 cells where this gives 5.6 M);
-//   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 (3956 MB for 8.61 M
-//                 cells, docs/mesh_case_benchmark.md): a calibration on that one run (a = 6,
-//                 N = 860 gave 490 per cell at 2.1 M cells, where gmsh's fixed costs weigh more).
+//   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
+//                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
+//                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
+//                 be meshed in slabs (shrink or none, no prism layers, mesh.slabs not 1), from
+//                 the same bed in 4 slabs (2666-2723 MB for 8.92 M cells, docs/findings.md).
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
   double cells = 0.0;

@@ -119,7 +119,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   if (plan.mesh.build) {
     const fs::path msh = opt.wants.mesh ? dir / ".fluid.partial.msh" /* gmsh picks the format by extension */ : fs::path();
     if (opt.wants.mesh) files.add_made("fluid.msh", msh);
-    MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.mesh, msh, dir / "bad_cells.vtk", console);
+    MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.surface, scene.mesh, msh, dir / "bad_cells.vtk", console);
     mesh = std::shared_ptr<const meshing::PolyMesh>(m.volume, &m.volume->mesh);
     record("mesh", std::move(m.report), keys.mesh);
   } else {

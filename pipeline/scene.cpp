@@ -128,6 +128,12 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection mesh = root.sub("mesh"), case_section = root.sub("case");
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   sc.mesh = meshing::read_volume_mesh_params(mesh);
+  if (sc.mesh.slabs > 1 && !meshing::slabs_possible(sc.surface, sc.mesh))
+    throw InputError(fmt::format("mesh.slabs = {}: the planes between slabs cut through the bed, and through treated "
+                                 "contacts they would open them; allowed: 0 or 1, or mesh.slabs > 1 with "
+                                 "contacts.treatment \"shrink\" or \"none\" (now \"{}\") and no prism layers "
+                                 "(mesh.layers.count = {})",
+                                 sc.mesh.slabs, meshing::treatment_name(sc.surface.treatment), sc.mesh.layers.count));
 #else
   if (sc.needs_mesh() || table.contains("mesh"))
     throw InputError("this bedforge was built without gmsh or CGAL, so it has no volume mesh stage ([mesh], "

@@ -20,6 +20,7 @@
 #include "meshing/fluid_surface.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+#include "meshing/slab_mesh.hpp"
 #include "meshing/volume_mesh.hpp"
 #endif
 

@@ -240,9 +240,12 @@ def plot_convergence(report, path):
     pack = stages.get("pack", {}).get("history", [])
     if pack:
         panels.append(("pack", pack))
-    for attempt in stages.get("mesh", {}).get("attempts", []):
+    mesh = stages.get("mesh", {})
+    # A mesh made in slabs has each slab's attempts; the first slab's stand for the rest.
+    for attempt in (mesh["slabs"][0] if "slabs" in mesh else mesh).get("attempts", []):
         if attempt.get("history"):
-            panels.append((f"mesh optimiser ({attempt['algorithm']}, {attempt.get('optimiser', 'gmsh')}'s)",
+            slab = f", slab 1 of {len(mesh['slabs'])}" if "slabs" in mesh else ""
+            panels.append((f"mesh optimiser ({attempt['algorithm']}, {attempt.get('optimiser', 'gmsh')}'s{slab})",
                            attempt["history"]))
     flow = stages.get("case", {}).get("flow", {}).get("history", [])
     if flow:

@@ -101,6 +101,28 @@ TEST(Primitives, SphereFacesAreFacetsOfTheHullOfItsVertices) {
   }
 }
 
+// A clip plane may keep less than half a sphere, whose centre then lies outside the part's hull:
+// the refinement's insertion into the hull must not take the centre for a point inside it (at
+// 79f64fb it did: this test failed with the plane 0.57 mm below the centre, and clip windows
+// through large beds failed, "a cut's loop is not an edge path"). Meshed and on its hull at 399
+// heights, at the spacings of a bead of 3 mm at the defaults.
+TEST(Primitives, APartSmallerThanAHemisphereMeshesAtEveryHeight) {
+  const Eigen::Vector3d c(-0.0055285, 0.0062260, 0.0340552);  // a bead of 3 mm, shrunk by 0.99, in a bed
+  const double r = 0.001485, d = 0.003;
+  for (int k = 1; k < 400; ++k) {
+    const double h = -r + 2.0 * r * k / 400.0;  // the part kept lies below the plane at c + h z
+    const SphereCut cut = plane(c, r, Eigen::Vector3d::UnitZ(), h, 0.03333 * d);
+    TriangleMesh m;
+    ASSERT_NO_THROW(m = sphere_mesh(c, r, {cut}, 0.1 * d, 1.5, true, "p")) << "h = " << h;
+    std::size_t beyond = 0;
+    for (const auto& t : m.triangles) {
+      const Eigen::Vector3d &a = m.points[t[0]], n = (m.points[t[1]] - a).cross(m.points[t[2]] - a).normalized();
+      for (const auto& q : m.points) beyond += n.dot(q - a) > 1e-12;
+    }
+    EXPECT_EQ(beyond, 0u) << "h = " << h;
+  }
+}
+
 TEST(Primitives, CutsThatOverlapOnTheSphereAreRefused) {
   const Eigen::Vector3d c = Eigen::Vector3d::Zero();
   std::vector<SphereCut> cuts{plane(c, 1.0, Eigen::Vector3d::UnitX(), 0.2, 0.05),

@@ -111,3 +111,22 @@ TEST(Scene, ContactTreatmentsAndTheirErrors) {
   }
 }
 #endif
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+// A plane between slabs cuts through the bed: bridges, caps and unions there would be opened,
+// and prism layers would meet it, so slabs are refused with them, naming the key.
+TEST(Scene, SlabsAreRefusedWhereTheirPlanesWouldChangeTheBed) {
+  const std::string bed = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
+  EXPECT_EQ(read(bed + "[mesh]\nslabs = 3\n").mesh.slabs, 3);
+  for (const std::string extra : {"[contacts]\ntreatment = \"bridge\"\n[mesh]\nslabs = 3\n",
+                                  "[mesh]\nslabs = 2\n[mesh.layers]\ncount = 2\n"}) {
+    try {
+      read(bed + extra);
+      ADD_FAILURE() << extra;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("mesh.slabs = "), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"bridge\"\n[mesh]\nslabs = 1\n").mesh.slabs, 1);
+}
+#endif
