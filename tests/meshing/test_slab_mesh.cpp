@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "meshing/surface_checks.hpp"
-#include "packer/soft_sphere.hpp"
+#include "support/packed_bed.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace bedforge;
@@ -15,11 +15,8 @@ using namespace bedforge::meshing;
 namespace fs = std::filesystem;
 
 TEST(SlabMesh, SlabsJoinIntoOneConformingMeshFillingTheirSurfaces) {
-  SizeDistribution spheres;
-  spheres.diameters_m = {1.0};
-  spheres.number_fractions = {1.0};
   Progress quiet("mesh", false);
-  const Bed b = packer::pack_soft_sphere({}, spheres, Cylinder(2.0), 80, 1, quiet).bed;
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
   SurfaceParams sp;  // shrink
   sp.edge_length_d = 0.15;
   VolumeMeshParams p;

@@ -12,7 +12,7 @@
 
 #include "meshing/fluid_surface.hpp"
 #include "meshing/surface_checks.hpp"
-#include "packer/soft_sphere.hpp"
+#include "support/packed_bed.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace bedforge;
@@ -135,11 +135,8 @@ TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
 // 7 of 360 k cells over the aspect-ratio limit of 1000, at 89f157a); HXT's own optimisation,
 // the retry, clears them.
 TEST(VolumeMesh, AnEnlargedBedPassesTheGateWithHxtsOwnOptimiser) {
-  SizeDistribution spheres;
-  spheres.diameters_m = {1.0};
-  spheres.number_fractions = {1.0};
   Progress quiet("mesh", false);
-  const Bed b = packer::pack_soft_sphere({}, spheres, Cylinder(2.0), 80, 1, quiet).bed;
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
   SurfaceParams sp;
   sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::enlarge;
   const FluidSurface s = build_fluid_surface(b, sp);
