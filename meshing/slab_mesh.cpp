@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <map>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -63,7 +62,7 @@ struct Joined {
   }
 
   // Slab `m` on top of what is joined: its inlet (unless `first`) must be the last slab's
-  // outlet; its outlet (unless `last`) waits for the next slab.
+  // outlet; its outlet (unless `last`) waits for the next slab. `slab` counts from 0.
   void add(const PolyMesh& m, bool first, bool last, int slab) {
     const int inlet = patch_number(m, "inlet"), outlet = patch_number(m, "outlet");
     std::vector<char> on_inlet(m.points.size(), 0), on_outlet(m.points.size(), 0);
@@ -81,7 +80,7 @@ struct Joined {
       if (!first && on_inlet[v]) {
         const auto it = top_points.find(key);
         if (it == top_points.end()) {
-          ++unmatched, unmatched_at = x;
+          if (unmatched++ == 0) unmatched_at = x;
           global[v] = static_cast<int>(points.size());
           points.push_back(x);
         } else {
@@ -116,7 +115,7 @@ struct Joined {
             "volume mesh: slabs {} and {} do not triangulate their shared plane alike ({} of its {} points and {} of "
             "{} triangles on one side only, the first point at ({:.6g}, {:.6g}, {:.6g}) m); please report it with the "
             "bed",
-            slab - 1, slab, unmatched, std::count(on_inlet.begin(), on_inlet.end(), 1), [&] {
+            slab, slab + 1, unmatched, std::count(on_inlet.begin(), on_inlet.end(), 1), [&] {
               std::vector<std::array<int, 3>> only;
               std::set_symmetric_difference(bottom_faces.begin(), bottom_faces.end(), top_faces.begin(),
                                             top_faces.end(), std::back_inserter(only));
@@ -216,7 +215,17 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
     progress.update(fmt::format("slab {} of {} ({:.2f}-{:.2f} d): surface", k + 1, slabs, q.clip_bottom_d, q.clip_top_d));
     VolumeMesh slab;
     {
-      const FluidSurface fs = build_fluid_surface(bed, q);
+      // The slab's clip planes may find no height clear of the spheres, or cut one too close to
+      // another cut: say which slab, since the scene set no clip window.
+      const FluidSurface fs = [&] {
+        try {
+          return build_fluid_surface(bed, q);
+        } catch (const InputError& e) {
+          throw InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut "
+                                       "from the bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
+                                       k + 1, slabs, q.clip_bottom_d, q.clip_top_d, e.what()));
+        }
+      }();
       Progress quiet("mesh", false);
       try {
         // Memory a slab frees stays with the allocator for the next slab and the join: handing it
