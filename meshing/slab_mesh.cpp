@@ -65,6 +65,9 @@ struct Joined {
   // outlet; its outlet (unless `last`) waits for the next slab. `slab` counts from 0.
   void add(const PolyMesh& m, bool first, bool last, int slab) {
     const int inlet = patch_number(m, "inlet"), outlet = patch_number(m, "outlet");
+    // The joined mesh's patches in the order of a slab's (gmsh_model's fixed order), as the
+    // one-piece mesh and the .msh file read back have them.
+    for (const auto& patch : m.patches) patch_index(patch.name);
     std::vector<char> on_inlet(m.points.size(), 0), on_outlet(m.points.size(), 0);
     for (const auto& [p, flags] : {std::pair{inlet, &on_inlet}, std::pair{outlet, &on_outlet}})
       for (int f = m.patches[p].start; f < m.patches[p].start + m.patches[p].size; ++f)

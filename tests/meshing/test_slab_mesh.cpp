@@ -1,11 +1,13 @@
 // A bed meshed in slabs: the slabs' cells join into one conforming mesh that fills exactly the
-// slabs' surfaces, with no boundary left on the planes between them.
+// slabs' surfaces, with no boundary left on the planes between them, and reads back from its
+// .msh file.
 #include "meshing/slab_mesh.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "meshing/gmsh_model.hpp"
 #include "meshing/surface_checks.hpp"
 #include "support/packed_bed.hpp"
 #include "support/temp_dir.hpp"
@@ -58,5 +60,13 @@ TEST(SlabMesh, SlabsJoinIntoOneConformingMeshFillingTheirSurfaces) {
       for (int f = patch.start; f < patch.start + patch.size; ++f)
         for (int v : vm.mesh.faces[f]) ASSERT_NEAR(vm.mesh.points[v].z(), z, 1e-9) << patch.name;
     }
-  EXPECT_TRUE(fs::exists(dir / "fluid.msh"));
+  // The .msh file (written by bedforge, not gmsh) reads back through gmsh as the same mesh.
+  const PolyMesh back = read_msh(dir / "fluid.msh");
+  EXPECT_EQ(back.cells, vm.mesh.cells);
+  EXPECT_EQ(back.internal_faces(), vm.mesh.internal_faces());
+  ASSERT_EQ(back.patches.size(), vm.mesh.patches.size());
+  for (std::size_t k = 0; k < back.patches.size(); ++k) {
+    EXPECT_EQ(back.patches[k].name, vm.mesh.patches[k].name);
+    EXPECT_EQ(back.patches[k].size, vm.mesh.patches[k].size);
+  }
 }
