@@ -333,6 +333,19 @@ TEST(CommandLine, SurfaceStageOnAPackedBed) {
   EXPECT_NE(reversed.output.find("surface.clip_window_d"), std::string::npos) << reversed.output;
 }
 
+// `bedforge mesh DIR` meshes DIR/fluid.stl as it is; slabs are surfaces built again from the
+// bed, so a scene asking for them there is refused by name before anything is meshed.
+TEST(CommandLine, MeshingADirectoryInSlabsIsRefused) {
+  const fs::path dir = fresh_dir("mesh_slabs");
+  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 4 --count 30 -o " + dir.string()).status, 0);
+  ASSERT_EQ(bedforge("--quiet surface " + dir.string() + " --edge-length-d 0.2").status, 0);
+  std::ofstream(dir / "scene.toml", std::ios::app) << "\n[mesh]\nslabs = 3\n";
+  const Result r = bedforge("mesh " + dir.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("mesh.slabs = 3"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+}
+
 TEST(CommandLine, SurfaceBelowTheAngleGateFailsAndWritesItsTriangles) {
   // A clip window cuts spheres near the wall and each other, leaving narrow inlet and outlet
   // triangles (13 degrees on this bed); a gate at 20 degrees refuses them. The stage fails
