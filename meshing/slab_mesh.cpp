@@ -12,7 +12,6 @@
 
 #include "core/error.hpp"
 #include "core/stage_meter.hpp"
-#include "meshing/defect_locations.hpp"
 
 namespace bedforge::meshing {
 
@@ -284,11 +283,7 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
   out.report["time_join_s"] = joined_at - written_at;
   out.report["time_quality_s"] = since() - joined_at;
   if (!bad.empty()) {
-    const std::vector<Eigen::Vector3d> centres = cell_centres(out.mesh);
-    std::vector<Eigen::Vector3d> at;
-    for (int c : bad) at.push_back(centres[c]);
-    const DefectLocations where = locate_defects(bed, at, "cells");
-    write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, where.nearest);
+    const DefectLocations where = locate_bad_cells(bed, out.mesh, out.quality, bad, bad_cells_path);
     if (!msh_path.empty()) std::filesystem::remove(msh_path);
     throw ConvergenceError(fmt::format(
         "volume mesh: every slab passed the quality gate but {} of {} cells of the joined mesh fail it (max "

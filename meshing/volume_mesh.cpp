@@ -245,8 +245,8 @@ void insert_layers(const PrismLayers& layers) {
   gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, fluid_entities), "fluid");
 }
 
-}  // namespace
-
+// Legacy VTK of the given cells as the polygons of their faces (any cell type), each carrying
+// its cell's quality and nearest particle, for ParaView.
 void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
                      const std::vector<int>& bad, const std::vector<int>& nearest) {
   std::unordered_map<int, int> rank;  // cell -> position in `bad`
@@ -282,6 +282,18 @@ void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const
   field("aspect_ratio", [&](int k) { return q.aspect_ratio[bad[k]]; });
   field("volume_m3", [&](int k) { return q.volume[bad[k]]; });
   field("nearest_particle", [&](int k) { return nearest[k]; });
+}
+
+}  // namespace
+
+DefectLocations locate_bad_cells(const Bed& bed, const PolyMesh& m, const CellQuality& q, const std::vector<int>& bad,
+                                 const std::filesystem::path& path) {
+  const std::vector<Eigen::Vector3d> centres = cell_centres(m);
+  std::vector<Eigen::Vector3d> at;
+  for (int c : bad) at.push_back(centres[c]);
+  DefectLocations where = locate_defects(bed, at, "cells");
+  if (!path.empty()) write_bad_cells(path, m, q, bad, where.nearest);
+  return where;
 }
 
 // Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
@@ -445,11 +457,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       return out;
     }
     // Say where the bad cells are: the nearest particle surface to each.
-    const std::vector<Eigen::Vector3d> centres = cell_centres(out.mesh);
-    std::vector<Eigen::Vector3d> at;
-    for (int c : bad) at.push_back(centres[c]);
-    const DefectLocations where = locate_defects(bed, at, "cells");
-    if (!bad_cells_path.empty()) write_bad_cells(bad_cells_path, out.mesh, out.quality, bad, where.nearest);
+    const DefectLocations where = locate_bad_cells(bed, out.mesh, out.quality, bad, bad_cells_path);
     failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
                           "most near {}; cells written to {}",

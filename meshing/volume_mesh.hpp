@@ -7,6 +7,7 @@
 #include "core/progress.hpp"
 #include "core/scene_section.hpp"
 #include "meshing/cell_quality.hpp"
+#include "meshing/defect_locations.hpp"
 #include "meshing/poly_mesh.hpp"
 #include "meshing/prism_layers.hpp"
 #include "meshing/triangle_mesh.hpp"
@@ -62,10 +63,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress, bool release_memory = true);
 
-// Legacy VTK of the cells `bad` of `m` as the polygons of their faces (any cell type), each
-// carrying its cell's quality `q` and nearest particle (`nearest`, one per cell of `bad`), for
-// ParaView.
-void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
-                     const std::vector<int>& bad, const std::vector<int>& nearest);
+// Where the cells `bad` of `m` (quality `q`) lie: the particle nearest to each and the summary
+// of locate_defects; when `path` is not empty, the cells are also written there as legacy VTK,
+// the polygons of their faces each carrying its cell's quality and nearest particle, for ParaView.
+DefectLocations locate_bad_cells(const Bed& bed, const PolyMesh& m, const CellQuality& q, const std::vector<int>& bad,
+                                 const std::filesystem::path& path);
 
 }  // namespace bedforge::meshing

@@ -40,7 +40,8 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
 //                 be meshed in slabs (shrink or none, no prism layers, mesh.slabs not 1), from
-//                 the same bed in 4 slabs (2666-2723 MB for 8.92 M cells, docs/findings.md).
+//                 the same bed in 4 slabs (2666-2816 MB for 8.92 M cells, 313-331 bytes per cell;
+//                 docs/findings.md, docs/mesh_case_benchmark.md).
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
   double cells = 0.0;
