@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -102,6 +103,105 @@ GridConvergence grid_convergence(const std::vector<GridLevel>& levels) {
                                  "not in the asymptotic range, so neither the extrapolation nor the GCI can be trusted",
                                  kAsymptoticOrder[0], kAsymptoticOrder[1]);
   return g;
+}
+
+nlohmann::json PowerLawFit::to_json() const {
+  auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  return {{"fitted", fitted},
+          {"levels", levels},
+          {"order", number(order)},
+          {"extrapolated", number(extrapolated)},
+          {"coefficient", number(coefficient)},
+          {"residual_sd", number(residual_sd)},
+          {"largest_residual", number(largest_residual)},
+          {"explanation", explanation}};
+}
+
+namespace {
+
+// The least-squares phi0 and alpha of phi = phi0 + alpha x for x_i = (h_i / h_1)^p, and the
+// sum of squared residuals.
+struct LinearFit {
+  double phi0 = 0.0, alpha = 0.0, squares = 0.0;
+};
+LinearFit fit_at_order(const std::vector<GridLevel>& levels, double p) {
+  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (const GridLevel& l : levels) {
+    const double x = std::pow(l.cell_size / levels.front().cell_size, p);
+    n += 1.0, sx += x, sy += l.value, sxx += x * x, sxy += x * l.value;
+  }
+  LinearFit f;
+  f.alpha = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  f.phi0 = (sy - f.alpha * sx) / n;
+  for (const GridLevel& l : levels) {
+    const double r = l.value - f.phi0 - f.alpha * std::pow(l.cell_size / levels.front().cell_size, p);
+    f.squares += r * r;
+  }
+  return f;
+}
+
+}  // namespace
+
+PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
+  if (levels.size() < 4)
+    throw std::invalid_argument(fmt::format("a least-squares power law needs at least 4 meshes, got {}", levels.size()));
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    if (!std::isfinite(levels[i].cell_size) || !std::isfinite(levels[i].value) || !(levels[i].cell_size > 0.0))
+      throw std::invalid_argument("least-squares power law: a cell size or value is not a finite number");
+    if (i > 0 && !(levels[i].cell_size > levels[i - 1].cell_size))
+      throw std::invalid_argument("least-squares power law: the meshes must go from fine to coarse (cell sizes increasing)");
+  }
+  PowerLawFit f;
+  f.levels = static_cast<int>(levels.size());
+  f.order = f.extrapolated = f.coefficient = f.residual_sd = f.largest_residual =
+      std::numeric_limits<double>::quiet_NaN();
+  // A power law changes one way: values that turn back are oscillation, which no order fits.
+  for (std::size_t i = 2; i < levels.size(); ++i)
+    if ((levels[i].value - levels[i - 1].value) * (levels[i - 1].value - levels[i - 2].value) <= 0.0) {
+      f.explanation = fmt::format("the {} levels' values do not change one way as the mesh refines: no power law fits "
+                                  "them",
+                                  f.levels);
+      return f;
+    }
+  // The sum of squares over p: scanned on a geometric grid, then its least sample's bracket
+  // narrowed by golden sections.
+  const int samples = 400;
+  const double step = std::log(kFitOrders[1] / kFitOrders[0]) / samples;
+  auto order_at = [&](int k) { return kFitOrders[0] * std::exp(step * k); };
+  int best = 0;
+  for (int k = 1; k <= samples; ++k)
+    if (fit_at_order(levels, order_at(k)).squares < fit_at_order(levels, order_at(best)).squares) best = k;
+  if (best == 0 || best == samples) {
+    f.explanation = fmt::format("no power law fits the {} levels with an order between {:g} and {:g} (the best lies at "
+                                "the range's end): they do not converge like one",
+                                f.levels, kFitOrders[0], kFitOrders[1]);
+    return f;
+  }
+  double lo = order_at(best - 1), hi = order_at(best + 1);
+  const double golden = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int it = 0; it < 100 && hi - lo > 1e-10 * hi; ++it) {
+    const double a = hi - golden * (hi - lo), b = lo + golden * (hi - lo);
+    if (fit_at_order(levels, a).squares < fit_at_order(levels, b).squares)
+      hi = b;
+    else
+      lo = a;
+  }
+  const double p = 0.5 * (lo + hi);
+  const LinearFit lin = fit_at_order(levels, p);
+  f.fitted = true;
+  f.order = p;
+  f.extrapolated = lin.phi0;
+  f.coefficient = lin.alpha;
+  f.residual_sd = std::sqrt(lin.squares / static_cast<double>(f.levels - 3));
+  f.largest_residual = 0.0;
+  for (const GridLevel& l : levels)
+    f.largest_residual = std::max(
+        f.largest_residual, std::abs(l.value - lin.phi0 - lin.alpha * std::pow(l.cell_size / levels.front().cell_size, p)));
+  f.explanation = fmt::format("over {} levels by least squares (Eca & Hoekstra 2014): order {:.2f}, extrapolated {:.6g}, "
+                              "the levels {:.2g} % from the fit at most (standard deviation {:.2g} %)",
+                              f.levels, p, lin.phi0, 100.0 * f.largest_residual / std::abs(lin.phi0),
+                              100.0 * f.residual_sd / std::abs(lin.phi0));
+  return f;
 }
 
 double observed_order(const std::vector<GridLevel>& levels, double exact) {

@@ -50,6 +50,29 @@ const char* verdict_name(GridConvergence::Verdict v);
 // (cell sizes strictly increasing) and all values finite.
 GridConvergence grid_convergence(const std::vector<GridLevel>& levels);
 
+// The power law phi = phi0 + alpha h^p fitted to four or more levels by least squares: the
+// "delta_RE" fit of Eca & Hoekstra (2014, J. Comput. Phys. 262, 104), whose scatter shows what
+// three levels cannot: how far the levels themselves stray from one power law. For each order p
+// the best phi0 and alpha are linear; p is searched over [kFitOrders[0], kFitOrders[1]].
+struct PowerLawFit {
+  bool fitted = false;         // the values change one way and the least-squares order lies
+                               // inside the range searched
+  int levels = 0;              // the levels fitted
+  double order = 0.0;          // p (NaN unless fitted)
+  double extrapolated = 0.0;   // phi0 (NaN unless fitted)
+  double coefficient = 0.0;    // alpha of phi0 + alpha (h / h_1)^p, h_1 the finest (NaN unless fitted)
+  double residual_sd = 0.0;    // sqrt(sum of squared residuals / (levels - 3)), phi's unit
+  double largest_residual = 0.0;  // max |phi_i - fit(h_i)|, phi's unit
+  std::string explanation;     // one sentence a report can show
+  nlohmann::json to_json() const;
+};
+
+inline constexpr double kFitOrders[2] = {0.05, 8.0};
+
+// std::invalid_argument unless there are at least four levels, each coarser than the one
+// before, all values finite.
+PowerLawFit fit_power_law(const std::vector<GridLevel>& levels);
+
 // Verification against a known answer: the order p of the error |phi / exact - 1| ~ C h^p, by
 // least squares on ln error against ln h over `levels` (any order, two or more with distinct
 // sizes). NaN when fewer than two levels have a nonzero error.

@@ -41,6 +41,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
     out["levels"].push_back(std::move(j));
   }
   if (complete) out["grid_convergence"] = convergence.to_json();
+  if (fit) out["least_squares"] = fit->to_json();
   if (exact_pa_m) {
     out["exact_pa_m"] = *exact_pa_m;
     out["order_from_exact"] = std::isfinite(order_from_exact) ? nlohmann::json(order_from_exact) : nullptr;
@@ -182,11 +183,18 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
       if (!l.failure.empty()) failed += fmt::format("{}level {}: {}", failed.empty() ? "" : "; ", l.level, l.failure);
     study.conclusion = "no three successive levels gave a pressure drop, so no error estimate: " + failed;
   }
+  std::vector<analysis::GridLevel> solved;
+  for (const StudyLevel& l : study.levels)
+    if (l.failure.empty()) solved.push_back({l.cell_size_m, l.pressure_gradient_pa_m});
+  const bool coarser_each = std::adjacent_find(solved.begin(), solved.end(), [](const auto& a, const auto& b) {
+                              return b.cell_size <= a.cell_size;
+                            }) == solved.end();
+  if (solved.size() >= 4 && coarser_each) {
+    study.fit = analysis::fit_power_law(solved);
+    study.conclusion += "; " + study.fit->explanation;
+  }
   if (finest.exact_pa_m) {
     const double exact = *finest.exact_pa_m;
-    std::vector<analysis::GridLevel> solved;
-    for (const StudyLevel& l : study.levels)
-      if (l.failure.empty()) solved.push_back({l.cell_size_m, l.pressure_gradient_pa_m});
     study.exact_pa_m = exact;
     study.order_from_exact = analysis::observed_order(solved, exact);
     study.conclusion += fmt::format("; against the exact {:.5g} Pa/m", exact);

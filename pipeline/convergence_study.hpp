@@ -44,6 +44,9 @@ struct ConvergenceStudy {
   std::vector<StudyLevel> levels;
   bool complete = false;                 // three usable finest levels in a row
   analysis::GridConvergence convergence; // when complete
+  // With four or more levels that gave a value: the least-squares power law over all of them,
+  // which says how far the levels stray from the one the finest three imply.
+  std::optional<analysis::PowerLawFit> fit;
   std::string conclusion;                // what the study could and could not conclude
   // An empty container's exact gradient (Pa/m): each level's error against it and the order of
   // those errors, the verification of the whole route.

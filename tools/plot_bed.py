@@ -201,6 +201,7 @@ def plot_mesh_section(mesh_dir, centres, diameters, pairs, path):
 def plot_mesh_convergence(case, path):
     """dp/L against cell size h = (V/N)^(1/3) over d on every level that gave a value; the
     extrapolation to h = 0 with the finest level's GCI as its band, when the study concluded one;
+    the least-squares power law over all levels, when there were four or more;
     the correlation at the bed's exact section void fraction with its data's scatter, or an empty
     container's exact value."""
     study, d = case["convergence"], case["d_ref_m"]
@@ -218,6 +219,11 @@ def plot_mesh_convergence(case, path):
         ax.errorbar([0.0], [g["extrapolated"]], fmt="rs", label=f"extrapolated, order {g['apparent_order']:.2f}")
         ax.errorbar([h[0]], [fine], yerr=[[band], [band]], fmt="none", ecolor="r", capsize=4,
                     label=f"GCI of the finest mesh {100 * g['gci_fine']:.1f} %")
+    fit = study.get("least_squares", {})
+    if fit.get("fitted"):
+        hs = [h[-1] * k / 100 for k in range(101)]  # from h = 0 to the coarsest level
+        ax.plot(hs, [fit["extrapolated"] + fit["coefficient"] * (x / h[0]) ** fit["order"] for x in hs], "b--", lw=1,
+                label=f"least squares over {fit['levels']} levels, order {fit['order']:.2f}")
     flow = case.get("flow", {})
     if "eisfeld_schnitzlein_bed_pa_m" in flow:
         es = flow["eisfeld_schnitzlein_bed_pa_m"]

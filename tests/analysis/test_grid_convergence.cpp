@@ -79,3 +79,64 @@ TEST(GridConvergence, RefusesWhatIsNotThreeMeshesFromFineToCoarse) {
   EXPECT_THROW(grid_convergence({{0.2, 1.0}, {0.15, 1.1}, {0.1, 1.2}}), std::invalid_argument);
   EXPECT_THROW(grid_convergence({{0.1, NAN}, {0.15, 1.1}, {0.2, 1.2}}), std::invalid_argument);
 }
+
+namespace {
+
+// Levels h1 r^k (k = 0 .. n-1, ratios alternating 1.3 and 1.45 so they are not equal) of
+// phi0 + c h^p, plus `noise[k]`.
+std::vector<GridLevel> power_law_levels(double phi0, double c, double p, int n, const std::vector<double>& noise = {}) {
+  std::vector<GridLevel> levels;
+  double h = 0.06;
+  for (int k = 0; k < n; ++k, h *= (k % 2 ? 1.3 : 1.45))
+    levels.push_back({h, phi0 + c * std::pow(h, p) + (noise.empty() ? 0.0 : noise[k])});
+  return levels;
+}
+
+}  // namespace
+
+TEST(PowerLawFit, AnExactPowerLawGivesItsOrderAndLimitBack) {
+  for (double p : {0.8, 1.44, 2.7})
+    for (int n : {4, 6})
+      for (double c : {30.0, -30.0}) {
+        const PowerLawFit f = fit_power_law(power_law_levels(25.0, c, p, n));
+        ASSERT_TRUE(f.fitted) << p << " " << n << " " << c << ": " << f.explanation;
+        EXPECT_EQ(f.levels, n);
+        EXPECT_NEAR(f.order, p, 1e-5 * p);
+        EXPECT_NEAR(f.extrapolated, 25.0, 1e-5);
+        EXPECT_NEAR(f.coefficient, c * std::pow(0.06, p), 1e-5 * std::abs(c));
+        EXPECT_LT(f.largest_residual, 1e-8);
+      }
+}
+
+// The least squares' residuals are at most those of the law the values were made from, whose
+// residuals are the noise itself: a bound that holds for any noise if the search finds the
+// least sum of squares.
+TEST(PowerLawFit, ItsScatterIsAtMostTheNoiseAddedToAPowerLaw) {
+  const std::vector<double> noise = {0.04, -0.03, 0.05, -0.02, 0.01};
+  double squares = 0.0;
+  for (double e : noise) squares += e * e;
+  const PowerLawFit f = fit_power_law(power_law_levels(25.0, -60.0, 1.2, 5, noise));
+  ASSERT_TRUE(f.fitted) << f.explanation;
+  EXPECT_LE(f.residual_sd, std::sqrt(squares / 2.0) * (1 + 1e-9));
+  EXPECT_GT(f.residual_sd, 0.0);
+  EXPECT_NE(f.explanation.find("least squares"), std::string::npos) << f.explanation;
+  EXPECT_EQ(f.to_json()["levels"], 5);
+}
+
+TEST(PowerLawFit, ValuesThatTurnBackOrDoNotSettleAreNotFitted) {
+  // Oscillation: up, down, up as the mesh coarsens.
+  const PowerLawFit osc = fit_power_law({{0.1, 1.00}, {0.13, 1.10}, {0.17, 1.05}, {0.22, 1.12}});
+  EXPECT_FALSE(osc.fitted);
+  EXPECT_TRUE(std::isnan(osc.extrapolated) && std::isnan(osc.order));
+  EXPECT_TRUE(osc.to_json()["extrapolated"].is_null());
+  // Steps that shrink as the mesh coarsens: converging nowhere, the best order is at the range's end.
+  const PowerLawFit away = fit_power_law({{0.1, 1.00}, {0.13, 1.40}, {0.17, 1.60}, {0.22, 1.70}});
+  EXPECT_FALSE(away.fitted) << away.explanation;
+  EXPECT_NE(away.explanation.find("no power law"), std::string::npos) << away.explanation;
+}
+
+TEST(PowerLawFit, RefusesFewerThanFourMeshesOrMeshesOutOfOrder) {
+  EXPECT_THROW(fit_power_law({{0.1, 1.0}, {0.13, 1.1}, {0.17, 1.2}}), std::invalid_argument);
+  EXPECT_THROW(fit_power_law({{0.1, 1.0}, {0.13, 1.1}, {0.13, 1.2}, {0.2, 1.3}}), std::invalid_argument);
+  EXPECT_THROW(fit_power_law({{0.1, 1.0}, {0.13, 1.1}, {0.17, NAN}, {0.2, 1.3}}), std::invalid_argument);
+}

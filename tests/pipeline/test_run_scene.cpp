@@ -150,23 +150,25 @@ TEST(RunScene, FilesDeletedByHandAreMadeAgain) {
   EXPECT_EQ(s.str(), vtp);  // the same bed, read back from bed.csv
 }
 
-// [case.convergence]: the scene's mesh and two coarser ones, each solved; the verdict is the
-// grid-convergence procedure's on the levels' own numbers.
+// [case.convergence]: the scene's mesh and three coarser ones, each solved; the verdict is the
+// grid-convergence procedure's on the finest three levels' own numbers, and the least-squares
+// power law the fit's on all four.
 TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   const fs::path dir = test_support::fresh_dir("convergence");
   const Scene scene =
-      small_scene("\"case\"", "[case]\nrun = true\n[case.convergence]\nlevels = 3\nratio = 1.3\n", kOpenSurface);
+      small_scene("\"case\"", "[case]\nrun = true\n[case.convergence]\nlevels = 4\nratio = 1.3\n",
+                  "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n");
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& study = r.stages["case"]["convergence"];
-  ASSERT_EQ(study["levels"].size(), 3u) << study.dump();
-  for (int k = 0; k < 3; ++k) {
+  ASSERT_EQ(study["levels"].size(), 4u) << study.dump();
+  for (int k = 0; k < 4; ++k) {
     const auto& level = study["levels"][k];
     ASSERT_FALSE(level.contains("failure")) << level.dump();
     EXPECT_EQ(level["level"], k + 1);
   }
   // Each coarser level's solved cells are 1.3 times the size of the finer one's: the sizing
   // search stops within 3 % of its target, on the points of the tetrahedra (one polyhedron each).
-  for (int k = 1; k < 3; ++k) {
+  for (int k = 1; k < 4; ++k) {
     const auto& level = study["levels"][k];
     const double h = level["cell_size_m"].get<double>(), h1 = study["levels"][0]["cell_size_m"].get<double>();
     EXPECT_NEAR(h / h1, std::pow(1.3, k), 0.03 * std::pow(1.3, k)) << level.dump();
@@ -181,7 +183,7 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   EXPECT_LT(flow["void_fraction_section_bed"].get<double>(), flow["void_fraction_section"].get<double>());
   EXPECT_EQ(flow["void_fraction_section_bed"], r.stages["case"]["section"]["void_fraction_bed"]);
   EXPECT_EQ(study["levels"][0]["pressure_gradient_bed_pa_m"], r.stages["case"]["flow"]["pressure_gradient_bed_pa_m"]);
-  for (int k = 1; k < 3; ++k) {
+  for (int k = 1; k < 4; ++k) {
     EXPECT_LT(study["levels"][k]["cells"].get<long>(), study["levels"][k - 1]["cells"].get<long>()) << k;
     EXPECT_GT(study["levels"][k]["cell_size_m"].get<double>(), study["levels"][k - 1]["cell_size_m"].get<double>());
   }
@@ -192,7 +194,7 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   EXPECT_DOUBLE_EQ(study["levels"][0]["own_time_s"].get<double>(),
                    stages["surface"]["time_s"].get<double>() + stages["mesh"]["time_s"].get<double>() +
                        stages["case"]["time_s"].get<double>());
-  for (int k = 1; k < 3; ++k) {
+  for (int k = 1; k < 4; ++k) {
     const auto& level = study["levels"][k];
     EXPECT_GT(level["own_time_s"].get<double>(), 0.0) << level.dump();
     EXPECT_LE(level["own_time_s"].get<double>(), level["time_s"].get<double>()) << level.dump();
@@ -206,8 +208,11 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   std::vector<bedforge::analysis::GridLevel> levels;
   for (const auto& l : study["levels"])
     levels.push_back({l["cell_size_m"].get<double>(), l["pressure_gradient_bed_pa_m"].get<double>()});
-  EXPECT_EQ(study["grid_convergence"], bedforge::analysis::grid_convergence(levels).to_json());
-  EXPECT_NE(r.stages["case"]["summary"].get<std::string>().find("convergence: levels 1-3"), std::string::npos);
+  EXPECT_EQ(study["grid_convergence"], bedforge::analysis::grid_convergence({levels[0], levels[1], levels[2]}).to_json());
+  EXPECT_EQ(study["least_squares"], bedforge::analysis::fit_power_law(levels).to_json());
+  const std::string summary = r.stages["case"]["summary"].get<std::string>();
+  EXPECT_NE(summary.find("convergence: levels 1-3"), std::string::npos) << summary;
+  EXPECT_NE(summary.find(study["least_squares"]["explanation"].get<std::string>()), std::string::npos) << summary;
   EXPECT_TRUE(fs::exists(dir / "convergence/level_3/Allrun"));
   // Rerun unchanged: the study is part of the case, reused with it.
   const RunOutcome again = run(scene, dir);
