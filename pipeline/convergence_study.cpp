@@ -57,6 +57,7 @@ LevelLengths level_lengths(const Scene& scene, double scale) {
   l.surface.contact_edge_length_d *= scale;
   l.surface.cells_per_gap /= scale;
   l.mesh.max_size_d *= scale;
+  l.mesh.layers.thickness_d *= scale;  // the layers' count and growth stay: each layer scales
   return l;
 }
 

@@ -56,7 +56,8 @@ struct ConvergenceStudy {
 };
 
 // The surface and mesh settings of a level whose lengths are `scale` times the scene's: the
-// surface's edge and contact edge, the mesh's largest cell, and the edge across narrow gaps
+// surface's edge and contact edge, the mesh's largest cell, the prism layers' thickness, and the
+// edge across narrow gaps
 // (gap / cells_per_gap: cells_per_gap is divided by `scale`, and the gaps it refines stay the
 // same). Celik et al.'s procedure needs meshes refined alike everywhere; with cells_per_gap
 // kept, the gaps' cells were the same on every level.

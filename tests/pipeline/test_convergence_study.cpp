@@ -9,19 +9,24 @@ using namespace bedforge;
 using namespace bedforge::pipeline;
 
 // Celik et al.'s procedure needs meshes refined alike everywhere: every edge the surface rules
-// ask for, the edge across narrow gaps included, is `scale` times the finest level's. Checked on
+// ask for, the edge across narrow gaps included, and the prism layers' thickness are `scale`
+// times the finest level's. Checked on
 // the gap rule itself (meshing::gap_spacing, as the surface stage applies it, lengths in d)
 // at points facing gaps from under the finest edge to past the coarsest.
 TEST(ConvergenceStudy, ACoarserLevelScalesEveryLengthTheSurfaceAsksFor) {
   const Scene scene = read_scene(toml::parse("[container]\ndiameter_d = 5\n[particles]\ncount = 2\ndiameter_m = 0.003\n"
                                              "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\n"
-                                             "cells_per_gap = 3\n"),
+                                             "cells_per_gap = 3\n[mesh.layers]\ncount = 3\nthickness_d = 0.05\n"),
                                  "test");
   const double scale = 1.62;
   const LevelLengths level = level_lengths(scene, scale);
   EXPECT_DOUBLE_EQ(level.surface.edge_length_d, scale * scene.surface.edge_length_d);
   EXPECT_DOUBLE_EQ(level.surface.contact_edge_length_d, scale * scene.surface.contact_edge_length_d);
   EXPECT_DOUBLE_EQ(level.mesh.max_size_d, scale * scene.mesh.max_size_d);
+  // Prism layers as many, each `scale` times as thick (until 2026-11-27 they kept their
+  // thickness, so a layered study refined only along the walls).
+  EXPECT_DOUBLE_EQ(level.mesh.layers.thickness_d, scale * 0.05);
+  EXPECT_EQ(level.mesh.layers.count, 3);
 
   // Two spheres of diameter 1 whose surfaces are `gap` apart along x, in a wide tube; the edge
   // asked for on the first, facing the second.
