@@ -169,8 +169,9 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
   const double step = std::log(kFitOrders[1] / kFitOrders[0]) / samples;
   auto order_at = [&](int k) { return kFitOrders[0] * std::exp(step * k); };
   int best = 0;
+  double least = fit_at_order(levels, order_at(0)).squares;
   for (int k = 1; k <= samples; ++k)
-    if (fit_at_order(levels, order_at(k)).squares < fit_at_order(levels, order_at(best)).squares) best = k;
+    if (const double squares = fit_at_order(levels, order_at(k)).squares; squares < least) best = k, least = squares;
   if (best == 0 || best == samples) {
     f.explanation = fmt::format("no power law fits the {} levels with an order between {:g} and {:g} (the best lies at "
                                 "the range's end): they do not converge like one",

@@ -67,6 +67,7 @@ struct PowerLawFit {
   nlohmann::json to_json() const;
 };
 
+// The orders fit_power_law searches: wide enough that an order at either end means no fit.
 inline constexpr double kFitOrders[2] = {0.05, 8.0};
 
 // std::invalid_argument unless there are at least four levels, each coarser than the one
