@@ -119,10 +119,10 @@ nlohmann::json PowerLawFit::to_json() const {
 
 namespace {
 
-// The least-squares phi0 and alpha of phi = phi0 + alpha x for x_i = (h_i / h_1)^p, and the
-// sum of squared residuals.
+// The least-squares phi0 and alpha of phi = phi0 + alpha x for x_i = (h_i / h_1)^p, the sum of
+// squared residuals and the largest residual.
 struct LinearFit {
-  double phi0 = 0.0, alpha = 0.0, squares = 0.0;
+  double phi0 = 0.0, alpha = 0.0, squares = 0.0, largest = 0.0;
 };
 LinearFit fit_at_order(const std::vector<GridLevel>& levels, double p) {
   double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
@@ -136,6 +136,7 @@ LinearFit fit_at_order(const std::vector<GridLevel>& levels, double p) {
   for (const GridLevel& l : levels) {
     const double r = l.value - f.phi0 - f.alpha * std::pow(l.cell_size / levels.front().cell_size, p);
     f.squares += r * r;
+    f.largest = std::max(f.largest, std::abs(r));
   }
   return f;
 }
@@ -194,10 +195,7 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
   f.extrapolated = lin.phi0;
   f.coefficient = lin.alpha;
   f.residual_sd = std::sqrt(lin.squares / static_cast<double>(f.levels - 3));
-  f.largest_residual = 0.0;
-  for (const GridLevel& l : levels)
-    f.largest_residual = std::max(
-        f.largest_residual, std::abs(l.value - lin.phi0 - lin.alpha * std::pow(l.cell_size / levels.front().cell_size, p)));
+  f.largest_residual = lin.largest;
   f.explanation = fmt::format("over {} levels by least squares (Eca & Hoekstra 2014): order {:.2f}, extrapolated {:.6g}, "
                               "the levels {:.2g} % from the fit at most (standard deviation {:.2g} %)",
                               f.levels, p, lin.phi0, 100.0 * f.largest_residual / std::abs(lin.phi0),
