@@ -18,6 +18,7 @@
 
 #include "analysis/laminar_duct.hpp"
 #include "analysis/pressure_drop.hpp"
+#include "analysis/stokes_arrays.hpp"
 #include "analysis/void_fraction.hpp"
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
@@ -46,6 +47,7 @@ CaseParams read_case_params(SceneSection& s) {
   p.snappy = s.boolean("snappy", p.snappy) || p.snappy_cells;
   p.snappy_cell_d = s.number("snappy_cell_d", p.snappy_cell_d, Range::closed(0.01, 10.0));
   p.snappy_level = static_cast<int>(s.integer("snappy_level", p.snappy_level, 0, 6));
+  p.slip_walls = s.choice("walls", "no_slip", {"no_slip", "slip"}) == "slip";
   p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
   p.run = s.boolean("run", p.run);
   SceneSection convergence = s.sub("convergence");
@@ -70,6 +72,7 @@ nlohmann::json to_json(const CaseParams& p) {
           {"format", p.binary ? "binary" : "ascii"}, {"cells", p.polyhedra ? "polyhedra" : "tetrahedra"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
+          {"walls", p.slip_walls ? "slip" : "no_slip"},
           {"run", p.run},                   {"mesher", p.snappy_cells ? "snappy" : "gmsh"},
           {"convergence", {{"levels", p.convergence.levels}, {"ratio", p.convergence.ratio}}}};
 }
@@ -232,11 +235,16 @@ std::string dict(const std::string& cls, const std::string& location, const std:
 // Walls and particles take the same conditions; `.*wall` matches wall and inner_wall. The
 // constraint types cover processor patches, so the fields serve snappyHexMesh's cells as they
 // come, decomposed.
-std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls) {
+// `particles` empty: the walls' condition on the particles too.
+std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
+                           const std::string& particles = {}) {
+  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles)\"\n    {{\n{}    }}\n", walls)
+                                               : fmt::format("    \".*wall\"\n    {{\n{}    }}\n"
+                                                             "    particles\n    {{\n{}    }}\n",
+                                                             walls, particles);
   return fmt::format("boundaryField\n{{\n    #includeEtc \"caseDicts/setConstraintTypes\"\n"
-                     "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n"
-                     "    \"(.*wall|particles)\"\n    {{\n{}    }}\n}}\n",
-                     inlet, outlet, walls);
+                     "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n{}}}\n",
+                     inlet, outlet, solids);
 }
 
 std::string surface_value(const std::string& name, const std::string& region, const std::string& operation,
@@ -400,7 +408,8 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                              "        type            inletOutlet;\n"
                                              "        inletValue      uniform (0 0 0);\n"
                                              "        value           uniform (0 0 0);\n",
-                                             "        type            noSlip;\n")));
+                                             p.slip_walls ? "        type            slip;\n" : "        type            noSlip;\n",
+                                             p.slip_walls ? "        type            noSlip;\n" : "")));
     write_text(tmp / "0/p", field_dict("volScalarField", "p",
                                        "// kinematic pressure p/rho\ndimensions      [0 2 -2 0 0 0 0];\n\n"
                                        "internalField   uniform 0;\n\n" +
@@ -543,7 +552,14 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
   CaseInfo info{case_dir, p, u, nu, mesh ? static_cast<long>(mesh->cells) : 0L, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
-  if (bed.size() == 0) info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
+  info.particles = bed.size() > 0;
+  if (!info.particles && !p.slip_walls)
+    info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
+  // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
+  // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
+  if (info.particles && p.slip_walls && p.reynolds <= 0.01)
+    info.exact_pressure_gradient_pa_m =
+        analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
   return info;
 }
 
@@ -754,7 +770,9 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   if (its.empty()) throw std::runtime_error(fmt::format("{}/log.simpleFoam holds no iteration", case_dir.string()));
   const long iterations = static_cast<long>(its.size());
   const double res_u = its.back().res_u, res_p = its.back().res_p;
-  const double rho = c.params.density_kg_m3, u = c.velocity_m_s, d = c.d_ref_m, a = c.aspect_ratio;
+  // Walls the flow slips along are mirror planes: the correlation's bed is then unbounded.
+  const double a = c.params.slip_walls ? std::numeric_limits<double>::infinity() : c.aspect_ratio;
+  const double rho = c.params.density_kg_m3, u = c.velocity_m_s, d = c.d_ref_m;
   const double zl = c.section.z_low, zh = c.section.z_high, re = c.params.reynolds;
   const std::vector<double> bottom = series(case_dir, "pBedBottom"), top = series(case_dir, "pBedTop");
   const std::size_t n = std::min(bottom.size(), top.size());
@@ -794,7 +812,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.flow_rate_m3_s = flow;
   r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;
   const ForceZ walls = last_force_z(case_dir, "forceWalls");
-  const ForceZ particles = c.exact_pressure_gradient_pa_m ? ForceZ{} : last_force_z(case_dir, "forceParticles");
+  const ForceZ particles = c.particles ? last_force_z(case_dir, "forceParticles") : ForceZ{};
   r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
   r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
   r.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet").total + last_force_z(case_dir, "forceOutlet").total);

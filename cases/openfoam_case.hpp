@@ -47,6 +47,9 @@ struct CaseParams {
   bool snappy = false;                  // write the snappyHexMesh set-up (with gmsh's cells: used by Allrun -snappy)
   double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
   int snappy_level = 2;                 // refinement levels at particles and walls
+  // walls = "slip": the flow slips along the container's walls, mirror planes of the flow (a box
+  // then stands for a slab of an unbounded bed, or a cell of an array); "no_slip" otherwise.
+  bool slip_walls = false;
   double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
   // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
@@ -112,9 +115,11 @@ struct CaseInfo {
   std::optional<double> fluid_volume_m3;  // of the written cells
   // snappyHexMesh's cells: the volume the fluid surface encloses, which they should fill.
   std::optional<double> surface_volume_m3;
-  // An empty container's known answer, the fully developed laminar gradient (Pa/m): the route's
-  // verification. Unset for a bed, which is compared with Eisfeld & Schnitzlein instead.
+  // A known answer (Pa/m), the route's verification: an empty container's fully developed laminar
+  // gradient, or a simple cubic column's Stokes drag (analysis/stokes_arrays.hpp). Unset for
+  // other beds, which are compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
+  bool particles = false;                // the bed has spheres (a particles patch)
   nlohmann::json to_json() const;        // its report.json entry
 };
 
@@ -164,8 +169,8 @@ struct FlowResult {
   double drag_walls_viscous_n = 0.0, drag_particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
   double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
   double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
-  // An empty container (no correlation applies): the exact gradient and the relative error
-  // dp/L / exact - 1. For a bed, unset and the correlation's fields below are filled.
+  // A case with a known answer (no correlation is compared): the exact gradient and the relative
+  // error dp/L / exact - 1. Otherwise unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;
   double relative_error_to_exact = 0.0;
   // The correlation at the section's meshed void fraction, when known (not on snappyHexMesh's cells).

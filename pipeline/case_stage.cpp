@@ -45,7 +45,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                         flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
                         flow.residual_p, flow.pressure_gradient_bed_pa_m);
     if (flow.exact_pa_m)
-      line += fmt::format("exact laminar flow {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
+      line += fmt::format("the exact {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
     else
       line += fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps", flow.ratio_to_eisfeld_schnitzlein_bed);
     if (flow.ratio_to_eisfeld_schnitzlein)
