@@ -51,6 +51,11 @@ verification: the empty tube of scenes/examples/empty_tube_verification.toml (D 
         [case.convergence] (--verify-levels meshes from a finest surface edge --verify-edge d,
         ratio --verify-ratio); each level's error against the exact value, the order of those
         errors, and the GCI the study would quote without the exact value.
+verification_spheres: a column of a simple cubic array of spheres in Stokes flow (Re_p = 0.01) in a square
+        box whose slip walls are the array's mirror planes, as scenes/examples/simple_cubic_verification.toml
+        (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
+        (1982) tabulate: one `bedforge run` each with [case.convergence] (--sphere-levels meshes from
+        --sphere-edge d, ratio 1.3); each level's error, the order of the errors, the study's own verdict.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -74,7 +79,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
-            "solver", "verification"]
+            "solver", "verification", "verification_spheres"]
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -381,6 +386,47 @@ files = ["case"]
         wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
         case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
         out["runs"][cells] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+    return out
+
+
+def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
+    """Simple cubic columns at each solid fraction: count spheres, the pressure drop over the middle
+    cells_measured, whose planes lie a whole number of cells apart at the same phase."""
+    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
+    for phi in fractions:
+        side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
+        # From the box's bottom and the top sphere's top, both planes at the same phase:
+        exclude = ((count - 0.5 - cells_measured) * side + 0.5) / 2.0
+        path = os.path.join(tmp, f"simple_cubic_{phi}")
+        with open(path + ".txt", "w") as f:
+            f.write("x y z d\n" + "".join(f"0 0 {(k + 0.5) * side * 3.0:.12f} 3.0\n" for k in range(count)))
+        open(path + ".toml", "w").write(f"""[container]
+type = "box"
+size_x_d = {side:.12f}
+size_y_d = {side:.12f}
+[packing]
+algorithm = "import"
+file = "{path}.txt"
+units = "mm"
+[contacts]
+treatment = "none"
+[surface]
+edge_length_d = {edge}
+contact_edge_length_d = {edge / 2}
+cells_per_gap = 4
+[case]
+walls = "slip"
+reynolds = 0.01
+section_exclude_d = {exclude:.12f}
+processors = 2
+run = true
+convergence = {{levels = {levels}, ratio = 1.3}}
+[outputs]
+files = ["case"]
+""")
+        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+        case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
+        out["runs"][str(phi)] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
     return out
 
 
@@ -758,21 +804,53 @@ def write(results):
                          f"the study's own verdict on the finest three: {st['conclusion']}.")
         lines += ["", "![error against cell size](verification_tube.png)", ""]
         plot_verification(v)
+    if "verification_spheres" in results:
+        v = results["verification_spheres"]
+        lines += ["## Verification around spheres: a simple cubic array against Zick & Homsy", "",
+                  f"Made at commit {v['commit']} on {v['date']}: one column of a simple cubic array of spheres in a "
+                  "square box whose sides the flow slips along (the array's mirror planes), six cells, the pressure "
+                  "drop over the middle four, Stokes flow (Re_p = 0.01), through the same route as a bed, on "
+                  f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}. Exact: Zick & "
+                  "Homsy (1982, Table 2), drag 6 pi mu a K U per sphere to about 0.1 %: K = 7.442 at solid fraction "
+                  "0.216, 28.1 at 0.45 (gaps of 0.05 d between neighbours). Error = dp/L / exact - 1; the order is a "
+                  "least-squares fit of ln |error| against ln h over all levels.", "",
+                  "| solid fraction | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
+                  "|---|---|---|---|---|---|---|"]
+        for phi, run in v["runs"].items():
+            for lv in run["study"]["levels"]:
+                if "failure" in lv:
+                    lines.append(f"| {phi} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
+                    continue
+                lines.append(f"| {phi} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
+                             f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
+                             f"{lv['time_s']:.1f} |")
+        lines.append("")
+        for phi, run in v["runs"].items():
+            st = run["study"]
+            order = st.get("order_from_exact")
+            lines.append(f"- {phi}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
+                         f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
+                         f"the study's own verdict: {st['conclusion']}.")
+        lines += ["", "![error against cell size](verification_spheres.png)", ""]
+        plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
+                          "solid fraction ")
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
-def plot_verification(v):
+def plot_verification(v, name="verification_tube.png", title="empty tube D = 2 d, Re_p = 1",
+                      reference="Hagen-Poiseuille", label=""):
+    """|error| against cell size, one line per run of a verification section."""
     fig, ax = plt.subplots(figsize=(6, 4))
-    for cells, run in v["runs"].items():
+    for key, run in v["runs"].items():
         ok = [lv for lv in run["study"]["levels"] if "failure" not in lv]
         h = [lv["cell_size_m"] / run["d_m"] for lv in ok]
-        ax.loglog(h, [abs(lv["relative_error_to_exact"]) for lv in ok], "o-", label=cells)
+        ax.loglog(h, [abs(lv["relative_error_to_exact"]) for lv in ok], "o-", label=label + key)
     ax.set_xlabel("cell size h / d, (V / N)^(1/3) of the cells solved on")
-    ax.set_ylabel("|dp/L / Hagen-Poiseuille - 1|")
-    ax.set_title("empty tube D = 2 d, Re_p = 1")
+    ax.set_ylabel(f"|dp/L / {reference} - 1|")
+    ax.set_title(title)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(os.path.join(DOCS, "verification_tube.png"), dpi=120)
+    fig.savefig(os.path.join(DOCS, name), dpi=120)
 
 
 def plot(results):
@@ -822,6 +900,8 @@ def main():
     ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
+    ap.add_argument("--sphere-edge", type=float, default=0.05, help="verification_spheres: finest surface edge (d)")
+    ap.add_argument("--sphere-levels", type=int, default=4, help="verification_spheres: meshes in all")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -876,6 +956,9 @@ def main():
             write(results)
         if "verification" in args.only:
             results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)
+            write(results)
+        if "verification_spheres" in args.only:
+            results["verification_spheres"] = verification_spheres(tmp, args.sphere_edge, args.sphere_levels)
             write(results)
 
 
