@@ -232,10 +232,9 @@ std::string dict(const std::string& cls, const std::string& location, const std:
          "\n// ************************************************************************* //\n";
 }
 
-// Walls and particles take the same conditions; `.*wall` matches wall and inner_wall. The
-// constraint types cover processor patches, so the fields serve snappyHexMesh's cells as they
-// come, decomposed.
-// `particles` empty: the walls' condition on the particles too.
+// Walls and particles take the same conditions unless `particles` gives the particles their own
+// (walls that slip); `.*wall` matches wall and inner_wall. The constraint types cover processor
+// patches, so the fields serve snappyHexMesh's cells as they come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
                            const std::string& particles = {}) {
   const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles)\"\n    {{\n{}    }}\n", walls)
