@@ -378,7 +378,7 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const fs::path& fluid_stl) {
+                    const std::string& bed_csv, const fs::path& fluid_stl, bool spheres_as_packed) {
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
   if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
@@ -556,7 +556,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
   // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
-  if (info.particles && p.slip_walls && p.reynolds <= 0.01)
+  if (info.particles && spheres_as_packed && p.slip_walls && p.reynolds <= 0.01)
     info.exact_pressure_gradient_pa_m =
         analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
   return info;

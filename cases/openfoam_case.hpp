@@ -130,10 +130,12 @@ struct CaseInfo {
 // fvSolution, decomposeParDict, Allrun, Allclean, the records `bedforge/scene.toml` and
 // `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
 // (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
+// `spheres_as_packed`: the mesh's spheres are the bed's own (no contact treatment changed them),
+// the condition for comparing a bed with a known answer (a simple cubic column's).
 CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const std::filesystem::path& fluid_stl);
+                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, bool spheres_as_packed);
 
 // The flow solved in a case: the solver's convergence and the bed's pressure gradient.
 struct FlowResult {

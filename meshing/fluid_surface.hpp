@@ -44,6 +44,8 @@ struct SurfaceParams {
   // Quality gate: a surface with a smaller angle fails, its triangles written to
   // bad_triangles.vtp (0 turns the gate off).
   double min_angle_deg = 2.0;
+  // No treatment changes a sphere: the surface's spheres are the bed's own.
+  bool keeps_spheres() const { return treatment == Treatment::none && wall_treatment == Treatment::none; }
 };
 const char* treatment_name(SurfaceParams::Treatment t);
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);

@@ -10,7 +10,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const Bed& bed,
                      const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     const Console& console) {
+                     bool spheres_as_packed, const Console& console) {
   const StageMeter meter;
   const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
   // The domain's extent and patches: from gmsh's cells, or from the surface snappyHexMesh meshes.
@@ -22,7 +22,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
   const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface->points, bed);
   CaseStage out;
   out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
-                               fluid_stl);
+                               fluid_stl, spheres_as_packed);
   if (!mesh) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
   std::string line = mesh ? fmt::format("case: {} cells in {}", mesh->cells, case_dir.string())

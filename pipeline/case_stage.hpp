@@ -22,7 +22,8 @@ struct CaseStage {
 };
 
 // Writes the case of `bed` (m) into `case_dir` (replacing one only with `overwrite`), recording
-// `scene_toml` and the bed, and runs it when params.run. On gmsh's cells `mesh`; or, when
+// `scene_toml` and the bed, and runs it when params.run. `spheres_as_packed`: the surface's spheres
+// are the bed's own (no contact treatment changed them), so a known answer for the bed applies. On gmsh's cells `mesh`; or, when
 // params.snappy_cells, with no cells (mesh null) for snappyHexMesh to make from `surface`, the
 // fluid surface whose ASCII STL is `fluid_stl` (also needed, with params.snappy, beside gmsh's).
 // Both are let go of once the case is written and the allocator's free pages handed back, so
@@ -31,6 +32,6 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const Bed& bed,
                      const cases::CaseParams& params, const Provenance& provenance, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     const Console& console);
+                     bool spheres_as_packed, const Console& console);
 
 }  // namespace bedforge::pipeline

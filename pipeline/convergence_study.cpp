@@ -137,7 +137,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     params.snappy = false;  // a coarser level is solved on its gmsh cells only
     const meshing::PolyMesh* cells = &m->volume->mesh;
     const CaseStage c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {},
-                                   case_dir, true, console);
+                                   case_dir, true, scene.surface.keeps_spheres(), console);
     StudyLevel solved = study_level(c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);
     l = std::move(solved);

@@ -142,9 +142,15 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
   else
     mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
+#ifdef BEDFORGE_HAVE_CGAL
+  SceneSection contacts(d.scene["contacts"].as_table(), "contacts"), surf(d.scene["surface"].as_table(), "surface");
+  const bool spheres_as_packed = meshing::read_surface_params(contacts, surf).keeps_spheres();
+#else
+  const bool spheres_as_packed = false;  // without a surface stage the treatment is not known
+#endif
   const CaseStage c = case_stage(std::move(mesh), std::move(surface), d.bed, params, prov,
                                  scene_to_toml(d.scene), params.snappy ? stl : fs::path(), dir / "case", overwrite,
-                                 console);
+                                 spheres_as_packed, console);
   nlohmann::json entry = c.report;
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // The coarser levels need the whole scene: their surface and mesh settings, scaled.

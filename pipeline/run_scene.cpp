@@ -142,7 +142,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   if (plan.case_.build) {
     const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
                                    scene.case_params.snappy ? dir / "fluid.stl" : fs::path(), dir / "case",
-                                   opt.overwrite, console);
+                                   opt.overwrite, scene.surface.keeps_spheres(), console);
     nlohmann::json entry = c.report;
     if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, report, dir, console, entry);
     record("case", std::move(entry), keys.case_);
