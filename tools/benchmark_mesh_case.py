@@ -784,25 +784,8 @@ def write(results):
                   f"Made at commit {v['commit']} on {v['date']}: the empty tube (D = 2 d, 12 d long, section 3 d clear "
                   f"of either end, Re_p = 1) through the same route as a bed, on {v['levels']} meshes from a surface "
                   f"edge of {v['edge_d']} d, ratio {v['ratio']}; `case.cells` the only difference. Error = dp/L / "
-                  "exact - 1; the order is a least-squares fit of ln |error| against ln h over all levels.", "",
-                  "| cells | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
-                  "|---|---|---|---|---|---|---|"]
-        for cells, run in v["runs"].items():
-            for lv in run["study"]["levels"]:
-                if "failure" in lv:
-                    lines.append(f"| {cells} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
-                    continue
-                lines.append(f"| {cells} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
-                             f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
-                             f"{lv['time_s']:.1f} |")
-        lines.append("")
-        for cells, run in v["runs"].items():
-            st = run["study"]
-            order = st.get("order_from_exact")
-            lines.append(f"- {cells}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
-                         f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
-                         f"the study's own verdict on the finest three: {st['conclusion']}.")
-        lines += ["", "![error against cell size](verification_tube.png)", ""]
+                  "exact - 1; the order is a least-squares fit of ln |error| against ln h over all levels.", ""]
+        lines += verification_lines(v, "cells", "verification_tube.png")
         plot_verification(v)
     if "verification_spheres" in results:
         v = results["verification_spheres"]
@@ -813,28 +796,34 @@ def write(results):
                   f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}. Exact: Zick & "
                   "Homsy (1982, Table 2), drag 6 pi mu a K U per sphere to about 0.1 %: K = 7.442 at solid fraction "
                   "0.216, 28.1 at 0.45 (gaps of 0.05 d between neighbours). Error = dp/L / exact - 1; the order is a "
-                  "least-squares fit of ln |error| against ln h over all levels.", "",
-                  "| solid fraction | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
-                  "|---|---|---|---|---|---|---|"]
-        for phi, run in v["runs"].items():
-            for lv in run["study"]["levels"]:
-                if "failure" in lv:
-                    lines.append(f"| {phi} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
-                    continue
-                lines.append(f"| {phi} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
-                             f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
-                             f"{lv['time_s']:.1f} |")
-        lines.append("")
-        for phi, run in v["runs"].items():
-            st = run["study"]
-            order = st.get("order_from_exact")
-            lines.append(f"- {phi}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
-                         f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
-                         f"the study's own verdict: {st['conclusion']}.")
-        lines += ["", "![error against cell size](verification_spheres.png)", ""]
+                  "least-squares fit of ln |error| against ln h over all levels.", ""]
+        lines += verification_lines(v, "solid fraction", "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
+
+
+def verification_lines(v, column, png):
+    """A verification section's levels against the exact value, one table row per level of each
+    run (runs keyed by what `column` names), then each run's order and the study's own verdict."""
+    lines = [f"| {column} | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for key, run in v["runs"].items():
+        for lv in run["study"]["levels"]:
+            if "failure" in lv:
+                lines.append(f"| {key} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
+                continue
+            lines.append(f"| {key} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
+                         f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
+                         f"{lv['time_s']:.1f} |")
+    lines.append("")
+    for key, run in v["runs"].items():
+        st = run["study"]
+        order = st.get("order_from_exact")
+        lines.append(f"- {key}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
+                     f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
+                     f"the study's own verdict: {st['conclusion']}.")
+    return lines + ["", f"![error against cell size]({png})", ""]
 
 
 def plot_verification(v, name="verification_tube.png", title="empty tube D = 2 d, Re_p = 1",
