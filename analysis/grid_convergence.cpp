@@ -119,20 +119,26 @@ nlohmann::json PowerLawFit::to_json() const {
 
 namespace {
 
+// The sums of a least-squares line y = a + b x through points added one by one.
+struct LineSums {
+  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  void add(double x, double y) { n += 1.0, sx += x, sy += y, sxx += x * x, sxy += x * y; }
+  double determinant() const { return n * sxx - sx * sx; }
+  double slope() const { return (n * sxy - sx * sy) / determinant(); }
+  double intercept() const { return (sy - slope() * sx) / n; }
+};
+
 // The least-squares phi0 and alpha of phi = phi0 + alpha x for x_i = (h_i / h_1)^p, the sum of
 // squared residuals and the largest residual.
 struct LinearFit {
   double phi0 = 0.0, alpha = 0.0, squares = 0.0, largest = 0.0;
 };
 LinearFit fit_at_order(const std::vector<GridLevel>& levels, double p) {
-  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-  for (const GridLevel& l : levels) {
-    const double x = std::pow(l.cell_size / levels.front().cell_size, p);
-    n += 1.0, sx += x, sy += l.value, sxx += x * x, sxy += x * l.value;
-  }
+  LineSums line;
+  for (const GridLevel& l : levels) line.add(std::pow(l.cell_size / levels.front().cell_size, p), l.value);
   LinearFit f;
-  f.alpha = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  f.phi0 = (sy - f.alpha * sx) / n;
+  f.alpha = line.slope();
+  f.phi0 = line.intercept();
   for (const GridLevel& l : levels) {
     const double r = l.value - f.phi0 - f.alpha * std::pow(l.cell_size / levels.front().cell_size, p);
     f.squares += r * r;
@@ -204,16 +210,13 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
 }
 
 double observed_order(const std::vector<GridLevel>& levels, double exact) {
-  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  LineSums line;
   for (const GridLevel& l : levels) {
     const double e = std::abs(l.value / exact - 1.0);
-    if (!(e > 0.0) || !(l.cell_size > 0.0)) continue;
-    const double x = std::log(l.cell_size), y = std::log(e);
-    n += 1.0, sx += x, sy += y, sxx += x * x, sxy += x * y;
+    if (e > 0.0 && l.cell_size > 0.0) line.add(std::log(l.cell_size), std::log(e));
   }
-  const double det = n * sxx - sx * sx;
-  if (n < 2.0 || !(det > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  return (n * sxy - sx * sy) / det;
+  if (line.n < 2.0 || !(line.determinant() > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return line.slope();
 }
 
 }  // namespace bedforge::analysis

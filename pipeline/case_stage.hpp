@@ -23,9 +23,10 @@ struct CaseStage {
 
 // Writes the case of `bed` (m) into `case_dir` (replacing one only with `overwrite`), recording
 // `scene_toml` and the bed, and runs it when params.run. `spheres_as_packed`: the surface's spheres
-// are the bed's own (no contact treatment changed them), so a known answer for the bed applies. On gmsh's cells `mesh`; or, when
-// params.snappy_cells, with no cells (mesh null) for snappyHexMesh to make from `surface`, the
-// fluid surface whose ASCII STL is `fluid_stl` (also needed, with params.snappy, beside gmsh's).
+// are the bed's own (no contact treatment changed them), so a known answer for the bed applies.
+// On gmsh's cells `mesh`; or, when params.snappy_cells, with no cells (mesh null) for
+// snappyHexMesh to make from `surface`, the fluid surface whose ASCII STL is `fluid_stl` (also
+// needed, with params.snappy, beside gmsh's).
 // Both are let go of once the case is written and the allocator's free pages handed back, so
 // that OpenFOAM's processes get the memory they held (callers pass their only reference).
 CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_ptr<const meshing::TriangleMesh> surface,

@@ -48,8 +48,8 @@ struct ConvergenceStudy {
   // which says how far the levels stray from the one the finest three imply.
   std::optional<analysis::PowerLawFit> fit;
   std::string conclusion;                // what the study could and could not conclude
-  // An empty container's exact gradient (Pa/m): each level's error against it and the order of
-  // those errors, the verification of the whole route.
+  // A known answer's gradient (Pa/m; an empty container's, a simple cubic column's): each level's
+  // error against it and the order of those errors, the verification of the whole route.
   std::optional<double> exact_pa_m;
   double order_from_exact = 0.0;         // observed_order over the levels that gave a value
   nlohmann::json to_json() const;
