@@ -114,6 +114,7 @@ nlohmann::json PowerLawFit::to_json() const {
           {"coefficient", number(coefficient)},
           {"residual_sd", number(residual_sd)},
           {"largest_residual", number(largest_residual)},
+          {"asymptotic", asymptotic},
           {"explanation", explanation}};
 }
 
@@ -206,6 +207,11 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
                               "the levels {:.2g} % from the fit at most (standard deviation {:.2g} %)",
                               f.levels, p, lin.phi0, 100.0 * f.largest_residual / std::abs(lin.phi0),
                               100.0 * f.residual_sd / std::abs(lin.phi0));
+  f.asymptotic = p >= kAsymptoticOrder[0] && p <= kAsymptoticOrder[1];
+  if (!f.asymptotic)
+    f.explanation += fmt::format(", but that order is outside {:g}-{:g}: the levels are not in the asymptotic range, so the "
+                                 "extrapolation cannot be trusted",
+                                 kAsymptoticOrder[0], kAsymptoticOrder[1]);
   return f;
 }
 

@@ -223,7 +223,8 @@ def plot_mesh_convergence(case, path):
     if fit.get("fitted"):
         hs = [h[-1] * k / 100 for k in range(101)]  # from h = 0 to the coarsest level
         ax.plot(hs, [fit["extrapolated"] + fit["coefficient"] * (x / h[0]) ** fit["order"] for x in hs], "b--", lw=1,
-                label=f"least squares over {fit['levels']} levels, order {fit['order']:.2f}")
+                label=f"least squares over {fit['levels']} levels, order {fit['order']:.2f}"
+                      + ("" if fit.get("asymptotic", True) else " (outside 1-3: not trusted)"))
     flow = case.get("flow", {})
     if "eisfeld_schnitzlein_bed_pa_m" in flow:
         es = flow["eisfeld_schnitzlein_bed_pa_m"]

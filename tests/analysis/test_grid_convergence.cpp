@@ -105,6 +105,10 @@ TEST(PowerLawFit, AnExactPowerLawGivesItsOrderAndLimitBack) {
         EXPECT_NEAR(f.extrapolated, 25.0, 1e-5);
         EXPECT_NEAR(f.coefficient, c * std::pow(0.06, p), 1e-5 * std::abs(c));
         EXPECT_LT(f.largest_residual, 1e-8);
+        // Trusted only inside the band the three-level procedure uses, however well it fits.
+        EXPECT_EQ(f.asymptotic, p >= kAsymptoticOrder[0] && p <= kAsymptoticOrder[1]) << p;
+        EXPECT_EQ(f.explanation.find("cannot be trusted") != std::string::npos, !f.asymptotic) << f.explanation;
+        EXPECT_EQ(f.to_json()["asymptotic"], f.asymptotic);
       }
 }
 
