@@ -64,8 +64,7 @@ struct PowerLawFit {
   double residual_sd = 0.0;    // sqrt(sum of squared residuals / (levels - 3)), phi's unit
   double largest_residual = 0.0;  // max |phi_i - fit(h_i)|, phi's unit
   // Fitted and the order within kAsymptoticOrder, the rule the three-level procedure applies: a
-  // small scatter does not make an order outside it trustworthy (docs/findings.md, session 29:
-  // five touching-array levels fitted order 0.55 within 0.5 % and extrapolated 19 % above a bound).
+  // small scatter does not make an order outside it trustworthy (docs/findings.md, session 29).
   bool asymptotic = false;
   std::string explanation;     // one sentence a report can show
   nlohmann::json to_json() const;
