@@ -63,6 +63,17 @@ auto read_section(toml::table& scene, const char* name, Reader reader) {
   return params;
 }
 
+#ifdef BEDFORGE_HAVE_CGAL
+// The contact treatment and surface settings, sections [contacts] and [surface], every key checked.
+meshing::SurfaceParams read_surface_sections(toml::table& scene) {
+  SceneSection contacts(scene["contacts"].as_table(), "contacts"), surface(scene["surface"].as_table(), "surface");
+  const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surface);
+  contacts.finish();
+  surface.finish();
+  return params;
+}
+#endif
+
 }  // namespace
 
 void analyse_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
@@ -79,10 +90,7 @@ void analyse_directory(const fs::path& dir, const std::vector<Override>& overrid
 #ifdef BEDFORGE_HAVE_CGAL
 void surface_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
   Directory d = open_directory(dir, overrides);
-  SceneSection contacts(d.scene["contacts"].as_table(), "contacts"), surf(d.scene["surface"].as_table(), "surface");
-  const meshing::SurfaceParams params = meshing::read_surface_params(contacts, surf);
-  contacts.finish();
-  surf.finish();
+  const meshing::SurfaceParams params = read_surface_sections(d.scene);
   SurfaceStage s = surface_stage(d.bed, params, dir / "bad_triangles.vtp", console);
   OutputFiles files;
   add_surface_files(s.surface, files);
@@ -143,8 +151,7 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
     mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
 #ifdef BEDFORGE_HAVE_CGAL
-  SceneSection contacts(d.scene["contacts"].as_table(), "contacts"), surf(d.scene["surface"].as_table(), "surface");
-  const bool spheres_as_packed = meshing::read_surface_params(contacts, surf).keeps_spheres();
+  const bool spheres_as_packed = read_surface_sections(d.scene).keeps_spheres();
 #else
   const bool spheres_as_packed = false;  // without a surface stage the treatment is not known
 #endif
