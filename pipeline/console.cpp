@@ -7,7 +7,9 @@
 namespace bedforge::pipeline {
 
 void Console::line(const std::string& s) const {
-  if (!quiet) std::printf("%s\n", s.c_str());
+  if (quiet) return;
+  std::printf("%s\n", s.c_str());
+  std::fflush(stdout);  // a log piped to a file shows each finished stage, even of a run killed later
 }
 
 void finish_stage(nlohmann::json& report, const StageMeter& meter, const std::string& line, const Console& console) {
