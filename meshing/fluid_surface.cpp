@@ -138,12 +138,31 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
   return GapSpacing(centres, radii, kept, container, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
 }
 
+namespace {
+
+// The planes asked for below and above the fluid domain (m), before treat_contacts moves clip planes.
+DomainPlanes asked_planes(const Bed& bed, const SurfaceParams& p) {
+  const double d = reference_diameter(bed);
+  if (p.clip) return {p.clip_bottom_d * d, p.clip_top_d * d, true};
+  return {-p.inlet_length_d * d, bed_height(bed) + p.outlet_length_d * d, false};
+}
+
+}  // namespace
+
+FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell) {
+  const TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
+  FluidDomainSize s;
+  s.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
+  const std::optional<GapSpacing> gaps = gap_spacing(p, reference_diameter(bed), bed.centres, tb.radius, tb.kept,
+                                                     *bed.container);
+  if (gaps) s.gap_cells = gaps->added_cells(volume_per_cell, tb.planes.z0, tb.planes.z1);
+  return s;
+}
+
 FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   const double d = reference_diameter(bed), edge = p.edge_length_d * d;
   const double top = bed_height(bed);
-  DomainPlanes planes{-p.inlet_length_d * d, top + p.outlet_length_d * d, p.clip};
-  if (p.clip) planes.z0 = p.clip_bottom_d * d, planes.z1 = p.clip_top_d * d;
-  TreatedBed tb = treat_contacts(bed, p, planes);
+  TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
   const double z0 = tb.planes.z0, z1 = tb.planes.z1;
   const Container& c = *bed.container;
   const auto* ann = dynamic_cast<const Annulus*>(&c);

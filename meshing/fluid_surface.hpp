@@ -58,6 +58,16 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
                                       const std::vector<double>& radii, const std::vector<char>& kept,
                                       const Container& container);
 
+// The fluid domain of `bed` under `p`, known before its surface is meshed: the treated bed's
+// exact fluid volume (m^3) and the tetrahedra its narrow gaps add to a mesh of the surface edge
+// everywhere (GapSpacing::added_cells with `volume_per_cell`; 0 without cells_per_gap).
+// Throws treat_contacts's InputErrors.
+struct FluidDomainSize {
+  double volume_m3 = 0.0;
+  double gap_cells = 0.0;
+};
+FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell);
+
 struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)
   TriangleMesh bed;    // the closed treated particles, normals outward (m)

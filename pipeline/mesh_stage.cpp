@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/error.hpp"
+#include "meshing/fluid_surface.hpp"
 
 namespace bedforge::pipeline {
 
@@ -48,9 +50,41 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   return out;
 }
 
+namespace {
+
+constexpr double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
+
+// The cell edge away from the surfaces (m), d the reference diameter.
+double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.edge_length_d, scene.mesh.max_size_d) * d; }
+
+MeshEstimate with_cells(const Scene& scene, double fluid_volume_m3, double gap_cells, double d) {
+  const double bytes_per_cell = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
+  const double h = bulk_edge(scene, d);
+  MeshEstimate e;
+  e.fluid_volume_m3 = fluid_volume_m3;
+  e.gap_cells = gap_cells;
+  e.cells = fluid_volume_m3 / (kVolumePerCell * h * h * h) + gap_cells;
+  e.peak_bytes = e.cells * bytes_per_cell;
+  return e;
+}
+
+std::string beyond_memory(const MeshEstimate& e, double available_bytes) {
+  return fmt::format("the volume mesh would take at least {:.3g} million cells and {:.1f} GB (an estimate that errs "
+                     "low), and this machine has {:.1f} GB available",
+                     e.cells / 1e6, e.peak_bytes / 1e9, available_bytes / 1e9);
+}
+
+void refuse_edge(const Scene& scene, const MeshEstimate& e, double available_bytes) {
+  // Cells scale with h^-3, so the edge that would fit is this one times the cube root of the excess.
+  const double fits = scene.surface.edge_length_d * std::cbrt(e.peak_bytes / available_bytes);
+  throw InputError(fmt::format("surface.edge_length_d = {}: {}; allowed: surface.edge_length_d >= {:.3g}, fewer "
+                               "spheres, or a clip window (surface.clip_window_d)",
+                               scene.surface.edge_length_d, beyond_memory(e, available_bytes), fits));
+}
+
+}  // namespace
+
 MeshEstimate estimate_mesh(const Scene& scene) {
-  const double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
-  const double kBytesPerCell = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
   const double pi = std::acos(-1.0);
   double d = 0.0, solid = 0.0;
   if (scene.import.bed) {
@@ -63,29 +97,41 @@ MeshEstimate estimate_mesh(const Scene& scene) {
   }
   const double area = scene.container->cross_section_area();
   const meshing::SurfaceParams& s = scene.surface;
-  MeshEstimate e;
+  double fluid = 0.0;
   if (s.clip) {
-    e.fluid_volume_m3 = area * (s.clip_top_d - s.clip_bottom_d) * d * kDensestVoidFraction;
+    fluid = area * (s.clip_top_d - s.clip_bottom_d) * d * kDensestVoidFraction;
   } else {
     const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
-    e.fluid_volume_m3 = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
+    fluid = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
   }
-  const double h = std::min(s.edge_length_d, scene.mesh.max_size_d) * d;
-  e.cells = e.fluid_volume_m3 / (kVolumePerCell * h * h * h);
-  e.peak_bytes = e.cells * kBytesPerCell;
-  return e;
+  return with_cells(scene, fluid, 0.0, d);
+}
+
+MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {
+  const meshing::FluidDomainSize f = meshing::fluid_domain_size(bed, scene.surface, kVolumePerCell);
+  return with_cells(scene, f.volume_m3, f.gap_cells, reference_diameter(bed));
 }
 
 void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes) {
   const MeshEstimate e = estimate_mesh(scene);
-  if (e.peak_bytes <= available_bytes) return;
-  // Cells scale with h^-3, so the edge that would fit is this one times the cube root of the excess.
-  const double fits = scene.surface.edge_length_d * std::cbrt(e.peak_bytes / available_bytes);
+  if (e.peak_bytes > available_bytes) refuse_edge(scene, e, available_bytes);
+}
+
+MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes) {
+  const MeshEstimate e = estimate_mesh(scene, bed);
+  if (e.peak_bytes <= available_bytes) return e;
+  const double bulk_bytes = e.peak_bytes * (1.0 - e.gap_cells / e.cells);
+  if (e.gap_cells == 0.0 || bulk_bytes > 0.5 * available_bytes) refuse_edge(scene, e, available_bytes);
+  // The gaps' cells grow about as cells_per_gap^2 / contact edge (a refined patch's cells go as
+  // cells_per_gap^3 over the gap squared, summed over gaps down to cells_per_gap x contact edge).
+  const meshing::SurfaceParams& s = scene.surface;
+  const double excess = (e.peak_bytes - bulk_bytes) / (available_bytes - bulk_bytes);
   throw InputError(fmt::format(
-      "surface.edge_length_d = {}: the volume mesh would take at least {:.3g} million cells and {:.1f} GB (an estimate "
-      "that errs low), and this machine has {:.1f} GB available; allowed: surface.edge_length_d >= {:.3g}, fewer "
-      "spheres, or a clip window (surface.clip_window_d)",
-      scene.surface.edge_length_d, e.cells / 1e6, e.peak_bytes / 1e9, available_bytes / 1e9, fits));
+      "surface.cells_per_gap = {} with surface.contact_edge_length_d = {}: {}, {:.3g} million of the cells across the "
+      "bed's narrow gaps; allowed: surface.cells_per_gap <= about {:.2g}, surface.contact_edge_length_d >= about {:.2g}, "
+      "or a clip window (surface.clip_window_d)",
+      s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), e.gap_cells / 1e6,
+      s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess));
 }
 
 }  // namespace bedforge::pipeline

@@ -28,14 +28,18 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
                      const std::filesystem::path& msh_path,
                      const std::filesystem::path& bad_cells_path, const Console& console);
 
-// The volume mesh a scene asks for, estimated from the scene alone before anything runs, low
-// on purpose: a refusal on it never stops a run that would have fitted.
-//   fluid volume: the domain less the spheres, the bed at the densest random packing
-//                 (eps 0.36, Scott & Kilgour 1969) so the bed is as short as it can be;
+// The volume mesh a scene asks for, estimated before it is made, low on purpose: a refusal on
+// it never stops a run that would have fitted.
+//   fluid volume: from the scene alone, the domain less the spheres, the bed at the densest
+//                 random packing (eps 0.36, Scott & Kilgour 1969) so the bed is as short as it
+//                 can be; once the bed is packed, the treated bed's exact fluid volume;
 //   cells:        that volume over 0.24 h^3 per cell, h the surface edge (the largest volume
 //                 per cell of the empty tube's meshes, 0.20-0.24 h^3 from 0.2 d to 0.07 d; beds
 //                 have more, being refined at contacts: a = 10, N = 4000 at 0.1 d made 8.65 M
-//                 cells where this gives 5.6 M);
+//                 cells where this gives 5.6 M); once the bed is packed, plus the cells its
+//                 narrow gaps add with surface.cells_per_gap (meshing::fluid_domain_size;
+//                 gmsh made 1.03-1.39 times these cells in nine runs with cells_per_gap 3-8,
+//                 docs/findings.md);
 //   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
 //                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
@@ -44,13 +48,18 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 docs/findings.md, docs/mesh_case_benchmark.md).
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
+  double gap_cells = 0.0;  // of `cells`, those the narrow gaps add
   double cells = 0.0;
   double peak_bytes = 0.0;
 };
 MeshEstimate estimate_mesh(const Scene& scene);
+MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);
 
 // InputError naming surface.edge_length_d when the estimate's peak exceeds `available_bytes`
 // (core's available_memory_bytes()): said before packing, not as a crash an hour later.
 void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
+// The same once `bed` is packed, before its surface: naming surface.cells_per_gap when the
+// narrow gaps' cells are what does not fit. Returns the estimate.
+MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes);
 
 }  // namespace bedforge::pipeline

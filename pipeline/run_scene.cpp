@@ -86,6 +86,20 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
           fmt::format("the bed in {} (container, particles and packing unchanged; --force redoes it)", dir.string()));
   }
 
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // Now with the bed's narrow gaps, whose cells the scene alone cannot foresee: before the surface.
+  MeshEstimate estimate;
+  if (plan.mesh.build) {
+    const double available = available_memory_bytes();
+    estimate = refuse_mesh_beyond_memory(scene, bed, available);
+    const std::string gaps = estimate.gap_cells > 0.0
+                                 ? fmt::format(" ({:.3g} million across narrow gaps)", estimate.gap_cells / 1e6)
+                                 : std::string();
+    console.line(fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB of the {:.1f} GB available",
+                             estimate.cells / 1e6, gaps, estimate.peak_bytes / 1e9, available / 1e9));
+  }
+#endif
+
   OutputFiles files;
   const Provenance prov{kVersion, scene.seed, scene.to_json()};
   if (plan.write_bed_csv) files.add("bed.csv", bed_to_csv(bed, prov));
@@ -121,6 +135,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     if (opt.wants.mesh) files.add_made("fluid.msh", msh);
     MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.surface, scene.mesh, msh, dir / "bad_cells.vtk", console);
     mesh = std::shared_ptr<const meshing::PolyMesh>(m.volume, &m.volume->mesh);
+    m.report["estimate"] = {{"cells", estimate.cells},
+                            {"gap_cells", estimate.gap_cells},
+                            {"peak_memory_mb", estimate.peak_bytes / 1048576.0}};
     record("mesh", std::move(m.report), keys.mesh);
   } else {
     if (plan.load_mesh) mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
