@@ -95,8 +95,10 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     const std::string gaps = estimate.gap_cells > 0.0
                                  ? fmt::format(" ({:.3g} million across narrow gaps)", estimate.gap_cells / 1e6)
                                  : std::string();
-    console.line(fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB of the {:.1f} GB available",
-                             estimate.cells / 1e6, gaps, estimate.peak_bytes / 1e9, available / 1e9));
+    console.line(fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB "
+                             "available",
+                             estimate.cells / 1e6, gaps, estimate.peak_bytes / 1e9,
+                             estimate.peak_in_dual ? "polyDualMesh" : "mesh stage", available / 1e9));
   }
 #endif
 

@@ -400,6 +400,27 @@ TEST(RunScene, AMeshBeyondMemoryIsRefusedBeforePacking) {
   EXPECT_THROW(refuse_mesh_beyond_memory(small, 1e6), InputError);
 }
 
+// A case run on polyhedra peaks in polyDualMesh, which holds the tetrahedra and their dual at
+// once (1.02-1.24 kB per tetrahedron measured, against the mesh stage's 0.41-0.51 kB): a memory
+// that fits the mesh alone is refused for it, naming the way out.
+TEST(RunScene, ACaseRunOnPolyhedraIsRefusedWhenPolyDualMeshWouldNotFit) {
+  const Scene tetrahedra = small_scene("\"case\"", "[case]\nrun = true\ncells = \"tetrahedra\"\n");
+  const Scene dual = small_scene("\"case\"", "[case]\nrun = true\n");
+  const MeshEstimate t = estimate_mesh(tetrahedra), d = estimate_mesh(dual);
+  EXPECT_EQ(t.cells, d.cells);
+  EXPECT_FALSE(t.peak_in_dual);
+  EXPECT_TRUE(d.peak_in_dual);
+  const double available = 0.5 * (t.peak_bytes + d.peak_bytes);
+  EXPECT_NO_THROW(refuse_mesh_beyond_memory(tetrahedra, available));
+  try {
+    refuse_mesh_beyond_memory(dual, available);
+    FAIL() << "polyDualMesh's " << d.peak_bytes << " bytes were not refused in " << available;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("in polyDualMesh"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("case.cells = \"tetrahedra\""), std::string::npos) << e.what();
+  }
+}
+
 // Bridged contacts, their gaps refined to 4 cells down to a contact edge of 0.02 d.
 const std::string kRefinedGaps =
     "[contacts]\ntreatment = \"bridge\"\n[surface]\nedge_length_d = 0.1\ncontact_edge_length_d = 0.02\n"
