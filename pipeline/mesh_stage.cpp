@@ -75,9 +75,11 @@ MeshEstimate with_cells(const Scene& scene, double fluid_volume_m3, double gap_c
 }
 
 std::string beyond_memory(const MeshEstimate& e, double available_bytes) {
-  return fmt::format("the volume mesh would take at least {:.3g} million cells and {:.1f} GB in {} (an estimate that "
-                     "errs low), and this machine has {:.1f} GB available",
-                     e.cells / 1e6, e.peak_bytes / 1e9,
+  const std::string gaps =
+      e.gap_cells > 0.0 ? fmt::format(" ({:.3g} million of them across the bed's narrow gaps)", e.gap_cells / 1e6) : "";
+  return fmt::format("the volume mesh would take at least {:.3g} million cells{} and {:.1f} GB in {} (an estimate "
+                     "that errs low), and this machine has {:.1f} GB available",
+                     e.cells / 1e6, gaps, e.peak_bytes / 1e9,
                      e.peak_in_dual ? "polyDualMesh, the case's first step" : "the mesh stage", available_bytes / 1e9);
 }
 
@@ -139,11 +141,9 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
   const meshing::SurfaceParams& s = scene.surface;
   const double excess = (e.peak_bytes - bulk_bytes) / (available_bytes - bulk_bytes);
   throw InputError(fmt::format(
-      "surface.cells_per_gap = {} with surface.contact_edge_length_d = {}: {}, {:.3g} million of the cells across the "
-      "bed's narrow gaps; allowed: surface.cells_per_gap <= about {:.2g}, surface.contact_edge_length_d >= about {:.2g}, "
-      "a clip window (surface.clip_window_d){}",
-      s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), e.gap_cells / 1e6,
-      s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_tetrahedra(e)));
+      "surface.cells_per_gap = {} with surface.contact_edge_length_d = {}: {}; allowed: surface.cells_per_gap <= about "
+      "{:.2g}, surface.contact_edge_length_d >= about {:.2g}, a clip window (surface.clip_window_d){}",
+      s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_tetrahedra(e)));
 }
 
 }  // namespace bedforge::pipeline
