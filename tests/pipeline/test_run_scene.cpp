@@ -401,8 +401,9 @@ TEST(RunScene, AMeshBeyondMemoryIsRefusedBeforePacking) {
 }
 
 // A case run on polyhedra peaks in polyDualMesh, which holds the tetrahedra and their dual at
-// once (1.02-1.24 kB per tetrahedron measured, against the mesh stage's 0.41-0.51 kB): a memory
-// that fits the mesh alone is refused for it, naming the way out.
+// once (1.02-1.24 kB per tetrahedron measured, about twice the mesh stage's on meshes of ten
+// million and more; docs/findings.md): a memory that fits the mesh alone is refused for it,
+// naming the way out.
 TEST(RunScene, ACaseRunOnPolyhedraIsRefusedWhenPolyDualMeshWouldNotFit) {
   const Scene tetrahedra = small_scene("\"case\"", "[case]\nrun = true\ncells = \"tetrahedra\"\n");
   const Scene dual = small_scene("\"case\"", "[case]\nrun = true\n");
