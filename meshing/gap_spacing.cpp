@@ -31,13 +31,17 @@ double GapSpacing::gap(const Eigen::Vector3d& p, int self) const {
   grid_.near(p, [&](int j) {
     if (j != self) gap = std::min(gap, std::max(0.0, (p - centres_[j]).norm() - radii_[j]));
   });
-  if (self >= 0) {
-    // A wall within reach overlaps the sphere of radius `reach` about p by reach - distance.
-    WallContact walls[Container::kMaxWallContacts];
-    const int n = container_.wall_contacts(p, reach, walls);
-    for (int k = 0; k < n; ++k) gap = std::min(gap, std::max(0.0, reach - walls[k].overlap));
-  }
-  return gap;
+  return self >= 0 ? std::min(gap, wall_distance(p)) : gap;
+}
+
+double GapSpacing::wall_distance(const Eigen::Vector3d& p) const {
+  // A wall within reach overlaps the sphere of radius `reach` about p by reach - distance.
+  const double reach = cells_ * coarsest_;
+  WallContact walls[Container::kMaxWallContacts];
+  const int n = container_.wall_contacts(p, reach, walls);
+  double distance = reach;
+  for (int k = 0; k < n; ++k) distance = std::min(distance, std::max(0.0, reach - walls[k].overlap));
+  return distance;
 }
 
 double GapSpacing::at(const Eigen::Vector3d& p, int self) const {
@@ -55,14 +59,7 @@ double GapSpacing::medial_distance(const Eigen::Vector3d& p, const Eigen::Vector
   });
   // The walls: where the ray's distance to the nearest wall falls to t, by bisection (that
   // distance less t decreases along the ray).
-  const double reach = cells_ * coarsest_;
-  auto nearer_wall = [&](double s) {
-    WallContact walls[Container::kMaxWallContacts];
-    const int k = container_.wall_contacts(p + s * n, reach, walls);
-    double to_wall = reach;
-    for (int w = 0; w < k; ++w) to_wall = std::min(to_wall, reach - walls[w].overlap);
-    return to_wall < s;
-  };
+  auto nearer_wall = [&](double s) { return wall_distance(p + s * n) < s; };
   if (nearer_wall(t)) {
     double lo = 0.0, hi = t;
     for (int k = 0; k < 30; ++k) (nearer_wall(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);

@@ -40,6 +40,8 @@ class GapSpacing {
   // Distance from p to the nearest surface other than sphere `self`'s, up to cells_per_gap x
   // coarsest.
   double gap(const Eigen::Vector3d& p, int self) const;
+  // Distance from p to the nearest wall, up to cells_per_gap x coarsest.
+  double wall_distance(const Eigen::Vector3d& p) const;
   // Distance along the unit normal `n` from p on sphere `self` to the medial surface, up to
   // half of cells_per_gap x coarsest.
   double medial_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& n, int self) const;

@@ -126,6 +126,18 @@ MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {
   return with_cells(scene, f.volume_m3, f.gap_cells, reference_diameter(bed));
 }
 
+std::string estimate_line(const MeshEstimate& e, double available_bytes) {
+  const std::string gaps =
+      e.gap_cells > 0.0 ? fmt::format(" ({:.3g} million across narrow gaps)", e.gap_cells / 1e6) : std::string();
+  return fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB available",
+                     e.cells / 1e6, gaps, e.peak_bytes / 1e9, e.peak_in_dual ? "polyDualMesh" : "mesh stage",
+                     available_bytes / 1e9);
+}
+
+nlohmann::json to_json(const MeshEstimate& e) {
+  return {{"cells", e.cells}, {"gap_cells", e.gap_cells}, {"peak_memory_mb", e.peak_bytes / 1048576.0}};
+}
+
 void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes) {
   const MeshEstimate e = estimate_mesh(scene);
   if (e.peak_bytes > available_bytes) refuse_edge(scene, e, available_bytes);

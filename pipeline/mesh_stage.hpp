@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "core/bed.hpp"
 #include "meshing/slab_mesh.hpp"
@@ -57,6 +58,9 @@ struct MeshEstimate {
 };
 MeshEstimate estimate_mesh(const Scene& scene);
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);
+// The console's line for `e` against `available_bytes`, and its report entry (stages.mesh.estimate).
+std::string estimate_line(const MeshEstimate& e, double available_bytes);
+nlohmann::json to_json(const MeshEstimate& e);
 
 // InputError naming surface.edge_length_d when the estimate's peak exceeds `available_bytes`
 // (core's available_memory_bytes()): said before packing, not as a crash an hour later.

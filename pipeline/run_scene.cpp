@@ -92,13 +92,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   if (plan.mesh.build) {
     const double available = available_memory_bytes();
     estimate = refuse_mesh_beyond_memory(scene, bed, available);
-    const std::string gaps = estimate.gap_cells > 0.0
-                                 ? fmt::format(" ({:.3g} million across narrow gaps)", estimate.gap_cells / 1e6)
-                                 : std::string();
-    console.line(fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB "
-                             "available",
-                             estimate.cells / 1e6, gaps, estimate.peak_bytes / 1e9,
-                             estimate.peak_in_dual ? "polyDualMesh" : "mesh stage", available / 1e9));
+    console.line(estimate_line(estimate, available));
   }
 #endif
 
@@ -137,9 +131,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     if (opt.wants.mesh) files.add_made("fluid.msh", msh);
     MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.surface, scene.mesh, msh, dir / "bad_cells.vtk", console);
     mesh = std::shared_ptr<const meshing::PolyMesh>(m.volume, &m.volume->mesh);
-    m.report["estimate"] = {{"cells", estimate.cells},
-                            {"gap_cells", estimate.gap_cells},
-                            {"peak_memory_mb", estimate.peak_bytes / 1048576.0}};
+    m.report["estimate"] = to_json(estimate);
     record("mesh", std::move(m.report), keys.mesh);
   } else {
     if (plan.load_mesh) mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
