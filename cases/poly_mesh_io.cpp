@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <fstream>
 #include <stdexcept>
+#include <type_traits>
 
 namespace bedforge::cases {
 
@@ -47,8 +48,11 @@ void write_list(std::ostream& out, const std::vector<T>& items, bool binary, Asc
 
 }  // namespace
 
-void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& m, bool binary,
-                     const std::string& note) {
+namespace {
+
+// Both meshes have the same members; their faces differ in how they are stored.
+template <class Mesh>
+void write_mesh(const std::filesystem::path& dir, const Mesh& m, bool binary, const std::string& note) {
   std::filesystem::create_directories(dir);
   const std::string loc = "constant/polyMesh";
   {
@@ -64,21 +68,27 @@ void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& 
     if (binary) {
       // Binary faces are a compact list: N+1 offsets, then the vertex labels of all faces.
       out << foam_header("faceCompactList", loc, "faces", note, true);
-      std::vector<std::int32_t> offsets{0}, labels;
-      offsets.reserve(m.faces.size() + 1);
-      labels.reserve(3 * m.faces.size());
-      for (const auto& f : m.faces) {
-        labels.insert(labels.end(), f.begin(), f.end());
-        offsets.push_back(static_cast<std::int32_t>(labels.size()));
+      if constexpr (std::is_same_v<Mesh, meshing::PolyhedralMesh>) {
+        write_list(out, m.faces.offsets, true, [](std::string&, std::int32_t) {});
+        out << "\n";
+        write_list(out, m.faces.points, true, [](std::string&, std::int32_t) {});
+      } else {
+        meshing::Polygons compact;
+        compact.offsets.reserve(m.faces.size() + 1);
+        compact.points.reserve(3 * m.faces.size());
+        for (const auto& f : m.faces) compact.push_back(std::span<const int>(f.begin(), f.end()));
+        write_list(out, compact.offsets, true, [](std::string&, std::int32_t) {});
+        out << "\n";
+        write_list(out, compact.points, true, [](std::string&, std::int32_t) {});
       }
-      write_list(out, offsets, true, [](std::string&, std::int32_t) {});
-      out << "\n";
-      write_list(out, labels, true, [](std::string&, std::int32_t) {});
     } else {
       out << foam_header("faceList", loc, "faces", note, false);
-      write_list(out, m.faces, false, [](std::string& b, const meshing::Face& f) {
-        fmt::format_to(std::back_inserter(b), "{}({})", f.size(), fmt::join(f, " "));
-      });
+      out << m.faces.size() << "\n(\n";
+      for (std::size_t f = 0; f < m.faces.size(); ++f) {
+        const auto& face = m.faces[f];
+        out << fmt::format("{}({})\n", face.size(), fmt::join(face.begin(), face.end(), " "));
+      }
+      out << ")\n";
     }
   }
   const std::string sizes = fmt::format("nPoints:{}  nCells:{}  nFaces:{}  nInternalFaces:{}", m.points.size(), m.cells,
@@ -98,6 +108,18 @@ void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& 
     out << fmt::format("        nFaces          {};\n        startFace       {};\n    }}\n", p.size, p.start);
   }
   out << ")\n";
+}
+
+}  // namespace
+
+void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& mesh, bool binary,
+                     const std::string& note) {
+  write_mesh(dir, mesh, binary, note);
+}
+
+void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyhedralMesh& mesh, bool binary,
+                     const std::string& note) {
+  write_mesh(dir, mesh, binary, note);
 }
 
 }  // namespace bedforge::cases

@@ -12,6 +12,8 @@ namespace bedforge::cases {
 // caller writes the whole case under a temporary name.
 void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyMesh& mesh, bool binary,
                      const std::string& note);
+void write_poly_mesh(const std::filesystem::path& dir, const meshing::PolyhedralMesh& mesh, bool binary,
+                     const std::string& note);
 
 // OpenFOAM's file header ("FoamFile" dictionary) for an object in `location`.
 std::string foam_header(const std::string& cls, const std::string& location, const std::string& object,

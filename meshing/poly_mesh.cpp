@@ -68,13 +68,13 @@ Eigen::Vector3d vertex_mean(const std::vector<Eigen::Vector3d>& p, const int* fi
 
 }  // namespace
 
-FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& p, const Face& f) {
+FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& p, std::span<const int> f) {
   if (f.size() == 3)
     return {(p[f[0]] + p[f[1]] + p[f[2]]) / 3.0, 0.5 * (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]])};
-  const Eigen::Vector3d mean = vertex_mean(p, f.begin(), f.size());
+  const Eigen::Vector3d mean = vertex_mean(p, f.data(), static_cast<int>(f.size()));
   Eigen::Vector3d sum_n = Eigen::Vector3d::Zero(), sum_ac = Eigen::Vector3d::Zero();
   double sum_a = 0.0;
-  for (int k = 0; k < f.size(); ++k) {
+  for (std::size_t k = 0; k < f.size(); ++k) {
     const Eigen::Vector3d& a = p[f[k]];
     const Eigen::Vector3d& b = p[f[(k + 1) % f.size()]];
     const Eigen::Vector3d n = (b - a).cross(mean - a);
@@ -87,7 +87,10 @@ FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& p, const Face& f)
   return {sum_ac / (3.0 * sum_a), 0.5 * sum_n};
 }
 
-CellGeometry cell_geometry(const PolyMesh& m) {
+namespace {
+
+template <class Mesh>
+CellGeometry cell_geometry_of(const Mesh& m) {
   // Face geometry is computed twice rather than kept: at 2 faces per cell it would be the
   // largest array of the mesh stage.
   std::vector<Eigen::Vector3d> estimate(m.cells, Eigen::Vector3d::Zero());
@@ -116,6 +119,11 @@ CellGeometry cell_geometry(const PolyMesh& m) {
   }
   return g;
 }
+
+}  // namespace
+
+CellGeometry cell_geometry(const PolyMesh& m) { return cell_geometry_of(m); }
+CellGeometry cell_geometry(const PolyhedralMesh& m) { return cell_geometry_of(m); }
 
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& m) { return cell_geometry(m).centres; }
 std::vector<double> cell_volumes(const PolyMesh& m) { return cell_geometry(m).volumes; }

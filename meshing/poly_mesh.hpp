@@ -4,6 +4,7 @@
 
 #include <array>
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,32 @@ struct PolyMesh {
   int internal_faces() const { return static_cast<int>(neighbour.size()); }
 };
 
+// Polygons of any size in one compact list (OpenFOAM's faceCompactList): face f's points are
+// points[offsets[f]] ... points[offsets[f + 1] - 1].
+struct Polygons {
+  std::vector<int> offsets{0};
+  std::vector<int> points;
+  std::size_t size() const { return offsets.size() - 1; }
+  std::span<const int> operator[](std::size_t f) const {
+    return {points.data() + offsets[f], static_cast<std::size_t>(offsets[f + 1] - offsets[f])};
+  }
+  void push_back(std::span<const int> face) {
+    points.insert(points.end(), face.begin(), face.end());
+    offsets.push_back(static_cast<int>(points.size()));
+  }
+};
+
+// A PolyMesh whose faces are polygons of any size: the polyhedral dual (dual_mesh.hpp).
+struct PolyhedralMesh {
+  std::vector<Eigen::Vector3d> points;  // m
+  Polygons faces;
+  std::vector<int> owner;
+  std::vector<int> neighbour;
+  std::vector<PolyMesh::Patch> patches;
+  int cells = 0;
+  int internal_faces() const { return static_cast<int>(neighbour.size()); }
+};
+
 // Cells with labelled boundary faces into a PolyMesh.
 //   points      P x 3, m
 //   cells       C cells, either orientation (each face is turned to point away from its cell's
@@ -74,7 +101,10 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
 struct FaceGeometry {
   Eigen::Vector3d centre, area;
 };
-FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& points, const Face& face);
+FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& points, std::span<const int> face);
+inline FaceGeometry face_geometry(const std::vector<Eigen::Vector3d>& points, const Face& face) {
+  return face_geometry(points, std::span<const int>(face.begin(), face.end()));
+}
 
 // Cell centres and volumes (m, m^3; volumes signed) as OpenFOAM computes them
 // (primitiveMeshCellCentresAndVols): pyramids from each face to the mean of the face centres.
@@ -83,6 +113,7 @@ struct CellGeometry {
   std::vector<double> volumes;
 };
 CellGeometry cell_geometry(const PolyMesh& mesh);
+CellGeometry cell_geometry(const PolyhedralMesh& mesh);
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& mesh);
 std::vector<double> cell_volumes(const PolyMesh& mesh);
 
