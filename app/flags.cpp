@@ -108,6 +108,8 @@ const std::vector<Flag>& table() {
       {"--iterations", {"case.iterations"}, "simpleFoam iteration cap", static_cast<unsigned>(Command::case_)},
       {"--processors", {"case.processors"}, "subdomains in decomposeParDict", static_cast<unsigned>(Command::case_)},
       {"--format", {"case.format"}, "polyMesh and field format", static_cast<unsigned>(Command::case_)},
+      {"--cells", {"case.cells"}, "the cells solved on: gmsh's tetrahedra or their dual polyhedra",
+       static_cast<unsigned>(Command::case_)},
       {"--snappy", {"case.snappy"}, "also write the snappyHexMesh set-up, used by Allrun -snappy",
        static_cast<unsigned>(Command::case_)},
       {"--mesher", {"case.mesher"},

@@ -25,6 +25,7 @@
 #include "core/error.hpp"
 #include "core/report.hpp"
 #include "core/stage_meter.hpp"
+#include "meshing/dual_mesh.hpp"
 
 namespace bedforge::cases {
 
@@ -337,14 +338,9 @@ std::string allrun(const CaseParams& p) {
          "    fi\n"
          "fi\n";
   if (p.polyhedra && !p.snappy_cells)
-    s += "# gmsh's tetrahedra become their dual polyhedra, once (the tetrahedra are kept in constant/tetrahedra):\n"
+    s += "# constant/polyMesh holds the dual polyhedra of gmsh's tetrahedra, as `polyDualMesh 80` makes them:\n"
          "# an empty tube's pressure drop converges to the exact one on the dual, not on the tetrahedra.\n"
-         "# Edges sharper than 80 degrees (inlet and outlet rims) stay edges of the dual.\n"
          "if [ \"$snappy\" = 0 ]; then\n"
-         "    if [ ! -d constant/tetrahedra ]; then\n"
-         "        cp -r constant/polyMesh constant/tetrahedra\n"
-         "        run polyDualMesh -overwrite 80\n"
-         "    fi\n"
          "    run checkMesh\n"
          "fi\n";
   s += "# Past about a million cells per process the solver's temporary fields outgrow glibc's 32 MB\n"
@@ -390,8 +386,17 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
       mesh ? std::optional(meshing::cell_geometry(*mesh)) : std::nullopt;
   BedSection section = bed_section(geometry ? &*geometry : nullptr, g, p.section_exclude_d);
   section.void_fraction_bed = analysis::void_fraction(bed, section.z_low, section.z_high);
+  long cells = mesh ? mesh->cells : 0;  // as written
   try {
-    if (mesh) write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
+    // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
+    // it (which peaked at about 1 kB per tetrahedron).
+    if (mesh && p.polyhedra && !p.snappy_cells) {
+      const meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, kDualFeatureAngleDeg);
+      write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
+      cells = dual.cells;
+    } else if (mesh) {
+      write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
+    }
     const std::string fmt_word = p.binary ? "binary" : "ascii";
     auto field_dict = [&](const std::string& cls, const std::string& object, const std::string& body) {
       return foam_header(cls, "0", object, note, false) + body;
@@ -549,7 +554,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   }
   std::optional<double> fluid_volume;
   if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
-  CaseInfo info{case_dir, p, u, nu, mesh ? static_cast<long>(mesh->cells) : 0L, section, g.aspect_ratio,
+  CaseInfo info{case_dir, p, u, nu, cells, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;
   if (!info.particles && !p.slip_walls)

@@ -18,6 +18,8 @@ namespace bedforge::cases {
 // SIMPLE's target for U's initial residual when [case] residual_u is unset.
 inline constexpr double kResidualU = 1.0e-4;
 inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism layers
+// Boundary edges sharper than this (deg; the inlet's and outlet's rims) stay edges of the dual.
+inline constexpr double kDualFeatureAngleDeg = 80.0;
 
 // The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
 // through the bed, inlet at the bottom.
@@ -37,9 +39,10 @@ struct CaseParams {
   // graph partitioning, for OpenFOAM builds that have it (Debian's v1912 ships only a stub).
   std::string decomposition = "hierarchical";
   bool binary = true;                   // polyMesh and fields in binary, else ASCII
-  // cells = "polyhedra": Allrun first replaces gmsh's tetrahedra by their dual polyhedra
-  // (OpenFOAM's polyDualMesh), on which an empty tube's pressure drop converges to the exact one;
-  // "tetrahedra" solves on gmsh's cells, where it does not (docs/defaults.md).
+  // cells = "polyhedra": the case holds the dual polyhedra of gmsh's tetrahedra (as OpenFOAM's
+  // polyDualMesh makes them, meshing/dual_mesh.hpp), on which an empty tube's pressure drop
+  // converges to the exact one; "tetrahedra" solves on gmsh's cells, where it does not
+  // (docs/defaults.md).
   bool polyhedra = true;
   // mesher = "snappy": snappyHexMesh makes the cells in Allrun from the fluid surface, on as
   // many processes as the run has, and no gmsh mesh is made: the route past one machine's memory.
@@ -107,12 +110,13 @@ struct CaseInfo {
   CaseParams params;
   double velocity_m_s = 0.0;             // superficial inlet velocity
   double kinematic_viscosity_m2_s = 0.0;
-  long cells = 0;                        // written into constant/polyMesh (0 when snappyHexMesh makes them)
+  long cells = 0;                        // written into constant/polyMesh (the dual's with polyhedra; 0 when
+                                         // snappyHexMesh makes them)
   BedSection section;                    // where the pressure drop is measured
   double aspect_ratio = 0.0;             // D_h / d, for the correlation
   double inlet_area_m2 = 0.0;
   double d_ref_m = 0.0;
-  std::optional<double> fluid_volume_m3;  // of the written cells
+  std::optional<double> fluid_volume_m3;  // of gmsh's cells (the flow result has the solved cells' own)
   // snappyHexMesh's cells: the volume the fluid surface encloses, which they should fill.
   std::optional<double> surface_volume_m3;
   // A known answer (Pa/m), the route's verification: an empty container's fully developed laminar
@@ -125,10 +129,10 @@ struct CaseInfo {
 
 // Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
 // an existing case is replaced (only with `overwrite`) once the new one is complete:
-// constant/polyMesh (from `mesh`, gmsh's cells; null when p.snappy_cells), 0/U, 0/p, transport
-// and turbulence properties, controlDict with pressure and flow function objects, fvSchemes,
-// fvSolution, decomposeParDict, Allrun, Allclean, the records `bedforge/scene.toml` and
-// `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
+// constant/polyMesh (from `mesh`, gmsh's cells, or their dual with p.polyhedra; null when
+// p.snappy_cells), 0/U, 0/p, transport and turbulence properties, controlDict with pressure and
+// flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, the records
+// `bedforge/scene.toml` and `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
 // (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
 // `spheres_as_packed`: the mesh's spheres are the bed's own (no contact treatment changed them),
 // the condition for comparing a bed with a known answer (a simple cubic column's).

@@ -85,7 +85,7 @@ constexpr double kSizeTolerance = 0.03;
 constexpr int kSizingAttempts = 4;
 
 // The cells the flow will be solved on, from the tetrahedra before the case is written:
-// polyDualMesh makes one polyhedron per point.
+// the dual has one polyhedron per point.
 long cells_to_solve(const meshing::PolyMesh& tets, bool polyhedra) {
   return polyhedra ? static_cast<long>(tets.points.size()) : tets.cells;
 }

@@ -53,9 +53,10 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 namespace {
 
 constexpr double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
-// polyDualMesh holds the tetrahedra and their dual at once: its peak was 1.02-1.24 kB per
-// tetrahedron in three runs of 6.9-14.4 M tetrahedra (docs/findings.md), above the mesh stage's.
-constexpr double kDualBytesPerCell = 1000.0;
+// simpleFoam's processes on the polyhedral dual held 897 and 1038 bytes per tetrahedron together
+// (2 processes; 5.95 M and 2.73 M tetrahedra, 2026-11-28, docs/findings.md), as much as the mesh
+// stage or more.
+constexpr double kSolverBytesPerCell = 850.0;
 
 // The cell edge away from the surfaces (m), d the reference diameter.
 double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.edge_length_d, scene.mesh.max_size_d) * d; }
@@ -63,14 +64,14 @@ double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.e
 MeshEstimate with_cells(const Scene& scene, double fluid_volume_m3, double gap_cells, double d) {
   const double mesh_bytes = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
   const cases::CaseParams& c = scene.case_params;
-  const bool dual = c.run && c.polyhedra && !c.snappy_cells;
+  const bool solver = c.run && c.polyhedra && !c.snappy_cells;
   const double h = bulk_edge(scene, d);
   MeshEstimate e;
   e.fluid_volume_m3 = fluid_volume_m3;
   e.gap_cells = gap_cells;
   e.cells = fluid_volume_m3 / (kVolumePerCell * h * h * h) + gap_cells;
-  e.peak_bytes = e.cells * (dual ? kDualBytesPerCell : mesh_bytes);
-  e.peak_in_dual = dual;
+  e.peak_bytes = e.cells * (solver ? kSolverBytesPerCell : mesh_bytes);
+  e.peak_in_solver = solver;
   return e;
 }
 
@@ -80,20 +81,18 @@ std::string beyond_memory(const MeshEstimate& e, double available_bytes) {
   return fmt::format("the volume mesh would take at least {:.3g} million cells{} and {:.1f} GB in {} (an estimate "
                      "that errs low), and this machine has {:.1f} GB available",
                      e.cells / 1e6, gaps, e.peak_bytes / 1e9,
-                     e.peak_in_dual ? "polyDualMesh, the case's first step" : "the mesh stage", available_bytes / 1e9);
+                     e.peak_in_solver ? "simpleFoam's processes together" : "the mesh stage", available_bytes / 1e9);
 }
 
-// What else would fit when the case's polyDualMesh sets the peak.
-std::string or_tetrahedra(const MeshEstimate& e) {
-  return e.peak_in_dual ? ", case.cells = \"tetrahedra\" or case.run = false" : "";
-}
+// What else would fit when the solver sets the peak: the case written, to run elsewhere.
+std::string or_not_run(const MeshEstimate& e) { return e.peak_in_solver ? ", case.run = false" : ""; }
 
 void refuse_edge(const Scene& scene, const MeshEstimate& e, double available_bytes) {
   // Cells scale with h^-3, so the edge that would fit is this one times the cube root of the excess.
   const double fits = scene.surface.edge_length_d * std::cbrt(e.peak_bytes / available_bytes);
   throw InputError(fmt::format("surface.edge_length_d = {}: {}; allowed: surface.edge_length_d >= {:.3g}, fewer "
                                "spheres, a clip window (surface.clip_window_d){}",
-                               scene.surface.edge_length_d, beyond_memory(e, available_bytes), fits, or_tetrahedra(e)));
+                               scene.surface.edge_length_d, beyond_memory(e, available_bytes), fits, or_not_run(e)));
 }
 
 }  // namespace
@@ -130,7 +129,7 @@ std::string estimate_line(const MeshEstimate& e, double available_bytes) {
   const std::string gaps =
       e.gap_cells > 0.0 ? fmt::format(" ({:.3g} million across narrow gaps)", e.gap_cells / 1e6) : std::string();
   return fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB available",
-                     e.cells / 1e6, gaps, e.peak_bytes / 1e9, e.peak_in_dual ? "polyDualMesh" : "mesh stage",
+                     e.cells / 1e6, gaps, e.peak_bytes / 1e9, e.peak_in_solver ? "simpleFoam" : "mesh stage",
                      available_bytes / 1e9);
 }
 
@@ -155,7 +154,7 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
   throw InputError(fmt::format(
       "surface.cells_per_gap = {} with surface.contact_edge_length_d = {}: {}; allowed: surface.cells_per_gap <= about "
       "{:.2g}, surface.contact_edge_length_d >= about {:.2g}, a clip window (surface.clip_window_d){}",
-      s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_tetrahedra(e)));
+      s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_not_run(e)));
 }
 
 }  // namespace bedforge::pipeline

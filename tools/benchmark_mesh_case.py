@@ -674,7 +674,7 @@ def write(results):
         lines += ["## OpenFOAM's settings on the same mesh", "", made_line(r), "",
                   f"The bed of the studies (a = 5, N = 500, bridges, Re_p = 1), surface edge {r['edge_d']} d with "
                   f"{r['cells_per_gap']:g} cells across narrow gaps: {r['cells']} polyhedra, written and solved once "
-                  f"by `bedforge run` (simpleFoam {r['bedforge_solve_s']:.0f} s with polyDualMesh and checkMesh), then "
+                  f"by `bedforge run` (simpleFoam {r['bedforge_solve_s']:.0f} s with the Allrun steps before it), then "
                   "solved again from that mesh with one setting changed at a time, side by side in one run "
                   f"(simpleFoam alone on 2 processes, at most {r.get('iteration_cap', 3000)} iterations). dp/L as "
                   "bedforge converts the case as written."

@@ -95,7 +95,9 @@ TEST(OpenFoamCase, ChangingOnlyTheCaseReusesTheMesh) {
   const Result first = run("a.toml", "[case]\nreynolds = 1.0\n");
   ASSERT_EQ(first.status, 0) << first.output;
   const auto msh_time = fs::last_write_time(dir / "fluid.msh");
-  const auto cells = nlohmann::json::parse(read(dir / "report.json"))["stages"]["mesh"]["cells"];
+  const auto first_report = nlohmann::json::parse(read(dir / "report.json"));
+  const auto cells = first_report["stages"]["mesh"]["cells"];
+  const auto case_cells = first_report["stages"]["case"]["cells"];  // the dual's, one per point of the mesh
 
   const Result case_only = run("b.toml", "[case]\nreynolds = 2.0\n");
   ASSERT_EQ(case_only.status, 0) << case_only.output;
@@ -106,7 +108,7 @@ TEST(OpenFoamCase, ChangingOnlyTheCaseReusesTheMesh) {
   EXPECT_TRUE(report["stages"]["mesh"].value("reused", false));
   EXPECT_EQ(report["stages"]["mesh"]["cells"], cells);
   EXPECT_EQ(report["stages"]["case"]["parameters"]["reynolds"], 2.0);  // the case itself was written again
-  EXPECT_NE(read(dir / "case/constant/polyMesh/owner").find("nCells:" + cells.dump()), std::string::npos);
+  EXPECT_NE(read(dir / "case/constant/polyMesh/owner").find("nCells:" + case_cells.dump()), std::string::npos);
 
   // Nothing changed: the case is reused too, so no --overwrite is needed.
   const auto u_time = fs::last_write_time(dir / "case/0/U");
@@ -137,10 +139,14 @@ TEST(OpenFoamCase, BinaryAndAsciiCasesAreTheSameMeshToCheckMesh) {
   // checkMesh's statistics (cells, faces, volumes, quality) agree line for line after the header.
   auto stats = [](const std::string& s) { return s.substr(s.find("Mesh stats"), s.find("End") - s.find("Mesh stats")); };
   EXPECT_EQ(stats(ascii.output), stats(binary.output));
-  // The mesh stage's own quality figures are checkMesh's, computed the same way.
+  EXPECT_NE(binary.output.find("polyhedra:"), std::string::npos) << binary.output;  // the dual, by default
+  // The mesh stage's own quality figures are checkMesh's on its tetrahedra, computed the same way.
+  ASSERT_EQ(bedforge("--quiet case " + dir.string() + " --cells tetrahedra --overwrite").status, 0);
+  const Result tetrahedra = check_mesh(dir / "case");
+  ASSERT_NE(tetrahedra.output.find("Mesh OK."), std::string::npos) << tetrahedra.output;
   auto number_after = [&](const std::string& key) {
-    const auto at = binary.output.find(key);
-    return at == std::string::npos ? -1.0 : std::stod(binary.output.substr(at + key.size()));
+    const auto at = tetrahedra.output.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(tetrahedra.output.substr(at + key.size()));
   };
   const auto q = nlohmann::json::parse(read(dir / "report.json"))["stages"]["mesh"]["quality"];
   EXPECT_NEAR(q["max_non_orthogonality_deg"].get<double>(), number_after("Mesh non-orthogonality Max:"), 1e-6);
@@ -187,7 +193,7 @@ TEST(OpenFoamCase, ACaseWithoutAMeshAndAMeshWithoutAClosedSurfaceAreRefused) {
 }
 
 // Prism layers on the particles: checkMesh passes the mixed mesh (prisms, pyramids,
-// tetrahedra) and its quality figures are the mesh stage's own.
+// tetrahedra) and its dual, and the mixed mesh's quality figures are the mesh stage's own.
 TEST(OpenFoamCase, PrismLayersGiveACaseCheckMeshPasses) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
   const fs::path dir = fresh_dir("layers");
@@ -196,7 +202,11 @@ TEST(OpenFoamCase, PrismLayersGiveACaseCheckMeshPasses) {
   const Result m = bedforge("mesh " + dir.string() + " --layers 3 --layer-thickness-d 0.02");
   ASSERT_EQ(m.status, 0) << m.output;
   EXPECT_NE(m.output.find("3 prism layers"), std::string::npos) << m.output;
+  // Their dual, the default cells, passes too.
   ASSERT_EQ(bedforge("--quiet case " + dir.string()).status, 0);
+  const Result dual = check_mesh(dir / "case");
+  ASSERT_NE(dual.output.find("Mesh OK."), std::string::npos) << dual.output;
+  ASSERT_EQ(bedforge("--quiet case " + dir.string() + " --cells tetrahedra --overwrite").status, 0);
   const Result c = check_mesh(dir / "case");
   ASSERT_NE(c.output.find("Mesh OK."), std::string::npos) << c.output;
   EXPECT_NE(c.output.find("prisms:"), std::string::npos) << c.output;
@@ -279,9 +289,10 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   EXPECT_GT(drag["walls_n"].get<double>(), 0.0) << drag.dump();
   EXPECT_GT(drag["particles_n"].get<double>(), 0.0) << drag.dump();
   EXPECT_LT(std::abs(drag["force_balance_relative_error"].get<double>()), 0.02) << drag.dump();
-  // Solved on the polyhedral dual (the default), not on gmsh's tetrahedra.
+  // Solved on the polyhedral dual (the default), the cells written, not on gmsh's tetrahedra.
   EXPECT_EQ(flow["mesh"]["mesher"], "gmsh polyhedral dual");
-  EXPECT_LT(flow["mesh"]["cells"].get<long>(), c["cells"].get<long>());
+  EXPECT_EQ(flow["mesh"]["cells"].get<long>(), c["cells"].get<long>());
+  EXPECT_LT(flow["mesh"]["cells"].get<long>(), report["stages"]["mesh"]["cells"].get<long>());
   // Eisfeld & Schnitzlein at the section's exact void fraction: the correlation's own scatter
   // is +-20 % (correlations.md, grade C), and this 0.1 d mesh is not converged: on this bed the
   // dual's dp/L at 0.1 d was 0.65 of what its 0.1, 0.07, 0.05 d sequence extrapolates to
