@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <optional>
 
@@ -21,7 +22,9 @@ namespace fs = std::filesystem;
 nlohmann::json ConvergenceStudy::to_json() const {
   nlohmann::json out = {{"complete", complete}, {"conclusion", conclusion}, {"levels", nlohmann::json::array()}};
   for (const StudyLevel& l : levels) {
-    nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}};
+    nlohmann::json j = {{"level", l.level}, {"scale", l.scale}, {"time_s", l.time_s}, {"alpha", l.alpha},
+                        {"cache_key", l.cache_key}};
+    if (l.reused) j["reused"] = true;
     if (!l.sizing.empty()) {
       j["sizing"] = nlohmann::json::array();
       for (const auto& [scale, h] : l.sizing) j["sizing"].push_back({{"scale", scale}, {"predicted_cell_size_m", h}});
@@ -49,6 +52,30 @@ nlohmann::json ConvergenceStudy::to_json() const {
       out["extrapolated_error_to_exact"] = convergence.extrapolated / *exact_pa_m - 1.0;
   }
   return out;
+}
+
+StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> exact_pa_m) {
+  StudyLevel l;
+  l.level = j.at("level").get<int>();
+  l.scale = j.at("scale").get<double>();
+  l.time_s = j.at("time_s").get<double>();
+  l.alpha = j.value("alpha", 1.0);
+  l.cache_key = j.value("cache_key", "");
+  for (const auto& s : j.value("sizing", nlohmann::json::array()))
+    l.sizing.emplace_back(s.at("scale").get<double>(), s.at("predicted_cell_size_m").get<double>());
+  if (j.contains("failure")) {
+    l.failure = j["failure"].get<std::string>();
+    return l;
+  }
+  l.cells = j.at("cells").get<long>();
+  l.cell_size_m = j.at("cell_size_m").get<double>();
+  l.pressure_gradient_pa_m = j.at("pressure_gradient_bed_pa_m").get<double>();
+  l.converged = j.at("converged").get<bool>();
+  l.wall_share_of_drag = j.at("wall_share_of_drag").get<double>();
+  l.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
+  l.own_time_s = j.at("own_time_s").get<double>();
+  l.exact_pa_m = exact_pa_m;
+  return l;
 }
 
 LevelLengths level_lengths(const Scene& scene, double scale) {
@@ -152,19 +179,46 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
 }  // namespace
 
 ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const fs::path& dir,
-                                   const Console& console) {
+                                   const Console& console, const nlohmann::json& earlier) {
   const cases::CaseParams::Convergence& p = scene.case_params.convergence;
   ConvergenceStudy study;
   study.levels.push_back(finest);
+  // Levels an earlier run left beyond this study's are not part of it.
+  if (fs::exists(dir))
+    for (const auto& e : fs::directory_iterator(dir)) {
+      int k = 0;
+      if (std::sscanf(e.path().filename().c_str(), "level_%d", &k) == 1 && k > p.levels) fs::remove_all(e.path());
+    }
   // Each level's cells `ratio` times the size of the finer one's, measured on the cells solved
   // on (Celik et al. 2008 ask r >= 1.3 of the grids, not of the settings that make them).
   Sized finer{1.0, finest.cell_size_m};
   double alpha = 1.0;  // the first guess: cell size in proportion to the lengths
   for (int k = 2; k <= p.levels; ++k) {
     const double target = finest.cell_size_m * std::pow(p.ratio, k - 1);
+    const fs::path level_dir = dir / fmt::format("level_{}", k);
+    // A level follows from its finer one's (its sizing starts there), the ratio and its number.
+    const std::string key =
+        stage_key({{"finer", study.levels.back().cache_key}, {"ratio", p.ratio}, {"level", k}});
+    nlohmann::json before;
+    if (earlier.is_object())
+      for (const auto& l : earlier.value("levels", nlohmann::json::array()))
+        if (l.value("level", 0) == k && l.value("cache_key", "") == key) before = l;
+    if (before.is_object() && !before.contains("failure") && fs::exists(level_dir / "constant/polyMesh/owner")) {
+      StudyLevel l = study_level_from_json(before, finest.exact_pa_m);
+      l.reused = true;
+      finer = {l.sizing.back().first, l.sizing.back().second};
+      alpha = l.alpha;
+      console.line(fmt::format("convergence: level {} of {} reused from {} ({} cells, dp/L {:.5g} Pa/m)", k, p.levels,
+                               level_dir.string(), l.cells, l.pressure_gradient_pa_m));
+      study.levels.push_back(std::move(l));
+      continue;
+    }
     console.line(fmt::format("convergence: level {} of {}, cells of {:.4g} d wanted", k, p.levels,
                              target / reference_diameter(bed)));
-    study.levels.push_back(solve_level(scene, bed, k, target, finer, alpha, dir / fmt::format("level_{}", k), console));
+    StudyLevel l = solve_level(scene, bed, k, target, finer, alpha, level_dir, console);
+    l.alpha = alpha;
+    l.cache_key = key;
+    study.levels.push_back(std::move(l));
   }
   // The finest three levels in a row that gave a value.
   for (std::size_t first = 0; first + 2 < study.levels.size(); ++first) {
@@ -209,14 +263,29 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
   return study;
 }
 
-void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const Report& report,
-                           const fs::path& dir, const Console& console, nlohmann::json& case_entry) {
+StudyLevel finest_level(const CaseStage& solved, const Report& report, const std::string& case_key) {
   // A mesh made outside this report (bedforge case on a copied fluid.msh) counts as free.
   const nlohmann::json none = nlohmann::json::object(), stages = report.data().value("stages", none);
   const double surface_mesh_s =
       stages.value("surface", none).value("time_s", 0.0) + stages.value("mesh", none).value("time_s", 0.0);
-  const StudyLevel finest = study_level(solved, 1, 1.0, surface_mesh_s);
-  const ConvergenceStudy study = convergence_study(scene, bed, finest, dir / "convergence", console);
+  StudyLevel finest = study_level(solved, 1, 1.0, surface_mesh_s);
+  finest.cache_key = case_key;
+  return finest;
+}
+
+void remove_convergence_study(nlohmann::json& case_entry) {
+  if (!case_entry.contains("convergence")) return;
+  const std::string summary = case_entry.value("summary", ""),
+                    study = "; convergence: " + case_entry["convergence"].value("conclusion", "");
+  if (summary.size() >= study.size() && summary.compare(summary.size() - study.size(), study.size(), study) == 0)
+    case_entry["summary"] = summary.substr(0, summary.size() - study.size());
+  case_entry.erase("convergence");
+}
+
+void add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
+                           const fs::path& dir, const Console& console, nlohmann::json& case_entry) {
+  const ConvergenceStudy study = convergence_study(scene, bed, finest, dir / "convergence", console, earlier);
+  remove_convergence_study(case_entry);
   case_entry["convergence"] = study.to_json();
   const std::string line = "convergence: " + study.conclusion;
   case_entry["summary"] = case_entry["summary"].get<std::string>() + "; " + line;

@@ -36,7 +36,12 @@ struct StudyLevel {
   // The scales tried to bring a coarser level's cells to their target size, with the cell size
   // each mesh promised ((fluid volume / cells to solve)^(1/3), m), the last one solved.
   std::vector<std::pair<double, double>> sizing;
+  double alpha = 1.0;      // the sizing's exponent (cell size ~ scale^alpha) after this level: the next one's start
+  std::string cache_key;   // the finest's: the case stage's; a coarser one's: its finer one's, the ratio and its number
+  bool reused = false;     // taken from the earlier run in the directory, not solved again
 };
+// A level as ConvergenceStudy::to_json wrote it; `exact_pa_m` the study's known answer, if any.
+StudyLevel study_level_from_json(const nlohmann::json& level, std::optional<double> exact_pa_m);
 
 // The pressure drop's discretisation error from the flow solved on the scene's mesh and on
 // coarser ones: the levels and the verdict on the finest three that gave a value.
@@ -76,15 +81,28 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
 // (level_lengths) by the factor that makes its cells ratio^(k - 1) times the size of the
 // finest's (searched: up to 4 surfaces and meshes, to within 3 %), builds its surface and mesh
 // in memory and solves its case in `dir`/level_k. A level that fails (a gate, the solver) is
-// reported with its reason, and the others go on.
+// reported with its reason, and the others go on. A level of `earlier` (the study an earlier
+// run left in `dir`, as to_json wrote it; null for none) with the same cache key, whose case is
+// still there, is taken as it is: adding a level, or going back to fewer, solves nothing again.
+// Level directories beyond the study's levels are removed.
 ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest,
-                                   const std::filesystem::path& dir, const Console& console);
+                                   const std::filesystem::path& dir, const Console& console,
+                                   const nlohmann::json& earlier = nullptr);
 
-// Runs the study of [case.convergence] after the scene's case `solved`, into `dir`/convergence,
-// and adds it to the case's report entry (its "convergence" and a summary that ends with the
-// study's conclusion, which is printed). `report` is the run's, whose surface and mesh stages
-// made the solved mesh (their times count in the finest level's own).
-void add_convergence_study(const Scene& scene, const Bed& bed, const CaseStage& solved, const Report& report,
+// The finest level of a study from the scene's solved case: `report` is the run's, whose surface
+// and mesh stages made the solved mesh (their times count in the level's own); `case_key` the
+// case stage's cache key (empty when the case is not cached).
+StudyLevel finest_level(const CaseStage& solved, const Report& report, const std::string& case_key);
+
+// Runs the study of [case.convergence] from `finest` into `dir`/convergence, reusing the levels
+// of `earlier` (an earlier run's study in `dir`, or null) that still hold, and puts it in the
+// case's report entry: its "convergence" and a summary that ends with the study's conclusion,
+// which is printed (an earlier study's conclusion there is replaced).
+void add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
                            const std::filesystem::path& dir, const Console& console, nlohmann::json& case_entry);
+
+// The case's report entry without its study (its "convergence" and the summary's conclusion):
+// for a case reused by a run that asks for none.
+void remove_convergence_study(nlohmann::json& case_entry);
 
 }  // namespace bedforge::pipeline

@@ -162,8 +162,8 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // The coarser levels need the whole scene: their surface and mesh settings, scaled.
   if (params.convergence.levels > 0)
-    add_convergence_study(read_scene(d.scene, (dir / "scene.toml").string(), dir), d.bed, c, d.report, dir, console,
-                          entry);
+    add_convergence_study(read_scene(d.scene, (dir / "scene.toml").string(), dir), d.bed, finest_level(c, d.report, ""),
+                          nullptr, dir, console, entry);
 #endif
   d.report.set_stage("case", std::move(entry));
   d.report.save(dir);

@@ -150,16 +150,39 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   files.write(dir);
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // The earlier run's study, whose coarser levels a new one reuses where they still hold.
+  const nlohmann::json none = nlohmann::json::object(),
+                       earlier_study = previous.is_object()
+                                           ? previous.value("stages", none).value("case", none).value("convergence", nlohmann::json())
+                                           : nlohmann::json();
+  const bool study = scene.case_params.convergence.levels > 0;
   if (plan.case_.build) {
     const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
                                    scene.case_params.snappy ? dir / "fluid.stl" : fs::path(), dir / "case",
                                    opt.overwrite, scene.surface.keeps_spheres(), console);
     nlohmann::json entry = c.report;
-    if (scene.case_params.convergence.levels > 0) add_convergence_study(scene, bed, c, report, dir, console, entry);
+    if (study) {
+      add_convergence_study(scene, bed, finest_level(c, report, keys.case_), earlier_study, dir, console, entry);
+      entry["convergence"]["cache_key"] = keys.study;
+    }
     record("case", std::move(entry), keys.case_);
-  } else {
+  } else if (plan.case_.involved) {
     reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));
+    // A changed study is redone from the case's finest level, solving only the levels that changed.
+    nlohmann::json entry = plan.case_.reused;
+    if (study && earlier_study.value("cache_key", "") != keys.study) {
+      const std::optional<double> exact = earlier_study.contains("exact_pa_m")
+                                              ? std::optional(earlier_study["exact_pa_m"].get<double>())
+                                              : std::nullopt;
+      add_convergence_study(scene, bed, study_level_from_json(earlier_study["levels"][0], exact), earlier_study, dir,
+                            console, entry);
+      entry["convergence"]["cache_key"] = keys.study;
+    } else if (!study) {
+      remove_convergence_study(entry);
+    }
+    report.set_stage("case", std::move(entry));
   }
+  if (plan.case_.involved && !study) fs::remove_all(dir / "convergence");  // an earlier run's study
 #endif
   report.save(dir);
 }

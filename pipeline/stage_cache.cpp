@@ -32,7 +32,7 @@ std::string downstream_key(const nlohmann::json& scene, const std::string& upstr
 Wants run_wants(const Scene& scene) {
   return {scene.wants("positions"), scene.wants("vtp"),  scene.wants("analysis"),
           scene.wants("stl") || scene.case_params.snappy, scene.wants("mesh"), scene.wants("case"),
-          !scene.case_params.snappy_cells};
+          !scene.case_params.snappy_cells, scene.case_params.convergence.levels > 0};
 }
 
 Wants pack_wants(const Scene& scene) { return {true, scene.wants("vtp"), false, false, false, false}; }
@@ -46,7 +46,11 @@ StageKeys stage_keys(const Scene& scene) {
   k.analysis = downstream_key(sc, k.pack, {"analysis"});
   k.surface = downstream_key(sc, k.pack, {"contacts", "surface"});
   k.mesh = downstream_key(sc, k.surface, {"mesh"});
-  k.case_ = downstream_key(sc, scene.case_params.snappy_cells ? k.surface : k.mesh, {"case"});
+  nlohmann::json without_study = sc;
+  if (without_study.contains("case")) without_study["case"].erase("convergence");
+  k.case_ = downstream_key(without_study, scene.case_params.snappy_cells ? k.surface : k.mesh, {"case"});
+  const nlohmann::json none = nlohmann::json::object();
+  k.study = stage_key({{"upstream", k.case_}, {"convergence", sc.value("case", none).value("convergence", none)}});
   return k;
 }
 
@@ -78,7 +82,9 @@ RunPlan plan_run(const Wants& w, const StageKeys& keys, const nlohmann::json& pr
   // Backwards from the case: what is missing is built, and what a built stage needs in memory
   // is read back where its files allow it, else built too.
   p.case_.involved = w.case_;
-  p.case_.build = w.case_ && (case_.is_null() || !exists("case/Allrun"));
+  const bool case_has_study =
+      !case_.is_null() && !case_.value("convergence", nlohmann::json::object()).value("levels", nlohmann::json::array()).empty();
+  p.case_.build = w.case_ && (case_.is_null() || !exists("case/Allrun") || (w.study && !case_has_study));
   const bool mesh_on_disk = !mesh.is_null() && exists("fluid.msh");
   const bool case_needs_mesh = p.case_.build && w.case_on_mesh;
   p.mesh.involved = w.mesh || (w.case_ && w.case_on_mesh);
@@ -88,8 +94,8 @@ RunPlan plan_run(const Wants& w, const StageKeys& keys, const nlohmann::json& pr
   p.surface.build = p.mesh.build || (w.stl && (surface.is_null() || !all_exist(surface_files)));
   p.analysis.involved = w.analysis;
   p.analysis.build = w.analysis && (analysis.is_null() || analysis_files.empty() || !all_exist(analysis_files));
-  const bool bed_needed = p.analysis.build || p.surface.build || p.case_.build || (w.positions && !exists("bed.csv")) ||
-                          (w.vtp && !exists("bed.vtp"));
+  const bool bed_needed = p.analysis.build || p.surface.build || p.case_.build || (w.case_ && w.study) ||
+                          (w.positions && !exists("bed.csv")) || (w.vtp && !exists("bed.vtp"));
   p.pack.involved = true;
   p.pack.build = pack.is_null() || (bed_needed && !exists("bed.csv"));
   p.load_bed = bed_needed && !p.pack.build;

@@ -16,6 +16,7 @@ struct Wants {
   bool mesh = false;       // fluid.msh
   bool case_ = false;      // the OpenFOAM case in case/
   bool case_on_mesh = true;  // the case solves on the mesh stage's cells (not on snappyHexMesh's)
+  bool study = false;        // a convergence study follows the case ([case.convergence] levels)
 };
 // `bedforge run`: the scene's [outputs]. `bedforge pack` and `import`: the bed only.
 Wants run_wants(const Scene& scene);
@@ -24,9 +25,11 @@ Wants pack_wants(const Scene& scene);
 // Each stage's cache key (see stage_key): a hash of its own scene sections and of the key of
 // the stage it builds on, so a change upstream reaches every later stage. The pack key covers
 // [container], [particles], [packing], the bedforge version and an imported file's content; the
-// case's builds on the mesh's, or on the surface's when snappyHexMesh makes its cells.
+// case's builds on the mesh's, or on the surface's when snappyHexMesh makes its cells, and leaves
+// out [case.convergence]: the study keys its levels itself (convergence_study.hpp), so a changed
+// study keeps the solved case. The study's key is the case's with [case.convergence].
 struct StageKeys {
-  std::string pack, analysis, surface, mesh, case_;
+  std::string pack, analysis, surface, mesh, case_, study;
 };
 StageKeys stage_keys(const Scene& scene);
 
@@ -41,7 +44,8 @@ struct StagePlan {
 // backwards: a stage whose key matches and whose files are there is reused, and what it was made
 // from is built only when another stage needs it in memory. A mesh is made from the surface in
 // memory, never from its STL read back, so building a mesh builds its surface. A case on
-// snappyHexMesh's cells needs no mesh, only the surface's files.
+// snappyHexMesh's cells needs no mesh, only the surface's files. A case reused for a study must
+// carry one (its finest level) and needs the bed, for the levels it may have to build.
 struct RunPlan {
   StagePlan pack, analysis, surface, mesh, case_;
   bool load_bed = false;       // read the reused bed from bed.csv: a stage built after it needs it

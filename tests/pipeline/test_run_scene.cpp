@@ -2,6 +2,7 @@
 // section and files deleted by hand make it do.
 #include "pipeline/run_scene.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -219,6 +220,56 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   const RunOutcome again = run(scene, dir);
   EXPECT_FALSE(again.built("case"));
   EXPECT_EQ(again.stages["case"]["convergence"], study);
+}
+
+// A study changed after it ran solves only what changed: the case (its finest level) stays, a
+// level added is the only one solved, fewer levels or none drop what is left over, and another
+// ratio solves the coarser levels again.
+TEST(RunScene, AChangedStudySolvesOnlyTheLevelsThatChanged) {
+  const fs::path dir = test_support::fresh_dir("study_reuse");
+  auto study_scene = [](int levels, double ratio) {
+    return small_scene("\"case\"",
+                       fmt::format("[case]\nrun = true\n[case.convergence]\nlevels = {}\nratio = {}\n", levels, ratio),
+                       "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n");
+  };
+  const RunOutcome three = run(study_scene(3, 1.3), dir);
+  const nlohmann::json& first = three.stages["case"]["convergence"];
+  ASSERT_EQ(first["levels"].size(), 3u) << first.dump();
+  const auto level_3_written = written(dir / "convergence/level_3/constant/polyMesh/owner");
+
+  const RunOutcome four = run(study_scene(4, 1.3), dir);
+  EXPECT_FALSE(four.built("case")) << four.printed;
+  const nlohmann::json& more = four.stages["case"]["convergence"];
+  ASSERT_EQ(more["levels"].size(), 4u) << more.dump();
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_TRUE(more["levels"][k].value("reused", false)) << four.printed;
+    EXPECT_EQ(more["levels"][k]["pressure_gradient_bed_pa_m"], first["levels"][k]["pressure_gradient_bed_pa_m"]);
+  }
+  EXPECT_FALSE(more["levels"][3].value("reused", false)) << four.printed;
+  EXPECT_NE(four.printed.find("level 4 of 4, cells of"), std::string::npos) << four.printed;
+  EXPECT_EQ(written(dir / "convergence/level_3/constant/polyMesh/owner"), level_3_written);
+  EXPECT_TRUE(more.contains("least_squares"));  // four levels: the fit over all of them
+
+  const RunOutcome back = run(study_scene(3, 1.3), dir);
+  EXPECT_EQ(back.printed.find("cells of"), std::string::npos) << back.printed;  // nothing solved
+  EXPECT_EQ(back.stages["case"]["convergence"]["conclusion"], first["conclusion"]);
+  EXPECT_EQ(back.stages["case"]["summary"], three.stages["case"]["summary"]);
+  EXPECT_FALSE(fs::exists(dir / "convergence/level_4"));
+
+  const RunOutcome none = run(study_scene(0, 1.3), dir);
+  EXPECT_FALSE(none.stages["case"].contains("convergence"));
+  const std::string summary = three.stages["case"]["summary"].get<std::string>();
+  EXPECT_EQ(none.stages["case"]["summary"], summary.substr(0, summary.find("; convergence: ")));
+  EXPECT_FALSE(fs::exists(dir / "convergence"));
+
+  // The case kept no study, so asking for one again solves the case with it; then another ratio
+  // keeps that case and solves the coarser levels anew.
+  const RunOutcome again = run(study_scene(3, 1.3), dir, true);
+  EXPECT_TRUE(again.built("case")) << again.printed;
+  const RunOutcome wider = run(study_scene(3, 1.4), dir);
+  EXPECT_FALSE(wider.built("case")) << wider.printed;
+  for (int k = 1; k < 3; ++k) EXPECT_FALSE(wider.stages["case"]["convergence"]["levels"][k].value("reused", false));
+  EXPECT_NE(wider.printed.find("level 3 of 3, cells of"), std::string::npos) << wider.printed;
 }
 
 // A study whose levels all fail (here the solver is stopped after 2 iterations) says so, level by
