@@ -53,10 +53,10 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 namespace {
 
 constexpr double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
-// simpleFoam's processes on the polyhedral dual held 897 and 1038 bytes per tetrahedron together
-// (2 processes; 5.95 M and 2.73 M tetrahedra, 2026-11-28, docs/findings.md), as much as the mesh
-// stage or more.
-constexpr double kSolverBytesPerCell = 850.0;
+// simpleFoam's two processes held together 897 and 1038 bytes per tetrahedron on the polyhedral
+// dual, 1300 and 1431 on the tetrahedra themselves (5.95 M and 2.73 M tetrahedra, 2026-11-28,
+// docs/findings.md): as much as the mesh stage or more.
+constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 1200.0;
 
 // The cell edge away from the surfaces (m), d the reference diameter.
 double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.edge_length_d, scene.mesh.max_size_d) * d; }
@@ -64,13 +64,14 @@ double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.e
 MeshEstimate with_cells(const Scene& scene, double fluid_volume_m3, double gap_cells, double d) {
   const double mesh_bytes = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
   const cases::CaseParams& c = scene.case_params;
-  const bool solver = c.run && c.polyhedra && !c.snappy_cells;
+  const bool solver = c.run && !c.snappy_cells;
   const double h = bulk_edge(scene, d);
   MeshEstimate e;
   e.fluid_volume_m3 = fluid_volume_m3;
   e.gap_cells = gap_cells;
   e.cells = fluid_volume_m3 / (kVolumePerCell * h * h * h) + gap_cells;
-  e.peak_bytes = e.cells * (solver ? kSolverBytesPerCell : mesh_bytes);
+  const double solver_bytes = c.polyhedra ? kSolverBytesPerCellDual : kSolverBytesPerCellTetrahedra;
+  e.peak_bytes = e.cells * (solver ? solver_bytes : mesh_bytes);
   e.peak_in_solver = solver;
   return e;
 }

@@ -46,15 +46,16 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
 //                 be meshed in slabs (shrink or none, no prism layers, mesh.slabs not 1), from
 //                 the same bed in 4 slabs (2666-2816 MB for 8.92 M cells, 313-331 bytes per cell;
-//                 docs/findings.md, docs/mesh_case_benchmark.md); 850 when the case is run on
-//                 polyhedra, for simpleFoam's processes together (897 and 1038 per tetrahedron
-//                 at 5.95 M and 2.73 M tetrahedra, 2 processes; docs/findings.md).
+//                 docs/findings.md, docs/mesh_case_benchmark.md); when the case is run, for
+//                 simpleFoam's processes together, 850 on the polyhedral dual and 1200 on the
+//                 tetrahedra (897 and 1038, 1300 and 1431 per tetrahedron at 5.95 M and 2.73 M
+//                 tetrahedra, 2 processes; docs/findings.md).
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
   double gap_cells = 0.0;  // of `cells`, those the narrow gaps add
   double cells = 0.0;
   double peak_bytes = 0.0;
-  bool peak_in_solver = false;  // the peak is simpleFoam's (the case is run on polyhedra), not the mesh stage's
+  bool peak_in_solver = false;  // the peak is simpleFoam's (the case is run), not the mesh stage's
 };
 MeshEstimate estimate_mesh(const Scene& scene);
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);

@@ -451,17 +451,20 @@ TEST(RunScene, AMeshBeyondMemoryIsRefusedBeforePacking) {
   EXPECT_THROW(refuse_mesh_beyond_memory(small, 1e6), InputError);
 }
 
-// A case run on polyhedra peaks in simpleFoam, whose two processes held 897 and 1038 bytes per
-// tetrahedron together on the dual (2.73 M and 5.95 M tetrahedra, 2026-11-28; docs/findings.md),
-// about twice the mesh stage's 460: a memory that fits the mesh alone is refused for the run,
-// naming the way out.
-TEST(RunScene, ACaseRunOnPolyhedraIsRefusedWhenTheSolverWouldNotFit) {
+// A case that is run peaks in simpleFoam, whose two processes held together 897 and 1038 bytes
+// per tetrahedron on the dual and 1300 and 1431 on the tetrahedra (5.95 M and 2.73 M
+// tetrahedra, 2026-11-28; docs/findings.md), above the mesh stage's 460: a memory that fits the
+// mesh alone is refused for the run, naming the way out, and the tetrahedra need more.
+TEST(RunScene, ACaseThatIsRunIsRefusedWhenTheSolverWouldNotFit) {
   const Scene written = small_scene("\"case\"", "[case]\nrun = false\n");
   const Scene run = small_scene("\"case\"", "[case]\nrun = true\n");
-  const MeshEstimate w = estimate_mesh(written), r = estimate_mesh(run);
+  const Scene run_tetrahedra = small_scene("\"case\"", "[case]\nrun = true\ncells = \"tetrahedra\"\n");
+  const MeshEstimate w = estimate_mesh(written), r = estimate_mesh(run), t = estimate_mesh(run_tetrahedra);
   EXPECT_EQ(w.cells, r.cells);
   EXPECT_FALSE(w.peak_in_solver);
   EXPECT_TRUE(r.peak_in_solver);
+  EXPECT_TRUE(t.peak_in_solver);
+  EXPECT_GT(t.peak_bytes, r.peak_bytes);
   const double available = 0.5 * (w.peak_bytes + r.peak_bytes);
   EXPECT_NO_THROW(refuse_mesh_beyond_memory(written, available));
   try {
