@@ -45,7 +45,8 @@ struct StagePlan {
 // from is built only when another stage needs it in memory. A mesh is made from the surface in
 // memory, never from its STL read back, so building a mesh builds its surface. A case on
 // snappyHexMesh's cells needs no mesh, only the surface's files. A case reused for a study must
-// carry one (its finest level) and needs the bed, for the levels it may have to build.
+// carry one (its finest level) and, when the study changed, needs the bed for the levels it may
+// have to build.
 struct RunPlan {
   StagePlan pack, analysis, surface, mesh, case_;
   bool load_bed = false;       // read the reused bed from bed.csv: a stage built after it needs it

@@ -255,6 +255,10 @@ TEST(RunScene, AChangedStudySolvesOnlyTheLevelsThatChanged) {
   EXPECT_EQ(back.stages["case"]["convergence"]["conclusion"], first["conclusion"]);
   EXPECT_EQ(back.stages["case"]["summary"], three.stages["case"]["summary"]);
   EXPECT_FALSE(fs::exists(dir / "convergence/level_4"));
+  // Unchanged, the study is reused with its case, and the bed (no bed.csv here) is not packed again.
+  const RunOutcome same = run(study_scene(3, 1.3), dir);
+  EXPECT_FALSE(same.built("pack")) << same.printed;
+  EXPECT_EQ(same.stages["case"]["convergence"], back.stages["case"]["convergence"]);
 
   const RunOutcome none = run(study_scene(0, 1.3), dir);
   EXPECT_FALSE(none.stages["case"].contains("convergence"));
