@@ -391,7 +391,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
     if (mesh && p.polyhedra && !p.snappy_cells) {
-      const meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, kDualFeatureAngleDeg);
+      const meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, geometry->centres, kDualFeatureAngleDeg);
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
     } else if (mesh) {

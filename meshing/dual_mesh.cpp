@@ -56,7 +56,7 @@ std::string where(const Eigen::Vector3d& x) { return fmt::format("({:.6g}, {:.6g
 
 }  // namespace
 
-PolyhedralMesh dual_mesh(const PolyMesh& m, double feature_angle_deg) {
+PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& cell_centres, double feature_angle_deg) {
   const int n_points = static_cast<int>(m.points.size());
   const int n_cells = m.cells;
   const int n_faces = static_cast<int>(m.faces.size());
@@ -140,7 +140,7 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, double feature_angle_deg) {
   // The dual's points: cell centres, boundary face centres, then feature points and edge
   // midpoints as they are first needed.
   PolyhedralMesh d;
-  d.points = cell_geometry(m).centres;
+  d.points = cell_centres;
   for (const FaceGeometry& b : boundary) d.points.push_back(b.centre);
   const int first_boundary_centre = n_cells - n_internal;  // + boundary face index
   std::vector<int> point_at(n_points, -1);
@@ -165,12 +165,26 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, double feature_angle_deg) {
     return std::runtime_error(fmt::format("dual mesh: the cells around the edge from {} to {} do not form a ring",
                                           where(m.points[p]), where(m.points[q])));
   };
+  // Appends to `polygon` the centres of the cells met walking about p -> q from cell c, until the
+  // walk leaves through a boundary face (returned) or comes back to c (-1); no more cells than
+  // touch p.
+  std::vector<int> polygon;
+  auto walk = [&](int c, int p, int q) {
+    const int first = c, limit = static_cast<int>(point_cells[p].size());
+    for (int steps = 1;; ++steps) {
+      polygon.push_back(c);
+      const int f = exit_face(c, p, q);
+      if (f < 0 || steps > limit) throw no_ring(p, q);
+      if (f >= n_internal) return f;
+      c = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
+      if (c == first) return -1;
+    }
+  };
 
   // Internal faces, one per edge (p, q), owned by the lower rank: by owner, then neighbour.
-  std::vector<int> ends, polygon;
+  std::vector<int> ends;
   for (int i = 0; i < n_points; ++i) {
     const int p = order[i];
-    const int limit = static_cast<int>(point_cells[p].size()) + 2;
     ends.clear();
     for (int c : point_cells[p])
       for (int f : cell_faces[c]) {
@@ -189,17 +203,9 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, double feature_angle_deg) {
         if (!runs(m.faces[start], q, p)) continue;
         on_boundary = true;
         polygon.assign(1, first_boundary_centre + start);
-        int c = m.owner[start], steps = 0;
-        while (true) {
-          polygon.push_back(c);
-          const int f = exit_face(c, p, q);
-          if (f < 0 || ++steps > limit) throw no_ring(p, q);
-          if (f >= n_internal) {
-            polygon.push_back(first_boundary_centre + f);
-            break;
-          }
-          c = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
-        }
+        const int end = walk(m.owner[start], p, q);
+        if (end < 0) throw no_ring(p, q);
+        polygon.push_back(first_boundary_centre + end);
         if (feature[p] || feature[q]) polygon.push_back(midpoint(p, q));
         d.faces.push_back(polygon);
         d.owner.push_back(i);
@@ -214,13 +220,7 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, double feature_angle_deg) {
         }
       if (first < 0) throw no_ring(p, q);
       polygon.clear();
-      int c = first, steps = 0;
-      do {
-        polygon.push_back(c);
-        const int f = exit_face(c, p, q);
-        if (f < 0 || f >= n_internal || ++steps > limit) throw no_ring(p, q);
-        c = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
-      } while (c != first);
+      if (walk(first, p, q) >= 0) throw no_ring(p, q);
       d.faces.push_back(polygon);
       d.owner.push_back(i);
       d.neighbour.push_back(rank[q]);

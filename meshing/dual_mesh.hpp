@@ -7,6 +7,8 @@ namespace bedforge::meshing {
 // (meshDualiser with its simple feature marking), so that a case can be written on the dual
 // without running polyDualMesh, whose peak was about 1 kB per tetrahedron.
 //   mesh                  tetrahedra (pyramids, prisms too), m; points all used
+//   cell_centres          C x 3, m: its cells' centres as OpenFOAM computes them
+//                         (cell_geometry(mesh).centres, which the caller has already)
 //   feature_angle_deg     a boundary edge between faces whose normals differ by more than this,
 //                         or between two patches, is a feature edge: its ends stay points of the
 //                         dual, and its midpoint too
@@ -20,6 +22,7 @@ namespace bedforge::meshing {
 // Internal faces come in upper-triangular order, boundary faces patch by patch as in `mesh`.
 // std::runtime_error, with the location, when an edge's cells do not form a ring (a mesh
 // that is not a manifold there).
-PolyhedralMesh dual_mesh(const PolyMesh& mesh, double feature_angle_deg);
+PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d>& cell_centres,
+                         double feature_angle_deg);
 
 }  // namespace bedforge::meshing

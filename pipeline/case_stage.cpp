@@ -26,7 +26,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
   if (!mesh) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
   std::string line = !mesh ? fmt::format("case: snappyHexMesh's set-up in {}", case_dir.string())
-                     : out.info.cells != mesh->cells
+                     : p.polyhedra
                          ? fmt::format("case: {} polyhedra (the dual of {} cells) in {}", out.info.cells, mesh->cells,
                                        case_dir.string())
                          : fmt::format("case: {} cells in {}", mesh->cells, case_dir.string());

@@ -170,7 +170,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));
     // A changed study is redone from the case's finest level, solving only the levels that changed.
     nlohmann::json entry = plan.case_.reused;
-    if (study && earlier_study.value("cache_key", "") != keys.study) {
+    if (plan.redo_study) {
       const std::optional<double> exact = earlier_study.contains("exact_pa_m")
                                               ? std::optional(earlier_study["exact_pa_m"].get<double>())
                                               : std::nullopt;

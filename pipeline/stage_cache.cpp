@@ -94,9 +94,8 @@ RunPlan plan_run(const Wants& w, const StageKeys& keys, const nlohmann::json& pr
   p.surface.build = p.mesh.build || (w.stl && (surface.is_null() || !all_exist(surface_files)));
   p.analysis.involved = w.analysis;
   p.analysis.build = w.analysis && (analysis.is_null() || analysis_files.empty() || !all_exist(analysis_files));
-  const bool study_changed =
-      w.study && case_has_study && case_["convergence"].value("cache_key", "") != keys.study;
-  const bool bed_needed = p.analysis.build || p.surface.build || p.case_.build || (w.case_ && study_changed) ||
+  p.redo_study = w.case_ && !p.case_.build && w.study && case_["convergence"].value("cache_key", "") != keys.study;
+  const bool bed_needed = p.analysis.build || p.surface.build || p.case_.build || p.redo_study ||
                           (w.positions && !exists("bed.csv")) || (w.vtp && !exists("bed.vtp"));
   p.pack.involved = true;
   p.pack.build = pack.is_null() || (bed_needed && !exists("bed.csv"));

@@ -53,6 +53,7 @@ struct RunPlan {
   bool load_mesh = false;      // read the reused mesh from fluid.msh: the case is rebuilt on it
   bool write_bed_csv = false;  // bed.csv is wanted and new or missing
   bool write_bed_vtp = false;
+  bool redo_study = false;     // the case is reused but its study changed: redone from its finest level
 };
 // `previous`: the earlier report.json (null for none, or to redo everything); `exists(name)`:
 // whether the directory holds that file.

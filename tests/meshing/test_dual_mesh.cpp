@@ -64,7 +64,7 @@ PolyMesh shaken_prisms(int n) {
 // Closed cells of positive volume that fill the n^3 box, one per point of `m`, in OpenFOAM's
 // face order, with patches on the box's sides.
 void expect_dual_fills_box(const PolyMesh& m, int n) {
-  const PolyhedralMesh d = dual_mesh(m, 80.0);
+  const PolyhedralMesh d = dual_mesh(m, cell_centres(m), 80.0);
   ASSERT_EQ(d.cells, static_cast<int>(m.points.size()));
   // Closed cells: the outward area vectors of each cell's faces sum to zero.
   std::vector<Eigen::Vector3d> closure(d.cells, Eigen::Vector3d::Zero());
@@ -88,9 +88,10 @@ void expect_dual_fills_box(const PolyMesh& m, int n) {
   // neighbour's.
   for (int f = 0; f < d.internal_faces(); ++f) {
     EXPECT_LT(d.owner[f], d.neighbour[f]);
-    if (f > 0)
+    if (f > 0) {
       EXPECT_TRUE(d.owner[f - 1] < d.owner[f] || (d.owner[f - 1] == d.owner[f] && d.neighbour[f - 1] <= d.neighbour[f]))
           << "face " << f;
+    }
     EXPECT_GT(face_geometry(d.points, d.faces[f]).area.dot(cg.centres[d.neighbour[f]] - cg.centres[d.owner[f]]), 0.0)
         << "face " << f;
   }
@@ -100,7 +101,9 @@ void expect_dual_fills_box(const PolyMesh& m, int n) {
   for (int p = 0; p < 6; ++p) {
     const auto& patch = d.patches[p];
     EXPECT_EQ(patch.name, kNames[p]);
-    if (p > 0) EXPECT_EQ(patch.start, d.patches[p - 1].start + d.patches[p - 1].size);
+    if (p > 0) {
+      EXPECT_EQ(patch.start, d.patches[p - 1].start + d.patches[p - 1].size);
+    }
     const int axis = p / 2;
     const double side = p % 2 ? n : 0.0, outward = p % 2 ? 1.0 : -1.0;
     double covered = 0.0;
@@ -158,7 +161,7 @@ void expect_polydualmesh_agrees(const PolyMesh& m) {
   write_case(theirs);
   write_case(ours);
   cases::write_poly_mesh(theirs / "constant/polyMesh", m, true, "test");
-  cases::write_poly_mesh(ours / "constant/polyMesh", dual_mesh(m, 80.0), true, "test");
+  cases::write_poly_mesh(ours / "constant/polyMesh", dual_mesh(m, cell_centres(m), 80.0), true, "test");
   const cli_test::Result r = cli_test::shell("cd " + theirs.string() +
                                              " && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} "
                                              "polyDualMesh -overwrite 80");

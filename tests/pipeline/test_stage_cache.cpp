@@ -11,7 +11,7 @@ using namespace bedforge::pipeline;
 
 namespace {
 
-const StageKeys kKeys{"pack-key", "analysis-key", "surface-key", "mesh-key", "case-key"};
+const StageKeys kKeys{"pack-key", "analysis-key", "surface-key", "mesh-key", "case-key", "study-key"};
 
 // The report a complete earlier run with these keys leaves.
 nlohmann::json complete_report(const StageKeys& k = kKeys) {
@@ -151,7 +151,7 @@ TEST(StageCache, FilesDeletedByHandAreMadeAgainAndNothingElse) {
 }
 
 TEST(StageCache, AChangedBedRebuildsEverythingAndForceIsNoEarlierRun) {
-  StageKeys other{"new-pack", "new-analysis", "new-surface", "new-mesh", "new-case"};
+  StageKeys other{"new-pack", "new-analysis", "new-surface", "new-mesh", "new-case", "new-study"};
   const RunPlan p = plan_run(kDefault, other, complete_report(), kEverything);
   EXPECT_EQ(built(p), 5);
   EXPECT_TRUE(p.write_bed_csv && p.write_bed_vtp);
