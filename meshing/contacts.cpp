@@ -343,10 +343,10 @@ class ContactTreatment {
   // circle of radius rho (given, so a bridge's loop is exactly its tube's) about `at` (default
   // c + h a), its rings jittered by `jitter` (SphereCut); returns the loop's frame.
   Frame plane_cut(std::size_t i, const Eigen::Vector3d& a, double h, double rho, int n, double jitter,
-                  const std::string& name, std::optional<Eigen::Vector3d> at = std::nullopt) {
+                  const std::string& name, std::optional<Eigen::Vector3d> at = std::nullopt, double turn = 0.0) {
     const Eigen::Vector3d& c = bed_.centres[i];
     const double r = out_.radius[i];
-    const Frame f = Frame::along(at.value_or(c + h * a), a);
+    const Frame f = Frame::along(at.value_or(c + h * a), a).turned(turn);
     SphereCut cut;
     // A clip plane's loop (`at` given) runs counterclockwise seen from above whichever side is
     // removed: the slabs on either side of a plane (meshing/slab_mesh.hpp) share it bit for bit.
@@ -381,9 +381,14 @@ class ContactTreatment {
       const double g = p_.cap_gap_d * d_, mid = 0.5 * (dist + ri - rj), cut_i = mid - 0.5 * g, cut_j = dist - mid - 0.5 * g;
       if (cut_i <= 0.1 * ri || cut_j <= 0.1 * rj)
         throw InputError(fmt::format("{} overlap too deeply to be capped (centre distance {:.3g} d)", who, dist / d_));
-      for (auto [k, h, axis] : {std::tuple{i, cut_i, a}, std::tuple{j, cut_j, Eigen::Vector3d(-a)}}) {
+      // The two disks face each other across a gap thinner than their edges: the same layout on
+      // both would put four points in a plane across it again and again, and gmsh's tetrahedra
+      // on them have no volume; the second disk is turned by half a rim step.
+      for (auto [k, h, axis, steps] : {std::tuple{i, cut_i, a, 0.0}, std::tuple{j, cut_j, Eigen::Vector3d(-a), 0.5}}) {
         const double r = out_.radius[k], rho = std::sqrt(r * r - h * h);
-        const Frame f = plane_cut(k, axis, h, rho, ring_points(rho, edge_c_), 0.0, fmt::format("cap towards sphere {}", k == i ? j : i));
+        const int n = ring_points(rho, edge_c_);
+        const Frame f = plane_cut(k, axis, h, rho, n, 0.0, fmt::format("cap towards sphere {}", k == i ? j : i),
+                                  std::nullopt, steps * 2.0 * kPi / n);
         out_.parts.push_back(ring_mesh(f, 0.0, rho, edge_c_, 0.0, true, "particles"));
         area_ += kPi * rho * rho;
       }

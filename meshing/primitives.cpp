@@ -194,6 +194,13 @@ Frame Frame::along(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis) {
   return f;
 }
 
+Frame Frame::turned(double angle) const {
+  Frame f = *this;
+  f.u = std::cos(angle) * u + std::sin(angle) * v;
+  f.v = w.cross(f.u);
+  return f;
+}
+
 Eigen::Vector3d on_circle(double R, int j, int n, bool stagger, double z) {
   const double theta = (j + (stagger ? 0.5 : 0.0)) * (2.0 * std::numbers::pi / n);
   return {R * std::cos(theta), R * std::sin(theta), z};

@@ -22,6 +22,7 @@ struct Frame {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero(), u = Eigen::Vector3d::UnitX(), v = Eigen::Vector3d::UnitY(),
                   w = Eigen::Vector3d::UnitZ();
   static Frame along(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis);
+  Frame turned(double angle) const;  // turned by `angle` (rad) about w
   Eigen::Vector3d to_world(const Eigen::Vector3d& local) const { return origin + local.x() * u + local.y() * v + local.z() * w; }
 };
 
@@ -48,7 +49,8 @@ std::vector<Eigen::Vector3d> circle_loop(const Frame& f, double rho, int n);
 // (seeded, the same every run) by up to kBreakCocircular / 2 of its spacing in each direction
 // leaves one Delaunay triangulation, which the surface and gmsh both find. Caps keep their
 // rings regular (jitter 0): a cap faces another across a thin gap, and two layouts moved
-// independently leave slivers between them.
+// independently leave slivers between them (the second of two facing caps is turned by half a
+// rim step instead: the same layout on both sets four points in a plane across the gap).
 constexpr double kBreakCocircular = 2e-3;
 
 struct SphereCut {
