@@ -38,6 +38,13 @@ FluidSurface coarse_surface(const Bed& b) {
   return build_fluid_surface(b, p);
 }
 
+// Every contact of `b`, walls included, treated by `t`; the default surface settings.
+FluidSurface treated_surface(const Bed& b, SurfaceParams::Treatment t) {
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = t;
+  return build_fluid_surface(b, p);
+}
+
 fs::path scratch(const std::string& name) {
   return test_support::fresh_dir(name, true);
 }
@@ -137,9 +144,7 @@ TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
 TEST(VolumeMesh, AnEnlargedBedPassesTheGateWithHxtsOwnOptimiser) {
   Progress quiet("mesh", false);
   const Bed b = test_support::packed_bed(80, 4.0, 1);
-  SurfaceParams sp;
-  sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::enlarge;
-  const FluidSurface s = build_fluid_surface(b, sp);
+  const FluidSurface s = treated_surface(b, SurfaceParams::Treatment::enlarge);
   const fs::path dir = scratch("enlarge");
   VolumeMeshParams p;
   p.fallback = false;  // HXT alone: the retry with its own optimiser is part of `optimize`
@@ -162,9 +167,7 @@ TEST(VolumeMesh, AnEnlargedBedPassesTheGateWithHxtsOwnOptimiser) {
 TEST(VolumeMesh, ACappedBedPassesTheGateAtTheFirstAttempt) {
   Progress quiet("mesh", false);
   const Bed b = test_support::packed_bed(80, 4.0, 1);
-  SurfaceParams sp;
-  sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::cap;
-  const FluidSurface s = build_fluid_surface(b, sp);
+  const FluidSurface s = treated_surface(b, SurfaceParams::Treatment::cap);
   VolumeMeshParams p;
   p.fallback = false;
   p.threads = 1;  // HXT on one thread: the same tetrahedra every run
