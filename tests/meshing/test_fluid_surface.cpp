@@ -444,9 +444,8 @@ TEST(FluidSurface, GmshHasNoFaceToRecoverUnderShrinkAndBridge) {
 
 // Two cap disks face each other across cap_gap_d, less than their edge. Laid out alike, each
 // edge of one and its copy on the other make a flat quadrilateral, and gmsh's tetrahedra on
-// such four points have no volume: 3 cells of some 6.3 M failed the gate on the a = 5, N = 500
-// bed (cap, 0.15 d, 4 per gap), and every attempt on a study's next level once. The second disk is
-// turned by half a rim step, which moves the points of its ring of radius r by
+// such four points have no volume (docs/findings.md, session 34). The second disk is turned by
+// half a rim step, which moves the points of its ring of radius r by
 // 2 r sin(pi / 2n) from their copies (n points on the rim): 0.0041 d, 0.12 of the edge, for the
 // innermost ring here (r = 0.025 d, n = 19); laid out alike they coincide (4e-12 d).
 TEST(FluidSurface, FacingCapDisksDoNotRepeatEachOthersLayout) {

@@ -160,17 +160,16 @@ TEST(VolumeMesh, AnEnlargedBedPassesTheGateWithHxtsOwnOptimiser) {
   EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
 }
 
-// Facing cap disks laid out alike put four surface points in a plane across every cap's gap;
-// HXT's first mesh of this bed was then invalid, its own optimiser left a sliver, and only the
-// Delaunay fallback passed (24 s against 3.5 s, 2026-11-28). With the second disk turned by half
-// a rim step the first attempt passes.
+// Facing cap disks laid out alike put four surface points in a plane across every cap's gap,
+// and HXT's first mesh of this bed then failed the gate (docs/findings.md, session 34). With the
+// second disk turned by half a rim step the first attempt passes.
 TEST(VolumeMesh, ACappedBedPassesTheGateAtTheFirstAttempt) {
   Progress quiet("mesh", false);
   const Bed b = test_support::packed_bed(80, 4.0, 1);
   const FluidSurface s = treated_surface(b, SurfaceParams::Treatment::cap);
   VolumeMeshParams p;
   p.fallback = false;
-  p.threads = 1;  // HXT on one thread: the same tetrahedra every run
+  p.threads = 1;  // as the check without the turn ran it (2 attempts there)
   const VolumeMesh vm = build_volume_mesh(s.fluid, b, 1.0, p, {}, {}, quiet);
   EXPECT_TRUE(vm.quality.bad_cells(p.gate, 1.0).empty());
   EXPECT_EQ(vm.report["attempts"].size(), 1u) << vm.report["attempts"].dump();
