@@ -7,11 +7,15 @@ namespace bedforge::analysis {
 //   f_p = (dp/L) (d / (rho u^2)) eps^3 / (1 - eps) = F(Re_m),   Re_m = Re_p / (1 - eps),
 // with u the superficial velocity and Re_p = rho u d / mu.
 
+// Eisfeld & Schnitzlein's stated accuracy, relative: particle-resolved CFD studies commonly
+// compare within about +-20 % of it, and its own data scatter as much (docs/reference.md, grade C).
+inline constexpr double kEisfeldSchnitzleinAccuracy = 0.20;
+
 // Eisfeld & Schnitzlein (2001), Chem. Eng. Sci. 56:4321, spheres, with the wall correction:
 //   F = K1 A_w^2 / Re_m + A_w / B_w,  K1 = 154,  A_w = 1 + 2 / (3 a (1 - eps)),
 //   B_w = (k1 / a^2 + k2)^2,  k1 = 1.15,  k2 = 0.87,
 // for 0.01 <= Re_p <= 17635, 1.624 <= a <= 250, 0.33 <= eps <= 0.882; a = D/d (for an annulus
-// its hydraulic aspect ratio). Its own data scatter about +-20 % (correlations.md, grade C).
+// its hydraulic aspect ratio); accurate to kEisfeldSchnitzleinAccuracy.
 inline double eisfeld_schnitzlein_f(double reynolds_p, double eps, double aspect_ratio) {
   const double re_m = reynolds_p / (1.0 - eps);
   const double a_w = 1.0 + 2.0 / (3.0 * aspect_ratio * (1.0 - eps));

@@ -13,6 +13,9 @@ int main(int argc, char** argv) {
   } catch (const bedforge::ConvergenceError& e) {
     std::fprintf(stderr, "bedforge: did not converge: %s\n", e.what());
     return 3;
+  } catch (const bedforge::NotSolvedError& e) {
+    std::fprintf(stderr, "bedforge: not solved: %s\n", e.what());
+    return 4;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bedforge: internal error: %s\n", e.what());
     return 1;

@@ -16,6 +16,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "analysis/laminar_duct.hpp"
 #include "analysis/pressure_drop.hpp"
 #include "analysis/stokes_arrays.hpp"
@@ -52,7 +54,11 @@ CaseParams read_case_params(SceneSection& s) {
   p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
   p.run = s.boolean("run", p.run);
   SceneSection convergence = s.sub("convergence");
-  p.convergence.levels = static_cast<int>(convergence.integer("levels", 0, 0, 6));
+  // A solved case is studied by default: a pressure drop without its discretisation error is
+  // half an answer (docs/defaults.md).
+  const int study_levels = p.run && !p.snappy_cells ? kStudyLevels : 0;
+  p.convergence.levels = static_cast<int>(convergence.integer(
+      "levels", study_levels, 0, 6, fmt::format("{} when case.run = true on gmsh's cells, else 0", kStudyLevels)));
   p.convergence.ratio = convergence.number("ratio", p.convergence.ratio, Range::closed(1.1, 2.0));
   convergence.finish();
   if (p.convergence.levels == 1 || p.convergence.levels == 2)
@@ -283,7 +289,8 @@ std::string plane_region(const std::string& name, double z) {
 // Allrun: the cells (the gmsh mesh as written, its polyhedral dual, or snappyHexMesh's), then
 // simpleFoam, on N processes with -np N. snappyHexMesh's cells stay decomposed for the solver,
 // and its results with them: gathering them would take one process the whole mesh's memory.
-std::string allrun(const CaseParams& p) {
+// It ends by printing the bed's pressure gradient over `section`, as run_case reads it.
+std::string allrun(const CaseParams& p, const BedSection& section) {
   const bool flag = p.snappy && !p.snappy_cells;  // gmsh's cells, snappyHexMesh's on request
   std::string s = "#!/bin/sh\n";
   s += p.snappy_cells
@@ -355,6 +362,24 @@ std::string allrun(const CaseParams& p) {
        "else\n"
        "    run simpleFoam\n"
        "fi\n";
+  // The result: the kinematic pressure the solver averaged over each section plane at its last
+  // iteration, their difference times the density over the planes' distance.
+  s += fmt::format(
+      "# The bed's pressure gradient between the section planes z = {0:.12g} and {1:.12g} m, from the\n"
+      "# last rows of the pressure averaged over each plane (kinematic, times rho = {2:.12g} kg/m3).\n"
+      "bottom=postProcessing/pBedBottom/0/surfaceFieldValue.dat\n"
+      "top=postProcessing/pBedTop/0/surfaceFieldValue.dat\n"
+      "awk -v rho={2:.12g} -v zl={0:.12g} -v zh={1:.12g} -v b=\"$bottom\" -v t=\"$top\" '\n"
+      "    FNR == 1 {{ file++ }}\n"
+      "    /^#/ {{ next }}\n"
+      "    file == 1 {{ pb = $2; nb++ }}\n"
+      "    file == 2 {{ pt = $2; nt++ }}\n"
+      "    END {{\n"
+      "        if (!nb || !nt) {{ print \"no pressure on the section planes in \" b \" or \" t > \"/dev/stderr\"; exit 1 }}\n"
+      "        printf \"dp/L over the bed section (z = %.6g to %.6g m): %.6g Pa/m\\n\", zl, zh, rho * (pb - pt) / (zh - zl)\n"
+      "        print \"  from the last rows of \" b \" and \" t\n"
+      "    }}' \"$bottom\" \"$top\" || exit 1\n",
+      section.z_low, section.z_high, p.density_kg_m3);
   return s;
 }
 
@@ -481,7 +506,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                 "hierarchicalCoeffs\n{{\n    n               (1 1 {});\n    delta           0.001;\n"
                                 "    order           xyz;\n}}\n",
                                 p.processors, p.decomposition, p.processors)));
-    write_text(tmp / "Allrun", allrun(p), true);
+    write_text(tmp / "Allrun", allrun(p, section), true);
     write_text(tmp / "Allclean", kAllclean, true);
     write_text(tmp / "case.foam", "");  // for ParaView
     write_text(tmp / "bedforge/scene.toml", scene_toml);
@@ -732,6 +757,20 @@ std::string last_line(const fs::path& path) {
 }
 
 }  // namespace
+
+std::string missing_openfoam_program(int processors) {
+  std::vector<std::string> programs = {"simpleFoam", "checkMesh"};
+  if (processors > 1) programs.insert(programs.end(), {"decomposePar", "reconstructPar", "mpirun"});
+  const char* path = std::getenv("PATH");
+  for (const std::string& program : programs) {
+    bool found = false;
+    std::istringstream dirs(path ? path : "");
+    for (std::string d; !found && std::getline(dirs, d, ':');)
+      found = !d.empty() && ::access((fs::path(d) / program).c_str(), X_OK) == 0;
+    if (!found) return program;
+  }
+  return {};
+}
 
 FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -18,6 +18,8 @@ namespace bedforge::cases {
 // SIMPLE's target for U's initial residual when [case] residual_u is unset.
 inline constexpr double kResidualU = 1.0e-4;
 inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism layers
+// The meshes of a convergence study when the case is run and the scene names none.
+inline constexpr int kStudyLevels = 3;
 // Boundary edges sharper than this (deg; the inlet's and outlet's rims) stay edges of the dual.
 inline constexpr double kDualFeatureAngleDeg = 80.0;
 
@@ -58,7 +60,8 @@ struct CaseParams {
   // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
   // drop's discretisation error (Richardson extrapolation and the grid convergence index).
   struct Convergence {
-    int levels = 0;        // meshes in all, the scene's own the finest; 0: no study, else 3-6
+    int levels = 0;        // meshes in all, the scene's own the finest; 0: no study, else 3-6 (a scene's
+                           // default: kStudyLevels when the case is run on gmsh's cells)
     double ratio = 1.3;    // cell size ratio between successive levels (surface and volume together)
   } convergence;
 };
@@ -192,6 +195,11 @@ struct FlowResult {
   nlohmann::json history;                // per iteration: residuals and the bed's gradient against time
   nlohmann::json to_json() const;        // the case entry's "flow"
 };
+
+// The first of the OpenFOAM programs Allrun needs on `processors` processes (simpleFoam and
+// checkMesh; decomposePar, reconstructPar and mpirun on more than one) that is not on PATH;
+// empty when all are.
+std::string missing_openfoam_program(int processors);
 
 // Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
 // reads back the solver's convergence and the pressure drop, compared with Eisfeld &

@@ -16,4 +16,10 @@ struct ConvergenceError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The run wrote its OpenFOAM case but could not solve it, as OpenFOAM's programs are not
+// installed: everything before the case is written and kept; the program exits with status 4.
+struct NotSolvedError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace bedforge

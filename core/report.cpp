@@ -43,6 +43,10 @@ void Report::save(const std::filesystem::path& dir) const {
   if (data_.contains("stages"))
     for (const char* stage : {"pack", "analysis", "surface", "mesh", "case"})  // pipeline order
       if (data_["stages"].contains(stage)) text += data_["stages"][stage].value("summary", std::string()) + "\n";
+  // The run's answer, when its case was solved, last.
+  const nlohmann::json none = nlohmann::json::object(), &stages = data_.contains("stages") ? data_["stages"] : none;
+  for (const auto& line : stages.value("case", none).value("answer", none).value("lines", nlohmann::json::array()))
+    text += line.get<std::string>() + "\n";
   write_file_atomically(dir / "summary.txt", text);
 }
 

@@ -16,7 +16,8 @@ class Report {
   // `stage` must hold "summary" (one line) and "time_s".
   void set_stage(const std::string& name, nlohmann::json stage);
   const nlohmann::json& data() const { return data_; }
-  // Writes DIR/report.json and DIR/summary.txt (the version, the seed and each stage's line).
+  // Writes DIR/report.json and DIR/summary.txt (the version, the seed, each stage's line and the
+  // lines of the case's answer, stages.case.answer.lines, when it has one).
   void save(const std::filesystem::path& dir) const;
 
  private:

@@ -42,7 +42,7 @@ const char* treatment_name(SurfaceParams::Treatment t) { return kTreatments[stat
 
 SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   SurfaceParams p;
-  p.treatment = treatment_of(c.choice("treatment", "shrink", {"none", "shrink", "enlarge", "bridge", "cap"}));
+  p.treatment = treatment_of(c.choice("treatment", "bridge", {"none", "shrink", "enlarge", "bridge", "cap"}));
   const std::string wall = c.choice("wall_treatment", "same", {"same", "bridge", "cap", "none"});
   p.wall_treatment = wall == "same" ? p.treatment : treatment_of(wall);
   if (wall != "same" && (p.treatment == SurfaceParams::Treatment::shrink || p.treatment == SurfaceParams::Treatment::enlarge))
@@ -56,10 +56,10 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, true, true});
   p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
   p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
-  p.edge_length_d = s.number("edge_length_d", p.edge_length_d, Range{1e-3, 1.0, false, false});
-  p.contact_edge_length_d = s.number("contact_edge_length_d", p.contact_edge_length_d, Range{1e-3, 1.0, false, false});
+  p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
+  p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
-  p.cells_per_gap = s.number("cells_per_gap", p.cells_per_gap, Range::closed(0.0, 20.0));
+  p.cells_per_gap = s.number("cells_per_gap", kSceneCellsPerGap, Range::closed(0.0, 20.0));
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
   if (const std::vector<double> w = s.numbers("clip_window_d", Range::non_negative()); !w.empty()) {

@@ -282,7 +282,7 @@ void remove_convergence_study(nlohmann::json& case_entry) {
   case_entry.erase("convergence");
 }
 
-void add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
+ConvergenceStudy add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
                            const fs::path& dir, const Console& console, nlohmann::json& case_entry) {
   const ConvergenceStudy study = convergence_study(scene, bed, finest, dir / "convergence", console, earlier);
   remove_convergence_study(case_entry);
@@ -290,6 +290,7 @@ void add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel&
   const std::string line = "convergence: " + study.conclusion;
   case_entry["summary"] = case_entry["summary"].get<std::string>() + "; " + line;
   console.line(line);
+  return study;
 }
 
 }  // namespace bedforge::pipeline

@@ -97,8 +97,8 @@ StudyLevel finest_level(const CaseStage& solved, const Report& report, const std
 // Runs the study of [case.convergence] from `finest` into `dir`/convergence, reusing the levels
 // of `earlier` (an earlier run's study in `dir`, or null) that still hold, and puts it in the
 // case's report entry: its "convergence" and a summary that ends with the study's conclusion,
-// which is printed (an earlier study's conclusion there is replaced).
-void add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
+// which is printed (an earlier study's conclusion there is replaced). Returns the study.
+ConvergenceStudy add_convergence_study(const Scene& scene, const Bed& bed, const StudyLevel& finest, const nlohmann::json& earlier,
                            const std::filesystem::path& dir, const Console& console, nlohmann::json& case_entry);
 
 // The case's report entry without its study (its "convergence" and the summary's conclusion):

@@ -24,6 +24,7 @@
 #include "pipeline/case_stage.hpp"
 #include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
+#include "pipeline/pressure_drop_answer.hpp"
 #endif
 
 namespace bedforge::pipeline {
@@ -57,6 +58,20 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   if (plan.case_.build) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (plan.mesh.build) refuse_mesh_beyond_memory(scene, available_memory_bytes());
+  // Without OpenFOAM the case is written and not solved, said now and by the exit status.
+  const std::string missing = plan.case_.build && scene.case_params.run
+                                  ? cases::missing_openfoam_program(scene.case_params.processors)
+                                  : std::string();
+  Scene unsolved_scene;
+  if (!missing.empty()) {
+    console.line(fmt::format("case: OpenFOAM's {} is not on PATH: the case will be written but not solved (install "
+                             "OpenFOAM, e.g. apt-get install openfoam, then run {}/Allrun or this command again)",
+                             missing, (dir / "case").string()));
+    unsolved_scene = scene;
+    unsolved_scene.case_params.run = false;
+    unsolved_scene.case_params.convergence.levels = 0;
+  }
+  const Scene& case_scene = missing.empty() ? scene : unsolved_scene;
 #endif
 
   // Results of other stages in DIR may belong to another bed: the report starts afresh.
@@ -155,17 +170,30 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
                        earlier_study = previous.is_object()
                                            ? previous.value("stages", none).value("case", none).value("convergence", nlohmann::json())
                                            : nlohmann::json();
-  const bool study = scene.case_params.convergence.levels > 0;
+  const bool study = case_scene.case_params.convergence.levels > 0;
+  // The answer (the pressure drop with its band and reference) into the case's entry, drawn in
+  // pressure_drop.svg; none for a case not solved.
+  auto answer = [&](nlohmann::json& entry, const ConvergenceStudy* s) {
+    fs::remove(dir / "pressure_drop.svg");
+    entry.erase("answer");
+    if (const std::optional<PressureDropAnswer> a = pressure_drop_answer(scene, entry, s)) {
+      entry["answer"] = a->to_json();
+      write_file_atomically(dir / "pressure_drop.svg", answer_svg(*a));
+    }
+  };
   if (plan.case_.build) {
-    const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, scene.case_params, prov, read_file(dir / "scene.toml"),
-                                   scene.case_params.snappy ? dir / "fluid.stl" : fs::path(), dir / "case",
-                                   opt.overwrite, scene.surface.keeps_spheres(), console);
+    const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, case_scene.case_params, prov,
+                                   read_file(dir / "scene.toml"), scene.case_params.snappy ? dir / "fluid.stl" : fs::path(),
+                                   dir / "case", opt.overwrite, scene.surface.keeps_spheres(), console);
     nlohmann::json entry = c.report;
+    std::optional<ConvergenceStudy> s;
     if (study) {
-      add_convergence_study(scene, bed, finest_level(c, report, keys.case_), earlier_study, dir, console, entry);
+      s = add_convergence_study(scene, bed, finest_level(c, report, keys.case_), earlier_study, dir, console, entry);
       entry["convergence"]["cache_key"] = keys.study;
     }
-    record("case", std::move(entry), keys.case_);
+    answer(entry, s ? &*s : nullptr);
+    // An unsolved case must not pass for a solved one when OpenFOAM is there next time.
+    record("case", std::move(entry), missing.empty() ? keys.case_ : keys.case_ + "-not-solved");
   } else if (plan.case_.involved) {
     reuse("case", plan.case_, fmt::format("{} (mesh and [case] unchanged)", (dir / "case").string()));
     // A changed study is redone from the case's finest level, solving only the levels that changed.
@@ -174,17 +202,31 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
       const std::optional<double> exact = earlier_study.contains("exact_pa_m")
                                               ? std::optional(earlier_study["exact_pa_m"].get<double>())
                                               : std::nullopt;
-      add_convergence_study(scene, bed, study_level_from_json(earlier_study["levels"][0], exact), earlier_study, dir,
-                            console, entry);
+      const ConvergenceStudy s = add_convergence_study(scene, bed, study_level_from_json(earlier_study["levels"][0], exact),
+                                                       earlier_study, dir, console, entry);
       entry["convergence"]["cache_key"] = keys.study;
+      answer(entry, &s);
     } else if (!study) {
       remove_convergence_study(entry);
+      answer(entry, nullptr);
     }
     report.set_stage("case", std::move(entry));
   }
   if (plan.case_.involved && !study) fs::remove_all(dir / "convergence");  // an earlier run's study
 #endif
   report.save(dir);
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // The answer is the run's last word, whatever was reused.
+  const nlohmann::json& stages = report.data()["stages"];
+  if (stages.contains("case") && stages["case"].contains("answer")) {
+    for (const auto& line : stages["case"]["answer"]["lines"]) console.line(line.get<std::string>());
+    console.line(fmt::format("  picture: {}; every level: {} (stages.case.convergence)", (dir / "pressure_drop.svg").string(),
+                             (dir / "report.json").string()));
+  }
+  if (!missing.empty())
+    throw NotSolvedError(fmt::format("the case in {} was written but not solved: OpenFOAM's {} is not on PATH",
+                                     (dir / "case").string(), missing));
+#endif
 }
 
 }  // namespace bedforge::pipeline

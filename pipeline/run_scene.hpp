@@ -18,7 +18,11 @@ struct RunOptions {
 // DIR with the same key and its files is reused (plan_run), and says so on `console`; an
 // unchanged rerun builds nothing. The case is refused before any work when it must be made
 // again, DIR/case exists and `overwrite` is not set. Files are written only once every stage
-// before the case has succeeded, the case itself through a temporary directory.
+// before the case has succeeded, the case itself through a temporary directory. A solved case's
+// answer (pressure_drop_answer) is printed last, kept in report.json (stages.case.answer) and
+// summary.txt, and drawn in DIR/pressure_drop.svg. When the scene asks for the case to be run
+// and OpenFOAM is not installed, the run says so first, writes the case unsolved and then throws
+// NotSolvedError.
 void run_scene(const Scene& scene, const std::filesystem::path& dir, const RunOptions& options, const Console& console);
 
 }  // namespace bedforge::pipeline

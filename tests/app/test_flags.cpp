@@ -42,7 +42,7 @@ TEST(Flags, HelpStatesRangeKeyAndDefaultFromTheSceneReaders) {
   EXPECT_NE(pack.find("sets particles.count); default none (required)"), std::string::npos) << pack;
   const std::string surface = help_of(Command::surface);
   EXPECT_NE(surface.find("--clip-window-d FLOAT x 2"), std::string::npos) << surface;  // the window's pair
-  EXPECT_NE(surface.find("sets contacts.treatment); default shrink"), std::string::npos) << surface;
+  EXPECT_NE(surface.find("sets contacts.treatment); default bridge"), std::string::npos) << surface;
 }
 
 TEST(Flags, EachCommandOffersOnlyTheOptionsThatActOnIt) {

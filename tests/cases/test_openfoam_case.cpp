@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/cli.hpp"
@@ -43,20 +44,55 @@ fs::path run_scene_text(const std::string& name, const std::string& toml, Result
 
 }  // namespace
 
-TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
-  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+// The shipped default scene with its text changed: each `{from, to}` must occur in it once.
+std::string default_scene_with(const std::vector<std::pair<std::string, std::string>>& changes) {
+  std::string text = read(fs::path(BEDFORGE_SOURCE_DIR) / "scenes/default.toml");
+  for (const auto& [from, to] : changes) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << "scenes/default.toml has no '" << from << "'";
+    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "scenes/default.toml has '" << from << "' twice";
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+// The README's path, the default scene, on a small bed (a = 4, N = 40 instead of a = 5, N = 500;
+// every other setting as shipped): bed, surface, mesh, case and three solves end in the answer,
+// its band and the correlation, on the terminal, in summary.txt, report.json and the picture.
+// Then the bed solved once more on a mesh one ratio finer than the study's finest: a value the
+// study did not see, which its band must hold (the band is meant to hold the mesh-independent
+// value, which that finer mesh is nearer to, with about 95 % confidence).
+TEST(OpenFoamCase, TheDefaultScenesPathEndsInThePressureDropWithItsBand) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam) not on PATH";
   const fs::path out = fresh_dir("default");
-  const Result r = bedforge("run scenes/default.toml -o " + out.string());
+  const std::string small = " --aspect-ratio 4 --count 40";
+  const Result r = bedforge("run scenes/default.toml" + small + " -o " + out.string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("analysis: eps whole"), std::string::npos) << r.output;
   for (const char* f : {"case/Allrun", "case/Allclean", "case/constant/polyMesh/faces", "case/0/U", "case/0/p",
-                        "case/system/decomposeParDict", "case/bedforge/scene.toml", "case/bedforge/bed.csv"})
+                        "case/system/decomposeParDict", "case/bedforge/scene.toml", "case/bedforge/bed.csv",
+                        "pressure_drop.svg"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   const Result c = check_mesh(out / "case");
   EXPECT_NE(c.output.find("Mesh OK."), std::string::npos) << c.output;
-  // The mesh encloses what the surface enclosed: the same volume error against the exact volume.
   const auto report = nlohmann::json::parse(read(out / "report.json"));
   const auto& stages = report["stages"];
+  // The answer is the run's last word, and summary.txt's.
+  const auto& answer = stages["case"]["answer"];
+  ASSERT_TRUE(answer.contains("best_estimate_pa_m")) << answer.dump(1);
+  const std::string printed_answer = r.output.substr(r.output.rfind("answer: dp/L over the bed section"));
+  for (const auto& line : answer["lines"]) {
+    EXPECT_NE(printed_answer.find(line.get<std::string>()), std::string::npos) << line;
+    EXPECT_NE(read(out / "summary.txt").find(line.get<std::string>()), std::string::npos) << line;
+  }
+  for (const char* what : {"best estimate: ", "band: ", "Eisfeld & Schnitzlein (2001): ", "picture: "})
+    EXPECT_NE(printed_answer.find(what), std::string::npos) << what << " in\n" << printed_answer;
+  const double low = answer["band_pa_m"][0].get<double>(), high = answer["band_pa_m"][1].get<double>();
+  const double best = answer["best_estimate_pa_m"].get<double>();
+  EXPECT_LT(low, best);
+  EXPECT_LT(best, high);
+  EXPECT_EQ(answer["reference"]["pa_m"], stages["case"]["flow"]["eisfeld_schnitzlein_bed_pa_m"]);
+  // The mesh encloses what the surface enclosed: the same volume error against the exact volume.
   EXPECT_NEAR(stages["mesh"]["fluid_volume_relative_error"].get<double>(),
               stages["surface"]["fluid_volume_relative_error"].get<double>(), 1e-9);
   // Every stage reports its time and its own peak memory, in the report and in its summary line.
@@ -65,18 +101,31 @@ TEST(OpenFoamCase, TheDefaultSceneGivesACaseCheckMeshPasses) {
     EXPECT_GE(stages[stage]["time_s"].get<double>(), 0.0) << stage;
     EXPECT_NE(stages[stage]["summary"].get<std::string>().find(" MB"), std::string::npos) << stage;
   }
-  // The mesh is far larger than the bed: a peak memory per stage, not the process's so far.
-  EXPECT_LT(stages["pack"]["peak_memory_mb"].get<double>(), stages["mesh"]["peak_memory_mb"].get<double>());
   // The optimiser's history: quality after generation, then after each pass, ending at the
   // quality the stage reports.
   const auto& attempt = stages["mesh"]["attempts"].back();
   const auto& history = attempt["history"];
-  ASSERT_GE(history.size(), 2u) << attempt.dump();
+  ASSERT_GE(history.size(), 1u) << attempt.dump();
   EXPECT_EQ(history[0]["pass"], 0);
   for (std::size_t k = 1; k < history.size(); ++k)
     EXPECT_GT(history[k]["time_s"].get<double>(), history[k - 1]["time_s"].get<double>());
   EXPECT_EQ(history.back()["max_non_orthogonality_deg"], stages["mesh"]["quality"]["max_non_orthogonality_deg"]);
-  EXPECT_LT(history.back()["max_aspect_ratio"].get<double>(), history[0]["max_aspect_ratio"].get<double>());
+
+  // One ratio (1.3) finer: every mesh length over 1.3, cells per gap times 1.3, one mesh.
+  const fs::path finer_scene = fresh_dir("default_finer_scene") / "finer.toml";
+  fs::create_directories(finer_scene.parent_path());
+  std::ofstream(finer_scene) << default_scene_with({{"edge_length_d = 0.15", "edge_length_d = 0.11538"},
+                                                    {"cells_per_gap = 4", "cells_per_gap = 5.2\ncontact_edge_length_d = 0.038462"},
+                                                    {"[mesh]\n", "[mesh]\nmax_size_d = 0.19231\n"},
+                                                    {"levels = 3", "levels = 0"}});
+  const fs::path finer = fresh_dir("default_finer");
+  const Result f = bedforge("--quiet run " + finer_scene.string() + small + " -o " + finer.string());
+  ASSERT_EQ(f.status, 0) << f.output;
+  const auto finer_flow = nlohmann::json::parse(read(finer / "report.json"))["stages"]["case"]["flow"];
+  const double finer_value = finer_flow["pressure_gradient_bed_pa_m"].get<double>();
+  EXPECT_GT(finer_flow["mesh"]["cells"].get<long>(), stages["case"]["flow"]["mesh"]["cells"].get<long>());
+  EXPECT_GE(finer_value, low) << answer.dump(1);
+  EXPECT_LE(finer_value, high) << answer.dump(1);
 }
 
 // Changing only the case settings reuses the mesh (and the surface and bed under it), changing
@@ -301,6 +350,46 @@ TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   const double ratio = flow["ratio_to_eisfeld_schnitzlein_bed"].get<double>();
   EXPECT_GT(ratio, 0.8 * 0.65) << flow.dump();
   EXPECT_LT(ratio, 1.2) << flow.dump();
+  // Allrun ends by saying the result, the same number bedforge read back, to its 6 digits.
+  const std::string allrun_log = read(out / "case/log.Allrun");
+  const auto at = allrun_log.find("dp/L over the bed section");
+  ASSERT_NE(at, std::string::npos) << allrun_log;
+  const double said = std::stod(allrun_log.substr(allrun_log.find("m): ", at) + 4));
+  EXPECT_NEAR(said, flow["pressure_gradient_bed_pa_m"].get<double>(), 1e-5 * said) << allrun_log;
+  EXPECT_NE(allrun_log.find("postProcessing/pBedBottom/0/surfaceFieldValue.dat", at), std::string::npos);
+  // One mesh: the answer gives the value and says its error is unknown, and how to learn it.
+  const auto& answer = c["answer"];
+  EXPECT_FALSE(answer.contains("best_estimate_pa_m")) << answer.dump(1);
+  EXPECT_NE(answer["advice"].get<std::string>().find("levels = 3"), std::string::npos) << answer.dump(1);
+  EXPECT_NE(r.output.find("no error band, so no best estimate"), std::string::npos) << r.output;
+}
+
+// Without OpenFOAM (PATH holds none of its programs) a scene that asks for the flow says so
+// before any work, writes its case all the same and exits with status 4, printing no pressure
+// drop; once OpenFOAM is there, the same command solves the case it wrote.
+TEST(OpenFoamCase, WithoutOpenFoamTheCaseIsWrittenNotSolvedAndTheRunSaysSo) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam) not on PATH";
+  const fs::path scene = fresh_dir("no_openfoam_scene") / "s.toml", out = fresh_dir("no_openfoam");
+  fs::create_directories(scene.parent_path());
+  std::ofstream(scene) << "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n"
+                          "[contacts]\ntreatment = \"shrink\"\n[surface]\nedge_length_d = 0.15\ncells_per_gap = 0\n"
+                          "[case]\nrun = true\n[case.convergence]\nlevels = 0\n[outputs]\nfiles = [\"case\"]\n";
+  const std::string run = "run " + scene.string() + " -o " + out.string();
+  const Result r = shell("PATH=/nonexistent " + std::string(BEDFORGE_BINARY) + " " + run);
+  EXPECT_EQ(r.status, 4) << r.output;
+  EXPECT_NE(r.output.find("simpleFoam is not on PATH: the case will be written but not solved"), std::string::npos)
+      << r.output;
+  EXPECT_LT(r.output.find("is not on PATH"), r.output.find("pack:")) << r.output;  // said first
+  EXPECT_EQ(r.output.find("answer:"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "case/Allrun"));
+  EXPECT_TRUE(fs::exists(out / "case/constant/polyMesh/owner"));
+  EXPECT_FALSE(fs::exists(out / "pressure_drop.svg"));
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  EXPECT_FALSE(report["stages"]["case"].contains("flow"));
+  const Result solved = bedforge(run + " --overwrite");
+  ASSERT_EQ(solved.status, 0) << solved.output;
+  EXPECT_NE(solved.output.find("answer: dp/L over the bed section"), std::string::npos) << solved.output;
+  EXPECT_TRUE(nlohmann::json::parse(read(out / "report.json"))["stages"]["case"].contains("flow"));
 }
 
 // Prism layers on the small bed: U's residual stalls near 3e-3 on them while the pressure drop
@@ -313,8 +402,11 @@ TEST(OpenFoamCase, OnPrismLayersTheSolverStopsOnceThePressureDropHasSettled) {
   const fs::path out = run_scene_text("layers_flow",
                                       "[container]\ntype = \"cylinder\"\ndiameter_d = 4.0\n"
                                       "[particles]\ncount = 40\ndiameter_m = 0.003\n[packing]\nseed = 1\n"
-                                      "[surface]\nedge_length_d = 0.1\n[mesh.layers]\ncount = 3\n"
+                                      "[contacts]\ntreatment = \"shrink\"\n"
+                                      "[surface]\nedge_length_d = 0.1\ncontact_edge_length_d = 0.033\n"
+                                      "cells_per_gap = 0\n[mesh.layers]\ncount = 3\n"
                                       "[case]\niterations = 300\nprocessors = 2\nrun = true\n"
+                                      "[case.convergence]\nlevels = 0\n"
                                       "[outputs]\nfiles = [\"case\"]\n",
                                       r);
   ASSERT_EQ(r.status, 0) << r.output;

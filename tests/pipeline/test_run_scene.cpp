@@ -26,10 +26,15 @@ using namespace bedforge::pipeline;
 
 namespace {
 
+// Shrunk contacts, no refinement across gaps: the cheapest surface (a scene's defaults bridge
+// the contacts and refine their gaps).
+const std::string kShrunk = "[contacts]\ntreatment = \"shrink\"\n";
+const std::string kPlainSurface = "contact_edge_length_d = 0.033\ncells_per_gap = 0\n";
+
 // 12 spheres in a = 3 with a coarse surface: every stage, in seconds. `extra` adds sections;
 // `surface` replaces the surface and contact settings.
 Scene small_scene(const std::string& outputs, const std::string& extra = "",
-                  const std::string& surface = "[surface]\nedge_length_d = 0.1\n") {
+                  const std::string& surface = kShrunk + "[surface]\nedge_length_d = 0.1\n" + kPlainSurface) {
   const std::string text = "[container]\ndiameter_d = 3\n[particles]\ncount = 12\ndiameter_m = 0.002\n" + surface +
                            "[mesh]\nthreads = 1\n[outputs]\nfiles = [" + outputs + "]\n" + extra;
   return read_scene(parse_scene_text(text, "small.toml"), "small.toml");
@@ -39,7 +44,7 @@ Scene small_scene(const std::string& outputs, const std::string& extra = "",
 // coarse wall facets (0.15 d and coarser), so each solve takes seconds. Measured on 2026-11-24:
 // at 0.15 d and ratio 1.3 each level converged in about 90 iterations; at 0.2 d and 1.4 the
 // coarsest level stalled in one of two runs (gmsh's mesh differs between builds).
-const std::string kOpenSurface = "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.15\n";
+const std::string kOpenSurface = kShrunk + "shrink_factor = 0.94\n[surface]\nedge_length_d = 0.15\n" + kPlainSurface;
 
 // The empty tube's coarser levels (1.3 k to 2.7 k polyhedra): twice the largest error measured
 // on such meshes, -2.2 % at 1.3 k cells (2026-11-24; the errors differ from mesh to mesh since
@@ -159,7 +164,7 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   const fs::path dir = test_support::fresh_dir("convergence");
   const Scene scene =
       small_scene("\"case\"", "[case]\nrun = true\n[case.convergence]\nlevels = 4\nratio = 1.3\n",
-                  "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n");
+                  kShrunk + "shrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n" + kPlainSurface);
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& study = r.stages["case"]["convergence"];
   ASSERT_EQ(study["levels"].size(), 4u) << study.dump();
@@ -230,7 +235,7 @@ TEST(RunScene, AChangedStudySolvesOnlyTheLevelsThatChanged) {
   auto study_scene = [](int levels, double ratio) {
     return small_scene("\"case\"",
                        fmt::format("[case]\nrun = true\n[case.convergence]\nlevels = {}\nratio = {}\n", levels, ratio),
-                       "[contacts]\nshrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n");
+                       kShrunk + "shrink_factor = 0.94\n[surface]\nedge_length_d = 0.1\n" + kPlainSurface);
   };
   const RunOutcome three = run(study_scene(3, 1.3), dir);
   const nlohmann::json& first = three.stages["case"]["convergence"];

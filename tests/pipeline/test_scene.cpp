@@ -117,9 +117,10 @@ TEST(Scene, ContactTreatmentsAndTheirErrors) {
 // and prism layers would meet it, so slabs are refused with them, naming the key.
 TEST(Scene, SlabsAreRefusedWhereTheirPlanesWouldChangeTheBed) {
   const std::string bed = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
-  EXPECT_EQ(read(bed + "[mesh]\nslabs = 3\n").mesh.slabs, 3);
+  EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"shrink\"\n[mesh]\nslabs = 3\n").mesh.slabs, 3);
   for (const std::string extra : {"[contacts]\ntreatment = \"bridge\"\n[mesh]\nslabs = 3\n",
-                                  "[mesh]\nslabs = 2\n[mesh.layers]\ncount = 2\n"}) {
+                                  "[mesh]\nslabs = 3\n",  // bridged by default
+                                  "[contacts]\ntreatment = \"shrink\"\n[mesh]\nslabs = 2\n[mesh.layers]\ncount = 2\n"}) {
     try {
       read(bed + extra);
       ADD_FAILURE() << extra;
