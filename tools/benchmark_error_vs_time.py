@@ -9,7 +9,7 @@ packer:   a = 5, N = 500, seeds 1-5, the overlap tolerance swept in both modes. 
           its seed-mean central void fraction and radial profile (0-3 d from the wall) against those
           of the tightest setting (accelerated, 1e-5 d); the seed-to-seed standard error of the mean
           is the floor below which no setting can be told apart.
-surface:  one bed (a = 5, N = 500, seed 1, default contacts), the surface edge length swept (contact
+surface:  one bed (a = 5, N = 500, seed 1, shrunk contacts, no refinement across gaps), the surface edge length swept (contact
           edge a third of it): volume error against the exact treated geometry and chordal deviation,
           against the stage's time.
 mesh:     mesh and CFD from the convergence studies in docs/mesh_case_benchmark.json (study_gaps and
@@ -108,7 +108,8 @@ def surface_section(work):
     for e in EDGES:
         d = os.path.join(work, f"surface_{e}")
         shutil.copytree(bed, d)
-        bedforge("surface", d, "--edge-length-d", str(e), "--contact-edge-length-d", f"{e / 3:.4g}")
+        bedforge("surface", d, "--contacts", "shrink", "--cells-per-gap", "0", "--edge-length-d", str(e),
+                 "--contact-edge-length-d", f"{e / 3:.4g}")
         s = report(d)["stages"]["surface"]
         points.append({"edge_d": e, "time_s": s["time_s"], "triangles": s["triangles"],
                        "volume_error": abs(s["fluid_volume_relative_error"]), "chordal_d": s["chordal_deviation_d"],

@@ -40,6 +40,12 @@ study_reynolds: the study_gaps run at each Re_p of --reynolds (laminar), with a 
 study_treatments: the study_gaps run with each contact treatment of --treatments (bridge is study_gaps),
         the same bed: how much of the pressure drop, and of its difference from E&S, the treatment
         of the contacts carries.
+default: the README's path, scenes/default.toml as shipped, one `bedforge run` timed from scene to printed
+        answer (its best estimate, band and Eisfeld & Schnitzlein); then its reference: the same scene
+        with every mesh length one study ratio finer and --default-reference-levels levels (so its
+        coarser levels are the default's), whose finest three's extrapolation the answer is held against:
+        the targets of issue 54 (at most 10 min; best estimate within 5 % of the reference; the band
+        holding it; a GCI no wider than the study_gaps run's 32.7 % at that cost).
 solver: the bed of the studies at a surface edge of 0.2 d, 3 cells across narrow gaps, its case written
         and solved once by `bedforge run`, then solved again from the same mesh with OpenFOAM's settings
         changed one at a time (non-orthogonal correction, gradient scheme, SIMPLE against SIMPLEC):
@@ -79,11 +85,13 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
-            "solver", "verification", "verification_spheres"]
+            "default", "solver", "verification", "verification_spheres"]
+DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
-def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000):
+def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000,
+          levels=0, ratio=1.3):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -108,6 +116,9 @@ reynolds = {reynolds}
 iterations = {iterations}
 processors = 2
 run = {"true" if run else "false"}
+[case.convergence]
+levels = {levels}
+ratio = {ratio}
 [outputs]
 files = ["positions", "stl", "mesh", "case"]
 """
@@ -280,8 +291,7 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
 def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0):
     """One run of the scene with a mesh-convergence study; its levels and verdict."""
     path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}")
-    text = (scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds)
-            + f"[case.convergence]\nlevels = {levels}\nratio = {ratio}\n")
+    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio)
     open(path + ".toml", "w").write(text)
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
@@ -294,6 +304,42 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
             "eps_section_bed": case["flow"]["void_fraction_section_bed"],
             "solid_volume_change_relative": rep["stages"]["surface"]["solid_volume_change_relative"],
             "wall_share_es": case["flow"]["drag"]["wall_share_eisfeld_schnitzlein"]}
+
+
+def finer_default_scene(ratio, levels):
+    """scenes/default.toml with every mesh length 1 / ratio of its own and `levels` levels; refuses a
+    default scene whose settings it does not recognise."""
+    text = open(DEFAULT_SCENE).read()
+    edge = float(re.search(r"^edge_length_d = ([0-9.]+)", text, re.M).group(1))
+    gap = float(re.search(r"^cells_per_gap = ([0-9.]+)", text, re.M).group(1))
+    changes = [(r"^edge_length_d = [0-9.]+", f"edge_length_d = {edge / ratio:.6g}\ncontact_edge_length_d = {edge / 3 / ratio:.6g}"),
+               (r"^cells_per_gap = [0-9.]+", f"cells_per_gap = {gap * ratio:.6g}"),
+               (r"^\[mesh\]$", f"[mesh]\nmax_size_d = {0.25 / ratio:.6g}"),
+               (r"^levels = \d+", f"levels = {levels}")]
+    for pattern, replacement in changes:
+        text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
+        if n != 1:
+            raise SystemExit(f"scenes/default.toml: no line matches {pattern}; update finer_default_scene")
+    return text
+
+
+def default_path(tmp, reference_levels):
+    """The README's path timed from scene to printed answer, and its finer reference study."""
+    out = os.path.join(tmp, "default")
+    wall, printed = timed([BEDFORGE, "run", DEFAULT_SCENE, "-o", out, "--overwrite"])
+    rep = json.load(open(os.path.join(out, "report.json")))
+    case = rep["stages"]["case"]
+    ratio = rep["scene"]["case"]["convergence"]["ratio"]
+    ref_path = os.path.join(tmp, "default_reference")
+    open(ref_path + ".toml", "w").write(finer_default_scene(ratio, reference_levels))
+    ref_wall, _ = timed([BEDFORGE, "--quiet", "run", ref_path + ".toml", "-o", ref_path, "--overwrite"])
+    ref = json.load(open(os.path.join(ref_path, "report.json")))["stages"]["case"]
+    return {**commit_and_date(), "wall_s": wall, "peak_mb": peak_mb(rep), "answer": case["answer"],
+            "printed": printed[printed.rfind("answer: "):].rstrip().splitlines(),
+            "study": case["convergence"], "d_m": case["d_ref_m"], "ratio": ratio,
+            "treatment": rep["scene"]["contacts"]["treatment"], "edge_d": rep["scene"]["surface"]["edge_length_d"],
+            "reference": {"wall_s": ref_wall, "edge_d": rep["scene"]["surface"]["edge_length_d"] / ratio,
+                          "study": ref["convergence"], "answer": ref["answer"]}}
 
 
 # OpenFOAM settings tried against the case as written: (name, [(file, pattern, replacement)]).
@@ -605,6 +651,59 @@ def scale_out_lines(rows):
     return lines
 
 
+# Issue 54's targets for the default scene's answer (a rule, not tuned here): scene to answer in at
+# most 10 min on this machine; the best estimate within 5 % of the finer reference; the band
+# holding the reference; a GCI no wider than the study_gaps run gave at that cost (4e6b193).
+DEFAULT_TARGETS = {"minutes": 10.0, "reference": 0.05, "gci": 0.327}
+
+
+def default_lines(r):
+    """The README's path: what it printed, the levels, the reference study and the targets."""
+    a, ref = r["answer"], r["reference"]
+    g_ref = ref["study"].get("grid_convergence", {})
+    lines = ["## The README's path: scenes/default.toml, from scene to answer", "",
+             f"Made at commit {r['commit']} on {r['date']}: `bedforge run scenes/default.toml` as shipped "
+             f"({r['treatment']} contacts, surface edge {r['edge_d']:g} d, {len(r['study']['levels'])} levels of "
+             f"ratio {r['ratio']:g}), {r['wall_s'] / 60:.1f} min wall from scene to answer (bed, surface, mesh, "
+             f"case and every solve), peak {r['peak_mb'] / 1024:.1f} GB. It printed:", "", "```",
+             *r["printed"], "```", "",
+             "| level | cells | h / d | dp/L (Pa/m) | own time (s) |", "|---|---|---|---|---|"]
+    for lv in r["study"]["levels"]:
+        lines.append(f"| {lv['level']} | {lv.get('cells', 'failed')} | "
+                     + (f"{lv['cell_size_m'] / r['d_m']:.4f} | {lv['pressure_gradient_bed_pa_m']:.4g} | {lv['own_time_s']:.0f} |"
+                        if "failure" not in lv else f"| {lv['failure']} | |"))
+    lines += ["", f"Reference: the same scene with every mesh length 1 / {r['ratio']:g} of the default's (finest surface "
+                  f"edge {ref['edge_d']:.4g} d) and {len(ref['study']['levels'])} levels, so its finest level is one "
+                  f"ratio finer than the default's and its coarser ones repeat the default's; "
+                  f"{ref['wall_s'] / 60:.1f} min. Its levels:", "",
+              "| level | cells | h / d | dp/L (Pa/m) |", "|---|---|---|---|"]
+    for lv in ref["study"]["levels"]:
+        lines.append(f"| {lv['level']} | {lv.get('cells', 'failed')} | "
+                     + (f"{lv['cell_size_m'] / r['d_m']:.4f} | {lv['pressure_gradient_bed_pa_m']:.4g} |"
+                        if "failure" not in lv else f"{lv['failure']} | |"))
+    lines += ["", f"Its verdict: {ref['study']['conclusion']}.", ""]
+    best = a.get("best_estimate_pa_m")
+    ref_value = g_ref.get("extrapolated") if g_ref.get("asymptotic") else None
+    if best is None or ref_value is None:
+        lines += ["Targets: not assessed: " + ("the default gave no best estimate." if best is None else
+                                              "the reference study is not in the asymptotic range."), ""]
+        return lines
+    low, high = a["band_pa_m"]
+    off = best / ref_value - 1.0
+    t = DEFAULT_TARGETS
+    lines += ["| target (issue 54) | measured | met |", "|---|---|---|",
+              f"| scene to answer at most {t['minutes']:g} min (aim 5) | {r['wall_s'] / 60:.1f} min | "
+              f"{'yes' if r['wall_s'] <= 60 * t['minutes'] else 'NO'} |",
+              f"| best estimate within {100 * t['reference']:g} % of the reference (its finest three extrapolated, "
+              f"{ref_value:.4g} Pa/m, GCI {100 * g_ref['gci_fine']:.1f} %) | {best:.4g} Pa/m, {100 * off:+.1f} % | "
+              f"{'yes' if abs(off) <= t['reference'] else 'NO'} |",
+              f"| the band holds the reference | {low:.4g} to {high:.4g} Pa/m | "
+              f"{'yes' if low <= ref_value <= high else 'NO'} |",
+              f"| GCI no wider than {100 * t['gci']:.1f} % (study_gaps, 7.0 min) | {100 * a['gci_fine']:.1f} % | "
+              f"{'yes' if a['gci_fine'] <= t['gci'] else 'NO'} |", ""]
+    return lines
+
+
 def write(results):
     json.dump(results, open(RESULTS, "w"), indent=1)
     lines = ["# Volume mesh and OpenFOAM case: pressure drop against run time", "",
@@ -613,6 +712,8 @@ def write(results):
              "d = 3 mm; dp/L is measured between the bed-section planes (0.5 d above the floor and below "
              "the bed top); Eisfeld & Schnitzlein (2001) is evaluated at that section's meshed void "
              "fraction and aspect ratio; *finest* is the finest gmsh level.", ""]
+    if "default" in results:
+        lines += default_lines(results["default"])
     if "sizes" in results:
         lines += ["## a = 5, N = 500, bridges: mesh size against the pressure drop", "", *stamp(results["sizes"]),
                   "| surface edge (d) | cells | surface s | mesh s | case s | simpleFoam s (its) | checkMesh | "
@@ -886,6 +987,8 @@ def main():
     ap.add_argument("--study-gap-cells", type=float, default=4, help="study_gaps: surface.cells_per_gap")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
     ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
+    ap.add_argument("--default-reference-levels", type=int, default=4,
+                    help="default: levels of the reference study, one ratio finer than the default's")
     ap.add_argument("--verify-edge", type=float, default=0.07, help="verification: finest surface edge (d)")
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
@@ -940,6 +1043,9 @@ def main():
                        for v in values]
                 results[key] = sorted(kept + new, key=lambda r: r[field])
                 write(results)
+        if "default" in args.only:
+            results["default"] = default_path(tmp, args.default_reference_levels)
+            write(results)
         if "solver" in args.only:
             results["solver"] = solver(tmp)
             write(results)

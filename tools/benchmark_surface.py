@@ -9,7 +9,8 @@ writes docs/surface_benchmark.md and .json.
     /usr/bin/python3 tools/benchmark_surface.py --counts 10000 --aspect-ratio 14 --keep   # N = 1e4 in a wider tube
 
 Beds: `bedforge pack --aspect-ratio A --count N --seed 1` (soft sphere, accelerated; A = 5 unless --aspect-ratio). Each
-treatment is a real `bedforge surface DIR --contacts T` on a copy of the bed, timed from outside
+treatment is a real `bedforge surface DIR --contacts T` (surface edge 0.1 d, 0.033 d at contacts, no refinement
+across gaps) on a copy of the bed, timed from outside
 (wall clock and peak resident memory from /usr/bin/time) with the stage's own split (build,
 checks) and accuracy from report.json. Linear scaling shows as a flat time per sphere; the
 ratio column is time per sphere over that at the smallest N (same script, same machine).
@@ -24,6 +25,10 @@ import subprocess
 import tempfile
 
 from bedforge_files import BEDFORGE, DOCS, commit_and_date
+
+# The surface settings every row was measured at (the scene defaults until 2026-11-28): a 0.1 d
+# edge, 0.033 d at contacts, no refinement across gaps.
+SURFACE = ["--edge-length-d", "0.1", "--contact-edge-length-d", "0.033", "--cells-per-gap", "0"]
 
 
 def made(row):
@@ -63,7 +68,7 @@ def main():
             for t in args.treatments:
                 work = os.path.join(tmp, f"{t}{n}")
                 shutil.copytree(bed, work)
-                wall, mb = timed([BEDFORGE, "--quiet", "surface", work, "--contacts", t])
+                wall, mb = timed([BEDFORGE, "--quiet", "surface", work, "--contacts", t, *SURFACE])
                 s = json.load(open(os.path.join(work, "report.json")))["stages"]["surface"]
                 rows.append({**commit_and_date(), "a": args.aspect_ratio, "n": n, "treatment": t, "wall_s": wall, "peak_mb": mb,
                              "stage_s": s["time_s"], "build_s": s["time_build_s"],
