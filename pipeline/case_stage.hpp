@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "cases/openfoam_case.hpp"
+#include "cases/case_runner.hpp"
 #include "core/bed.hpp"
 #include "core/bed_io.hpp"
 #include "meshing/poly_mesh.hpp"

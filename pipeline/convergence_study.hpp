@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "analysis/grid_convergence.hpp"
-#include "cases/openfoam_case.hpp"
 #include "core/bed.hpp"
 #include "core/report.hpp"
 #include "pipeline/case_stage.hpp"

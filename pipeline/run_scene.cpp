@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "cases/case_writer.hpp"
 #include "core/atomic_file.hpp"
 #include "core/bed_io.hpp"
 #include "core/error.hpp"

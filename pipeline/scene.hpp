@@ -13,7 +13,7 @@
 #include "core/container.hpp"
 #include "core/dem_import.hpp"
 #include "core/size_distribution.hpp"
-#include "cases/openfoam_case.hpp"
+#include "cases/case_params.hpp"
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL

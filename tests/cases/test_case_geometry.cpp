@@ -1,10 +1,10 @@
-// Where the case puts the point snappyHexMesh keeps its cells around (cases/openfoam_case).
+// Where the case puts the point snappyHexMesh keeps its cells around (cases/case_writer).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <memory>
 
-#include "cases/openfoam_case.hpp"
+#include "cases/case_writer.hpp"
 #include "core/container.hpp"
 
 using bedforge::Bed;

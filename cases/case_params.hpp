@@ -1,0 +1,60 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "core/scene_section.hpp"
+
+namespace bedforge::cases {
+
+// SIMPLE's target for U's initial residual when [case] residual_u is unset.
+inline constexpr double kResidualU = 1.0e-4;
+inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism layers
+// The meshes of a convergence study when the case is run and the scene names none.
+inline constexpr int kStudyLevels = 3;
+// The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
+// through the bed, inlet at the bottom.
+struct CaseParams {
+  double reynolds = 1.0;                // particle Reynolds number rho u d / mu, u superficial, d the reference diameter
+  double density_kg_m3 = 1000.0;        // fluid density (water)
+  double viscosity_pa_s = 1.0e-3;       // dynamic viscosity (water)
+  int iterations = 3000;                // simpleFoam iteration cap (endTime)
+  double residual_p = 1.0e-4;           // SIMPLE stops when the initial residuals fall below these (on
+                                        // these tetrahedral meshes p plateaus near 5e-5 once dp has 4 digits)
+  // Unset: kResidualU, or kResidualULayered on cells with prism layers, where U's residual
+  // stalls near 3e-3 while the pressure drop has settled (docs/findings.md, 2026-11-26, night);
+  // write_case sets it.
+  std::optional<double> residual_u;
+  int processors = 1;                   // subdomains in decomposeParDict; Allrun -np N overrides
+  // hierarchical: slabs along the column (n = 1 1 N), few interface faces in a column; scotch:
+  // graph partitioning, for OpenFOAM builds that have it (Debian's v1912 ships only a stub).
+  std::string decomposition = "hierarchical";
+  bool binary = true;                   // polyMesh and fields in binary, else ASCII
+  // cells = "polyhedra": the case holds the dual polyhedra of gmsh's tetrahedra (as OpenFOAM's
+  // polyDualMesh makes them, meshing/dual_mesh.hpp), on which an empty tube's pressure drop
+  // converges to the exact one; "tetrahedra" solves on gmsh's cells, where it does not
+  // (docs/defaults.md).
+  bool polyhedra = true;
+  // mesher = "snappy": snappyHexMesh makes the cells in Allrun from the fluid surface, on as
+  // many processes as the run has, and no gmsh mesh is made: the route past one machine's memory.
+  bool snappy_cells = false;
+  bool snappy = false;                  // write the snappyHexMesh set-up (with gmsh's cells: used by Allrun -snappy)
+  double snappy_cell_d = 0.25;          // snappyHexMesh background cell, in reference diameters
+  int snappy_level = 2;                 // refinement levels at particles and walls
+  // walls = "slip": the flow slips along the container's walls, mirror planes of the flow (a box
+  // then stands for a slab of an unbounded bed, or a cell of an array); "no_slip" otherwise.
+  bool slip_walls = false;
+  double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
+  bool run = false;                     // run Allrun after writing and read the pressure drop back
+  // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
+  // drop's discretisation error (Richardson extrapolation and the grid convergence index).
+  struct Convergence {
+    int levels = 0;        // meshes in all, the scene's own the finest; 0: no study, else 3-6 (a scene's
+                           // default: kStudyLevels when the case is run on gmsh's cells)
+    double ratio = 1.3;    // cell size ratio between successive levels (surface and volume together)
+  } convergence;
+};
+CaseParams read_case_params(SceneSection& s);
+nlohmann::json to_json(const CaseParams& p);
+
+}  // namespace bedforge::cases

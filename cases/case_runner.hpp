@@ -1,0 +1,77 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cases/case_writer.hpp"
+#include "core/progress.hpp"
+
+namespace bedforge::cases {
+
+// The flow solved in a case: the solver's convergence and the bed's pressure gradient.
+struct FlowResult {
+  double time_s = 0.0;                   // wall time of Allrun
+  double solver_peak_memory_mb = 0.0;    // OpenFOAM's largest process
+  std::string mesher;                    // what made the cells solved on: "gmsh tetrahedra", "gmsh polyhedral dual", "snappyHexMesh"
+  long solved_cells = -1;                // the cells solved on, as Allrun's checkMesh counted them (-1: no checkMesh ran)
+  std::optional<double> solved_volume_m3;  // their total volume, as that checkMesh summed it
+  // snappyHexMesh's cells: 1 - their volume / the surface's, the fluid they do not fill
+  // (throats and gaps narrower than the cells, dropped).
+  std::optional<double> volume_lost;
+  // Allrun's steps, each with its wall time and its largest process's peak memory (from GNU
+  // time when the machine has it: empty otherwise). On N processes that is the largest rank's.
+  struct Step {
+    std::string name;
+    double time_s = 0.0, peak_memory_mb = 0.0;
+  };
+  std::vector<Step> steps;
+  long iterations = 0;
+  bool converged = false;                // SIMPLE's own verdict at the residual targets
+  double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
+  double pressure_gradient_bed_pa_m = 0.0;    // over the bed section
+  double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
+  double pressure_drop_inlet_outlet_pa = 0.0;
+  double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
+  // Forces along the flow (N, OpenFOAM's forces function object, pressure and viscous, over the
+  // whole domain): the drag on the walls and on the particles, and the push of the fluid through
+  // the inlet and outlet. Steady flow conserves momentum, so the drag equals the push but for the
+  // momentum flux difference between inlet and outlet (rho u^2 A / 3 from a plug to a parabola),
+  // the solver's convergence and the wall gradient the forces object takes (a discretisation
+  // error, falling as the mesh refines).
+  double drag_walls_n = 0.0, drag_particles_n = 0.0, push_inlet_outlet_n = 0.0;
+  double drag_walls_viscous_n = 0.0, drag_particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
+  double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
+  double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
+  // A case with a known answer (no correlation is compared): the exact gradient and the relative
+  // error dp/L / exact - 1. Otherwise unset and the correlation's fields below are filled.
+  std::optional<double> exact_pa_m;
+  double relative_error_to_exact = 0.0;
+  // The correlation at the section's meshed void fraction, when known (not on snappyHexMesh's cells).
+  std::optional<double> eisfeld_schnitzlein_pa_m, ratio_to_eisfeld_schnitzlein, void_fraction_section;
+  // The same at the section's exact void fraction of the spheres as packed: the bed the
+  // correlation describes, whatever the contact treatment and the facets did to it.
+  double eisfeld_schnitzlein_bed_pa_m = 0.0;
+  double ratio_to_eisfeld_schnitzlein_bed = 0.0;
+  double void_fraction_section_bed = 0.0;
+  // The wall's share of the wetted area at that void fraction: its share of the drag in the
+  // correlation's wall term (analysis::wall_wetted_area_share), to hold the measured share against.
+  double wall_share_of_drag_eisfeld_schnitzlein = 0.0;
+  nlohmann::json history;                // per iteration: residuals and the bed's gradient against time
+  nlohmann::json to_json() const;        // the case entry's "flow"
+};
+
+// The first of the OpenFOAM programs Allrun needs on `processors` processes (simpleFoam and
+// checkMesh; decomposePar, reconstructPar and mpirun on more than one) that is not on PATH;
+// empty when all are.
+std::string missing_openfoam_program(int processors);
+
+// Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
+// reads back the solver's convergence and the pressure drop, compared with Eisfeld &
+// Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
+// while it runs. ConvergenceError when snappyHexMesh's cells lost the inlet or the outlet (the
+// fluid they kept does not reach it), naming the settings that make finer cells;
+// std::runtime_error naming the log and Allrun's last words when another step fails.
+FlowResult run_case(const CaseInfo& c, Progress& progress);
+
+}  // namespace bedforge::cases

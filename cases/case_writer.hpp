@@ -1,0 +1,96 @@
+#pragma once
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cases/case_params.hpp"
+#include "core/bed.hpp"
+#include "meshing/cell_quality.hpp"
+#include "meshing/poly_mesh.hpp"
+
+namespace bedforge::cases {
+
+// Boundary edges sharper than this (deg; the inlet's and outlet's rims) stay edges of the dual.
+inline constexpr double kDualFeatureAngleDeg = 80.0;
+
+// What the case needs to know about the bed and its domain (m).
+struct CaseGeometry {
+  double d_ref = 0.0;          // reference (Sauter) diameter
+  // D_h/d for the correlation, D_h = 4 A / P the hydraulic diameter: D for a cylinder. Eisfeld &
+  // Schnitzlein fitted cylinders; their wall term A_w (Mehta & Hawley's wall area per bed
+  // volume, 4 / D) is exact for any cross-section with D_h, B_w is carried over unproven.
+  double aspect_ratio = 0.0;
+  double cross_section_area = 0.0;
+  Eigen::Vector4d lateral_bounds = Eigen::Vector4d::Zero();  // xmin, ymin, xmax, ymax of the cross-section
+  double inlet_z = 0.0, outlet_z = 0.0;
+  double bed_bottom = 0.0, bed_top = 0.0;  // the floor and the top sphere; an empty container's inlet and outlet
+};
+
+// The case geometry of a bed (m) and the points of its fluid domain (the volume mesh's or the
+// fluid surface's): the inlet and outlet are their lowest and highest, the rest comes from the
+// bed's container and spheres.
+CaseGeometry case_geometry(const std::vector<Eigen::Vector3d>& points, const Bed& bed);
+
+// A point of the fluid domain as far as it can find from every sphere, wall, inlet and outlet
+// (m): snappyHexMesh keeps the cells connected to it. Searched on a lattice over the domain.
+Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g);
+
+// Bed section over which the pressure drop is measured: its planes and its void fraction as
+// meshed (cells with their centre between the planes over the container's volume between them),
+// from the mesh's cell geometry.
+struct BedSection {
+  double z_low = 0.0, z_high = 0.0;
+  // As meshed: the treated contacts and the facets included; unknown when snappyHexMesh makes
+  // the cells.
+  std::optional<double> void_fraction;
+  double void_fraction_bed = 0.0;  // of the spheres as packed, exact (set by write_case)
+};
+// `cells` null: the planes only.
+BedSection bed_section(const meshing::CellGeometry* cells, const CaseGeometry& g, double exclude_d);
+
+// InputError when `case_dir` exists and `overwrite` is false (checked again by write_case;
+// callers check first to refuse before the long stages).
+void refuse_existing_case(const std::filesystem::path& case_dir, bool overwrite);
+
+// A case as written: what running it and comparing its pressure drop need.
+struct CaseInfo {
+  std::filesystem::path directory;
+  CaseParams params;
+  double velocity_m_s = 0.0;             // superficial inlet velocity
+  double kinematic_viscosity_m2_s = 0.0;
+  long cells = 0;                        // written into constant/polyMesh (the dual's with polyhedra; 0 when
+                                         // snappyHexMesh makes them)
+  BedSection section;                    // where the pressure drop is measured
+  double aspect_ratio = 0.0;             // D_h / d, for the correlation
+  double inlet_area_m2 = 0.0;
+  double d_ref_m = 0.0;
+  std::optional<double> fluid_volume_m3;  // of gmsh's cells (the flow result has the solved cells' own)
+  // snappyHexMesh's cells: the volume the fluid surface encloses, which they should fill.
+  std::optional<double> surface_volume_m3;
+  // A known answer (Pa/m), the route's verification: an empty container's fully developed laminar
+  // gradient, or a simple cubic column's Stokes drag (analysis/stokes_arrays.hpp). Unset for
+  // other beds, which are compared with Eisfeld & Schnitzlein instead.
+  std::optional<double> exact_pressure_gradient_pa_m;
+  bool particles = false;                // the bed has spheres (a particles patch)
+  nlohmann::json to_json() const;        // its report.json entry
+};
+
+// Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
+// an existing case is replaced (only with `overwrite`) once the new one is complete:
+// constant/polyMesh (from `mesh`, gmsh's cells, or their dual with p.polyhedra; null when
+// p.snappy_cells), 0/U, 0/p, transport and turbulence properties, controlDict with pressure and
+// flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, the records
+// `bedforge/scene.toml` and `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
+// (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
+// `spheres_as_packed`: the mesh's spheres are the bed's own (no contact treatment changed them),
+// the condition for comparing a bed with a known answer (a simple cubic column's).
+CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
+                    const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
+                    const CaseParams& p, const std::string& note, const std::string& scene_toml,
+                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, bool spheres_as_packed);
+
+}  // namespace bedforge::cases
