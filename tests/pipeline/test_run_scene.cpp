@@ -296,6 +296,13 @@ TEST(RunScene, AConvergenceStudyReportsTheLevelsThatFailed) {
     EXPECT_FALSE(level.contains("own_time_s")) << level.dump();  // no value, so no cost of one
   }
   EXPECT_NE(study["conclusion"].get<std::string>().find("no three successive levels"), std::string::npos);
+  // The answer prints no number that was not computed: the finest value as such, no estimate.
+  const nlohmann::json& answer = r.stages["case"]["answer"];
+  EXPECT_FALSE(answer.contains("best_estimate_pa_m")) << answer.dump(1);
+  EXPECT_FALSE(answer.contains("band_pa_m")) << answer.dump(1);
+  EXPECT_NE(r.printed.find("no error band, so no best estimate"), std::string::npos) << r.printed;
+  EXPECT_NE(r.printed.find("NOT converged"), std::string::npos) << r.printed;
+  EXPECT_TRUE(fs::exists(dir / "pressure_drop.svg"));
 }
 
 TEST(RunScene, AConvergenceRequestThatCannotWorkIsRefusedByKey) {
