@@ -325,6 +325,7 @@ def finer_default_scene(ratio, levels):
 
 def default_path(tmp, reference_levels):
     """The README's path timed from scene to printed answer, and its finer reference study."""
+    made = commit_and_date()  # the code the runs are made by: commits made meanwhile are not in it
     out = os.path.join(tmp, "default")
     wall, printed = timed([BEDFORGE, "run", DEFAULT_SCENE, "-o", out, "--overwrite"])
     rep = json.load(open(os.path.join(out, "report.json")))
@@ -334,7 +335,7 @@ def default_path(tmp, reference_levels):
     open(ref_path + ".toml", "w").write(finer_default_scene(ratio, reference_levels))
     ref_wall, _ = timed([BEDFORGE, "--quiet", "run", ref_path + ".toml", "-o", ref_path, "--overwrite"])
     ref = json.load(open(os.path.join(ref_path, "report.json")))["stages"]["case"]
-    return {**commit_and_date(), "wall_s": wall, "peak_mb": peak_mb(rep), "answer": case["answer"],
+    return {**made, "wall_s": wall, "peak_mb": peak_mb(rep), "answer": case["answer"],
             "printed": printed[printed.rfind("answer: "):].rstrip().splitlines(),
             "study": case["convergence"], "d_m": case["d_ref_m"], "ratio": ratio,
             "treatment": rep["scene"]["contacts"]["treatment"], "edge_d": rep["scene"]["surface"]["edge_length_d"],
@@ -657,8 +658,9 @@ def scale_out_lines(rows):
 DEFAULT_TARGETS = {"minutes": 10.0, "reference": 0.05, "gci": 0.327}
 
 
-def default_lines(r):
-    """The README's path: what it printed, the levels, the reference study and the targets."""
+def default_lines(r, same_settings=None):
+    """The README's path: what it printed, the levels, the reference study and the targets;
+    `same_settings`, an earlier study_gaps run, whose levels' times show the machine's speed."""
     a, ref = r["answer"], r["reference"]
     g_ref = ref["study"].get("grid_convergence", {})
     lines = ["## The README's path: scenes/default.toml, from scene to answer", "",
@@ -672,6 +674,14 @@ def default_lines(r):
         lines.append(f"| {lv['level']} | {lv.get('cells', 'failed')} | "
                      + (f"{lv['cell_size_m'] / r['d_m']:.4f} | {lv['pressure_gradient_bed_pa_m']:.4g} | {lv['own_time_s']:.0f} |"
                         if "failure" not in lv else f"| {lv['failure']} | |"))
+    if same_settings and len(same_settings["study"]["levels"]) == len(r["study"]["levels"]):
+        then = [lv.get("own_time_s", 0) for lv in same_settings["study"]["levels"]]
+        now = [lv.get("own_time_s", 0) for lv in r["study"]["levels"]]
+        lines += ["", f"The study_gaps run below has these settings; made at {same_settings['commit']} on "
+                      f"{same_settings['date']}, its levels' own times were {', '.join(f'{t:.0f}' for t in then)} s "
+                      f"against {', '.join(f'{t:.0f}' for t in now)} s here "
+                      f"({', '.join(f'{b / a:.2f}' for a, b in zip(then, now) if a > 0)} times), its whole run "
+                      f"{same_settings['wall_s'] / 60:.1f} min: what the same work takes on the machine of each run."]
     lines += ["", f"Reference: the same scene with every mesh length 1 / {r['ratio']:g} of the default's (finest surface "
                   f"edge {ref['edge_d']:.4g} d) and {len(ref['study']['levels'])} levels, so its finest level is one "
                   f"ratio finer than the default's and its coarser ones repeat the default's; "
@@ -713,7 +723,7 @@ def write(results):
              "the bed top); Eisfeld & Schnitzlein (2001) is evaluated at that section's meshed void "
              "fraction and aspect ratio; *finest* is the finest gmsh level.", ""]
     if "default" in results:
-        lines += default_lines(results["default"])
+        lines += default_lines(results["default"], results.get("study_gaps"))
     if "sizes" in results:
         lines += ["## a = 5, N = 500, bridges: mesh size against the pressure drop", "", *stamp(results["sizes"]),
                   "| surface edge (d) | cells | surface s | mesh s | case s | simpleFoam s (its) | checkMesh | "

@@ -98,7 +98,7 @@ def write(rows):
     lines = ["# Surface stage: speed, memory and accuracy against N", "",
              "Made by `/usr/bin/python3 tools/benchmark_surface.py` (soft-sphere beds in a tube of a = D/d as in the "
              "*a* column, seed 1, "
-             "default `[contacts]` and `[surface]` settings, 2 cores). Wall time and peak memory of the whole "
+             "`[contacts]` defaults but the treatment, surface edge 0.1 d, 0.033 d at contacts, no refinement across gaps (the `[surface]` defaults until 2026-11-28), 2 cores). Wall time and peak memory of the whole "
              "`bedforge surface DIR` command, including writing the STL files; *ratio* = time per sphere "
              "over that at the smallest N (1 = linear scaling). The allocator matters here: bedforge is linked "
              "with tcmalloc when `libgoogle-perftools-dev` is installed (these rows: "
