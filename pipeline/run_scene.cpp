@@ -66,7 +66,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   Scene unsolved_scene;
   if (!missing.empty()) {
     console.line(fmt::format("case: OpenFOAM's {} is not on PATH: the case will be written but not solved (install "
-                             "OpenFOAM, e.g. apt-get install openfoam, then run {}/Allrun or this command again)",
+                             "OpenFOAM, e.g. apt-get install openfoam, then run {}/Allrun, or this command again with --overwrite)",
                              missing, (dir / "case").string()));
     unsolved_scene = scene;
     unsolved_scene.case_params.run = false;
