@@ -31,7 +31,7 @@ struct CaseParams {
   std::string decomposition = "hierarchical";
   bool binary = true;                   // polyMesh and fields in binary, else ASCII
   // cells = "polyhedra": the case holds the dual polyhedra of gmsh's tetrahedra (as OpenFOAM's
-  // polyDualMesh makes them, meshing/dual_mesh.hpp), on which an empty tube's pressure drop
+  // polyDualMesh makes them, meshing/volume/dual_mesh.hpp), on which an empty tube's pressure drop
   // converges to the exact one; "tetrahedra" solves on gmsh's cells, where it does not
   // (docs/defaults.md).
   bool polyhedra = true;

@@ -14,7 +14,7 @@
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "meshing/dual_mesh.hpp"
+#include "meshing/volume/dual_mesh.hpp"
 
 namespace bedforge::cases {
 

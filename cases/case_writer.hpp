@@ -9,8 +9,8 @@
 
 #include "cases/case_params.hpp"
 #include "core/bed.hpp"
-#include "meshing/cell_quality.hpp"
-#include "meshing/poly_mesh.hpp"
+#include "meshing/volume/cell_quality.hpp"
+#include "meshing/volume/poly_mesh.hpp"
 
 namespace bedforge::cases {
 

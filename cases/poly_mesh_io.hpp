@@ -2,7 +2,7 @@
 #include <filesystem>
 #include <string>
 
-#include "meshing/poly_mesh.hpp"
+#include "meshing/volume/poly_mesh.hpp"
 
 namespace bedforge::cases {
 

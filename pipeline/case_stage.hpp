@@ -8,8 +8,8 @@
 #include "cases/case_runner.hpp"
 #include "core/bed.hpp"
 #include "core/bed_io.hpp"
-#include "meshing/poly_mesh.hpp"
-#include "meshing/triangle_mesh.hpp"
+#include "meshing/volume/poly_mesh.hpp"
+#include "meshing/surface/triangle_mesh.hpp"
 #include "pipeline/console.hpp"
 
 namespace bedforge::pipeline {

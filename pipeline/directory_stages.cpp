@@ -13,9 +13,9 @@
 #include "core/version.hpp"
 #include "pipeline/analysis_stage.hpp"
 #include "pipeline/output_files.hpp"
-#include "meshing/stl_io.hpp"
+#include "meshing/surface/stl_io.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
-#include "meshing/surface_checks.hpp"
+#include "meshing/surface/surface_checks.hpp"
 #include "pipeline/surface_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
@@ -23,7 +23,7 @@
 #include "pipeline/mesh_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
-#include "meshing/gmsh_model.hpp"
+#include "meshing/volume/gmsh_model.hpp"
 #include "pipeline/case_stage.hpp"
 #endif
 

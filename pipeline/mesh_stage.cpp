@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "meshing/fluid_surface.hpp"
+#include "meshing/surface/fluid_surface.hpp"
 
 namespace bedforge::pipeline {
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "core/bed.hpp"
-#include "meshing/slab_mesh.hpp"
-#include "meshing/volume_mesh.hpp"
+#include "meshing/volume/slab_mesh.hpp"
+#include "meshing/volume/volume_mesh.hpp"
 #include "pipeline/console.hpp"
 #include "pipeline/scene.hpp"
 

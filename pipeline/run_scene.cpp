@@ -13,7 +13,7 @@
 #include "core/report.hpp"
 #include "core/stage_meter.hpp"
 #include "core/version.hpp"
-#include "meshing/stl_io.hpp"
+#include "meshing/surface/stl_io.hpp"
 #include "pipeline/analysis_stage.hpp"
 #include "pipeline/output_files.hpp"
 #include "pipeline/pack_stage.hpp"
@@ -21,7 +21,7 @@
 #include "pipeline/surface_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
-#include "meshing/gmsh_model.hpp"
+#include "meshing/volume/gmsh_model.hpp"
 #include "pipeline/case_stage.hpp"
 #include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"

@@ -17,11 +17,11 @@
 #include "packer/monte_carlo.hpp"
 #include "packer/soft_sphere.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
-#include "meshing/fluid_surface.hpp"
+#include "meshing/surface/fluid_surface.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
-#include "meshing/slab_mesh.hpp"
-#include "meshing/volume_mesh.hpp"
+#include "meshing/volume/slab_mesh.hpp"
+#include "meshing/volume/volume_mesh.hpp"
 #endif
 
 namespace bedforge::pipeline {

@@ -5,8 +5,8 @@
 #include <algorithm>
 
 #include "core/version.hpp"
-#include "meshing/stl_io.hpp"
-#include "meshing/vtp_io.hpp"
+#include "meshing/surface/stl_io.hpp"
+#include "meshing/surface/vtp_io.hpp"
 
 namespace bedforge::pipeline {
 

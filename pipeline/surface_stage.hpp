@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/bed.hpp"
-#include "meshing/fluid_surface.hpp"
+#include "meshing/surface/fluid_surface.hpp"
 #include "pipeline/console.hpp"
 #include "pipeline/output_files.hpp"
 

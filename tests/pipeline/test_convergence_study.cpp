@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "meshing/fluid_surface.hpp"
+#include "meshing/surface/fluid_surface.hpp"
 
 using namespace bedforge;
 using namespace bedforge::pipeline;

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "meshing/triangle_mesh.hpp"
+#include "meshing/surface/triangle_mesh.hpp"
 
 namespace test_support {
 

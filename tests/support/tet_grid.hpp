@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "meshing/poly_mesh.hpp"
+#include "meshing/volume/poly_mesh.hpp"
 
 namespace bedforge::meshing {
 

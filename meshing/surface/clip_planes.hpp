@@ -1,0 +1,50 @@
+#pragma once
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "core/bed.hpp"
+#include "meshing/surface/contacts.hpp"
+#include "meshing/surface/fluid_surface.hpp"
+
+namespace bedforge::meshing {
+
+// A contact of a bed of n spheres as one number: spheres i < j, or sphere i and wall w as
+// j = n + w; and back.
+inline long long contact_key(std::size_t i, std::size_t j, std::size_t n) {
+  return static_cast<long long>(i) * (n + 8) + j;
+}
+inline std::pair<std::size_t, std::size_t> contact_of(long long k, std::size_t n) {
+  return {static_cast<std::size_t>(k) / (n + 8), static_cast<std::size_t>(k) % (n + 8)};
+}
+
+// What each treated contact occupies in z (m), by contact key: a clip plane must keep clear of it.
+using ContactExtents = std::unordered_map<long long, std::pair<double, double>>;
+
+// Contacts a clip plane cuts through, opened instead of treated: their spheres shrink by
+// contacts.shrink_factor and the contacts are left as gaps.
+struct ClipOpening {
+  std::vector<char> spheres;              // per sphere
+  std::unordered_set<long long> contacts;  // by contact_key
+};
+
+struct ClipPlacement {
+  DomainPlanes planes;     // the asked window's planes, each moved clear of the bed
+  ClipOpening opening;     // empty where both planes found room between the contacts
+  nlohmann::json report;   // per plane: asked_d, used_d, clearance_d, contacts_opened
+};
+
+// Places the clip planes of `asked` (m) within surface.clip_shift_d of where they were asked,
+// surface.clip_clearance_d clear of every sphere's top and bottom (`radius`: the treated radii,
+// m) and of every treated contact (`extents`, from treating the whole bed). A packed bed has
+// bridges or caps at every height, so a plane often finds no height clear of them; it then keeps
+// clear of the spheres' tops and bottoms only (at either radius) and the contacts near it are
+// opened (not with enlarge, whose grown neighbours a shrunk sphere would still overlap).
+// InputError naming the key when no height will do.
+ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes asked,
+                                const std::vector<double>& radius, const ContactExtents& extents);
+
+}  // namespace bedforge::meshing

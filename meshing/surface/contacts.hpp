@@ -1,0 +1,57 @@
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+#include "core/bed.hpp"
+#include "meshing/surface/fluid_surface.hpp"
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/wall_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// The planes that bound the fluid domain below and above (m). With `clip` they cut the bed (a
+// height window of it); otherwise no sphere may reach them.
+struct DomainPlanes {
+  double z0 = 0.0, z1 = 0.0;
+  bool clip = false;
+};
+
+// The bed after its contact treatment, as pieces the surface is meshed from. Lengths in m.
+struct TreatedBed {
+  std::vector<char> kept;                         // per sphere: false when wholly outside a clip window (not meshed)
+  std::vector<double> radius;                     // per sphere, after shrink or enlarge
+  std::vector<std::vector<SphereCut>> cuts;       // per sphere: where its mesh stops
+  std::vector<std::vector<std::string>> cut_names;  // per sphere and cut, for error messages ("sphere 7", "wall")
+  std::vector<TriangleMesh> parts;                // cap disks and bridges, normals out of the solid
+  // Where the bed meets each wall of the container: cylinder {wall}, annulus {wall, inner
+  // wall}, box {x min, x max, y min, y max}; and where spheres cross the clip planes.
+  std::vector<std::vector<WallHole>> wall_holes;
+  std::vector<WallHole> inlet_holes, outlet_holes;
+  DomainPlanes planes;                            // as used: clip planes move off near-tangent spheres and contacts
+  double solid_volume = 0.0;                      // exact volume of the treated solid (m^3)
+  // Narrowest gap left between a sphere and a cylinder wall around the fluid (m): that wall's
+  // facets lie inside it, towards the spheres (an annulus's inner wall's lie away from them).
+  double min_concave_wall_gap = 0.0;
+  nlohmann::json report;                          // contacts treated, volume and area change, gaps, angles
+};
+
+// Contact treatment (section [contacts]) of `bed` in a cylinder, annulus or walled box whose
+// fluid domain runs between `planes`. A clip plane moves (by up to surface.clip_shift_d) to the
+// height nearest the one asked for that lies surface.clip_clearance_d clear of every sphere's
+// top and bottom and of every treated contact; spheres crossing it are cut there, spheres and
+// contacts beyond it are left out. Where no height is clear of the treated contacts, the plane
+// keeps clear of the spheres' ends (at their radius and shrunk by contacts.shrink_factor) and
+// the contacts near it are opened: both spheres shrink by shrink_factor and the contact is left
+// as a gap (not with enlarge, whose grown neighbours a shrunk sphere would still overlap).
+// Pairs and wall contacts closer than the treatment's gap tolerance get its geometry; every
+// other gap is left as it is and the narrowest is reported. Volumes and areas are exact
+// (closed forms, or quadrature to 1e-10 for bridges to a curved wall and spheres crossing one).
+// InputError naming the particles when the treatment cannot give a valid solid: contacts left
+// touching, overlaps too deep, a bridge through a third sphere, a sphere or bridge reaching an
+// unclipped inlet or outlet plane, no clear height for a clip plane, an opened contact still
+// overlapping, cuts on one sphere that overlap, a periodic box.
+TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes);
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,387 @@
+#include "meshing/surface/fluid_surface.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <future>
+#include <numbers>
+#include <optional>
+#include <tuple>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/version.hpp"
+#include "meshing/surface/defect_locations.hpp"
+#include "meshing/surface/contacts.hpp"
+#include "meshing/surface/delaunay_walls.hpp"
+#include "meshing/surface/gap_spacing.hpp"
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/stl_io.hpp"
+#include "meshing/surface/vtp_io.hpp"
+#include "meshing/surface/wall_mesh.hpp"
+
+namespace bedforge::meshing {
+
+namespace {
+
+constexpr std::array<const char*, 5> kTreatments{"none", "shrink", "enlarge", "bridge", "cap"};
+
+SurfaceParams::Treatment treatment_of(const std::string& name) {
+  return static_cast<SurfaceParams::Treatment>(std::find(kTreatments.begin(), kTreatments.end(), name) -
+                                               kTreatments.begin());
+}
+
+}  // namespace
+
+const char* treatment_name(SurfaceParams::Treatment t) { return kTreatments[static_cast<int>(t)]; }
+
+SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
+  SurfaceParams p;
+  p.treatment = treatment_of(c.choice("treatment", "bridge", {"none", "shrink", "enlarge", "bridge", "cap"}));
+  const std::string wall = c.choice("wall_treatment", "same", {"same", "bridge", "cap", "none"});
+  p.wall_treatment = wall == "same" ? p.treatment : treatment_of(wall);
+  if (wall != "same" && (p.treatment == SurfaceParams::Treatment::shrink || p.treatment == SurfaceParams::Treatment::enlarge))
+    throw InputError(fmt::format("contacts.wall_treatment = '{}' with contacts.treatment = '{}': shrink and enlarge act "
+                                 "on the spheres, so on their wall contacts too; allowed: 'same', or a treatment "
+                                 "bridge, cap or none",
+                                 wall, treatment_name(p.treatment)));
+  p.shrink_factor = c.number("shrink_factor", p.shrink_factor, Range{0.5, 1.0, false, true});
+  p.enlarge_factor = c.number("enlarge_factor", p.enlarge_factor, Range{1.0, 1.2, true, false});
+  p.enlarge_join_gap_d = c.number("enlarge_join_gap_d", p.enlarge_join_gap_d, Range::closed(0.0, 0.1));
+  p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, true, true});
+  p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
+  p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
+  p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
+  p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
+  p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
+  p.cells_per_gap = s.number("cells_per_gap", kSceneCellsPerGap, Range::closed(0.0, 20.0));
+  p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
+  p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
+  if (const std::vector<double> w = s.numbers("clip_window_d", Range::non_negative()); !w.empty()) {
+    if (w.size() != 2 || !(w[1] > w[0]))
+      throw InputError(fmt::format("surface.clip_window_d = [{}]: allowed: two heights above the floor in diameters, "
+                                   "bottom below top, e.g. [2.0, 8.0]",
+                                   fmt::join(w, ", ")));
+    for (const char* k : {"inlet_length_d", "outlet_length_d"})
+      if (s.has(k))
+        throw InputError(fmt::format("surface.{} with surface.clip_window_d: a clipped domain begins and ends at the "
+                                     "window's planes; allowed: one of the two",
+                                     k));
+    p.clip = true;
+    p.clip_bottom_d = w[0];
+    p.clip_top_d = w[1];
+  }
+  p.clip_shift_d = s.number("clip_shift_d", p.clip_shift_d, Range::closed(0.0, 1.0));
+  p.clip_clearance_d = s.number("clip_clearance_d", p.clip_clearance_d, Range::closed(0.0, 0.1));
+  p.min_angle_deg = s.number("min_angle_deg", p.min_angle_deg, Range::closed(0.0, 30.0));
+  return p;
+}
+
+nlohmann::json to_json(const SurfaceParams& p) {
+  return {{"treatment", treatment_name(p.treatment)},
+          {"wall_treatment", treatment_name(p.wall_treatment)},
+          {"shrink_factor", p.shrink_factor},
+          {"enlarge_factor", p.enlarge_factor},
+          {"enlarge_join_gap_d", p.enlarge_join_gap_d},
+          {"bridge_diameter_d", p.bridge_diameter_d},
+          {"bridge_gap_d", p.bridge_gap_d},
+          {"cap_gap_d", p.cap_gap_d},
+          {"edge_length_d", p.edge_length_d},
+          {"contact_edge_length_d", p.contact_edge_length_d},
+          {"growth", p.growth},
+          {"cells_per_gap", p.cells_per_gap},
+          {"inlet_length_d", p.inlet_length_d},
+          {"outlet_length_d", p.outlet_length_d},
+          {"clip_window_d", p.clip ? nlohmann::json::array({p.clip_bottom_d, p.clip_top_d}) : nlohmann::json(nullptr)},
+          {"clip_shift_d", p.clip_shift_d},
+          {"clip_clearance_d", p.clip_clearance_d},
+          {"min_angle_deg", p.min_angle_deg}};
+}
+
+namespace {
+
+// Points along the axis-aligned edge from corner a to corner b, about `edge` apart, b left out.
+// Computed from the corners in one fixed order, so the faces that share an edge get
+// bit-identical vertices and weld.
+std::vector<Eigen::Vector3d> box_edge(Eigen::Vector3d a, Eigen::Vector3d b, double edge) {
+  const bool flip = std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3);
+  if (flip) std::swap(a, b);
+  const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / edge)));
+  std::vector<Eigen::Vector3d> pts;
+  for (int k = 0; k <= n; ++k) pts.push_back(k == n ? b : Eigen::Vector3d(a + (b - a) * (static_cast<double>(k) / n)));
+  if (flip) std::reverse(pts.begin(), pts.end());
+  pts.pop_back();
+  return pts;
+}
+
+std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>& corners, double edge) {
+  std::vector<Eigen::Vector3d> loop;
+  for (int k = 0; k < 4; ++k) {
+    const auto side = box_edge(corners[k], corners[(k + 1) % 4], edge);
+    loop.insert(loop.end(), side.begin(), side.end());
+  }
+  return loop;
+}
+
+}  // namespace
+
+std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                      const std::vector<double>& radii, const std::vector<char>& kept,
+                                      const Container& container) {
+  if (p.cells_per_gap <= 0.0) return std::nullopt;
+  const double edge = p.edge_length_d * d;
+  return GapSpacing(centres, radii, kept, container, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
+}
+
+namespace {
+
+// The planes asked for below and above the fluid domain (m), before treat_contacts moves clip planes.
+DomainPlanes asked_planes(const Bed& bed, const SurfaceParams& p) {
+  const double d = reference_diameter(bed);
+  if (p.clip) return {p.clip_bottom_d * d, p.clip_top_d * d, true};
+  return {-p.inlet_length_d * d, bed_height(bed) + p.outlet_length_d * d, false};
+}
+
+}  // namespace
+
+FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell) {
+  const TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
+  FluidDomainSize s;
+  s.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
+  const std::optional<GapSpacing> gaps = gap_spacing(p, reference_diameter(bed), bed.centres, tb.radius, tb.kept,
+                                                     *bed.container);
+  if (gaps) s.gap_cells = gaps->added_cells(volume_per_cell, tb.planes.z0, tb.planes.z1);
+  return s;
+}
+
+FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
+  const double d = reference_diameter(bed), edge = p.edge_length_d * d;
+  const double top = bed_height(bed);
+  TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
+  const double z0 = tb.planes.z0, z1 = tb.planes.z1;
+  const Container& c = *bed.container;
+  const auto* ann = dynamic_cast<const Annulus*>(&c);
+  const auto* cyl = dynamic_cast<const Cylinder*>(&c);
+  const auto* box = dynamic_cast<const Box*>(&c);
+  const double R = ann ? ann->outer_radius() : cyl ? cyl->radius() : 0.0;
+  const double r_in = ann ? ann->inner_radius() : 0.0;
+
+  // A curved wall is faceted between vertices on it: its facets lie inside it by up to the
+  // sagitta, which must stay below half the narrowest wall gap or a facet would come close to a
+  // sphere. Where the spheres' edge is too long for that, the curved walls (a few thousand
+  // triangles; an annulus's two share the end rings' meshes) take the longest edge whose
+  // sagitta is 0.4 of the gap, down to the contact edge.
+  double wall_edge = edge;
+  if (!box && ring_sagitta(R, edge) >= 0.5 * tb.min_concave_wall_gap) {
+    wall_edge = tb.min_concave_wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * tb.min_concave_wall_gap) : 0.0;
+    if (!(wall_edge >= p.contact_edge_length_d * d))
+      throw InputError(fmt::format(
+          "surface.edge_length_d = {}: the wall facets would lie up to {:.3g} d inside the wall, more than half the "
+          "narrowest gap left at the wall ({:.3g} d), and a wall edge short enough ({:.3g} d) is below "
+          "surface.contact_edge_length_d = {}; allowed: a treatment that leaves a wider gap at the wall",
+          p.edge_length_d, ring_sagitta(R, edge) / d, tb.min_concave_wall_gap / d, wall_edge / d,
+          p.contact_edge_length_d));
+  }
+  const double wall_sag = box ? 0.0 : ring_sagitta(R, wall_edge);
+
+  // Edges shortened where the surface faces another across a narrow gap.
+  const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
+  auto field = [&](int self) {
+    return gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
+                : SpacingField{};
+  };
+
+  // Spheres, each on its own (in parallel), stopping at their cuts: meshed on other threads
+  // while this one meshes the container, whose wall is one large piece.
+  const std::size_t n = bed.size();
+  std::vector<TriangleMesh> spheres(n);
+  std::vector<double> chordal(n, 0.0);
+  std::vector<std::string> failure(n);
+  std::future<void> spheres_meshed = std::async(std::launch::async, [&] {
+#pragma omp parallel for schedule(dynamic, 16)
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!tb.kept[i]) continue;
+      try {
+        spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
+                                 field(static_cast<int>(i)));
+        chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
+      } catch (const CutConflict& e) {
+        failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
+                                 "another treatment",
+                                 i, fmt::join(tb.cut_names[i], ", "), e.what());
+      }
+    }
+  });
+
+  // Container: walls with holes where the bed meets them, inlet and outlet sharing their edges
+  // (with holes where spheres cross clip planes); what the holes cut out closes the bed solid.
+  FluidSurface out;
+  TriangleMesh& f = out.fluid;
+  // The triangles appended since the last piece, as a piece of the self-intersection test.
+  using Shape = SurfacePiece::Shape;
+  auto piece = [&f, &out](Shape shape, const Eigen::Vector3d& centre = Eigen::Vector3d::Zero(), double radius = 0.0,
+                          std::vector<std::pair<Eigen::Vector3d, double>> cut_planes = {}) {
+    const std::size_t first = out.pieces.empty() ? 0 : out.pieces.back().last;
+    if (f.triangles.size() <= first) return;
+    SurfacePiece p;
+    p.first = first, p.last = f.triangles.size(), p.shape = shape, p.centre = centre, p.radius = radius;
+    p.cut_planes = std::move(cut_planes);
+    out.pieces.push_back(std::move(p));
+  };
+  auto add = [&](const std::string& what, Shape shape, double radius, const std::function<WallMesh()>& mesh) {
+    try {
+      const WallMesh m = mesh();
+      f.append(m.outside);
+      piece(shape, Eigen::Vector3d::Zero(), radius);
+      out.bed.append(m.inside);
+    } catch (const CutConflict& e) {
+      throw InputError(fmt::format("the {}: {}", what, e.what()));
+    }
+  };
+  const double hx = box ? 0.5 * box->size_x() : 0.0, hy = box ? 0.5 * box->size_y() : 0.0;
+  auto corner = [&](const Eigen::Vector2d& s, double z) { return Eigen::Vector3d(s.x() * hx, s.y() * hy, z); };
+  if (box) {
+    // Sides in the order of TreatedBed::wall_holes: normal out of the fluid (+w of the face's
+    // frame) and the signs (x, y) of its two ends.
+    const std::array<std::tuple<Eigen::Vector3d, Eigen::Vector2d, Eigen::Vector2d>, 4> sides{
+        {{-Eigen::Vector3d::UnitX(), {-1, -1}, {-1, 1}},
+         {Eigen::Vector3d::UnitX(), {1, -1}, {1, 1}},
+         {-Eigen::Vector3d::UnitY(), {-1, -1}, {1, -1}},
+         {Eigen::Vector3d::UnitY(), {-1, 1}, {1, 1}}}};
+    for (std::size_t k = 0; k < sides.size(); ++k) {
+      const auto& [normal, a, b] = sides[k];
+      const auto loop = box_face_loop({corner(a, z0), corner(b, z0), corner(b, z1), corner(a, z1)}, edge);
+      const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
+      add("wall", Shape::plane, 0.0,
+          [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
+    }
+  } else {
+    add("wall", Shape::cylinder, R,
+        [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
+    if (ann)
+      add("inner_wall", Shape::cylinder, r_in,
+          [&] { return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
+  }
+  // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
+  using Loops = std::vector<std::vector<Eigen::Vector3d>>;
+  auto end_boundary = [&](const Frame& frame, double z) {
+    if (box) return Loops{box_face_loop({corner({-1, -1}, z), corner({1, -1}, z), corner({1, 1}, z), corner({-1, 1}, z)}, edge)};
+    Loops boundary{circle_loop(frame, R, ring_points(R, wall_edge))};
+    if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, wall_edge)));
+    return boundary;
+  };
+  for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
+    const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
+    if (!box && !p.clip) {  // nothing cuts it: the structured ring
+      f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
+      piece(Shape::plane);
+      continue;
+    }
+    add(patch, Shape::plane, 0.0, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
+  }
+  spheres_meshed.get();
+  for (const auto& message : failure)
+    if (!message.empty()) throw InputError(message);
+  // The bed solid (normals out of it), and the same pieces turned inside out for the fluid;
+  // each piece is released once appended (at N = 1e4 the pieces are gigabytes).
+  std::size_t points = 0, triangles = 0;
+  for (const auto* pieces : {&spheres, &tb.parts})
+    for (const auto& m : *pieces) points += m.points.size(), triangles += m.triangles.size();
+  f.reserve(points, triangles);
+  out.bed.reserve(points, triangles);
+  auto add_solid = [&](TriangleMesh& m) {
+    out.bed.append(m);
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+    f.append(m);
+    m = TriangleMesh();
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<std::pair<Eigen::Vector3d, double>> cut_planes;
+    for (const SphereCut& cut : tb.cuts[i]) {  // at the loop's farthest point along the axis (a curved wall's loop is not flat)
+      double h = -HUGE_VAL;
+      for (const auto& q : cut.loop) h = std::max(h, cut.axis.dot(q - bed.centres[i]));
+      cut_planes.emplace_back(cut.axis, h);
+    }
+    add_solid(spheres[i]);
+    piece(Shape::sphere, bed.centres[i], tb.radius[i], std::move(cut_planes));
+  }
+  for (auto& m : tb.parts) {  // cap disks (ring_mesh) or bridges, which the test finds not flat and takes whole
+    add_solid(m);
+    piece(Shape::plane);
+  }
+  f.weld();
+  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 4.0 * wall_edge);
+  round_to_ascii_stl(f);
+  out.bed.weld();
+
+  const double domain = c.cross_section_area() * (z1 - z0);
+  const double section = p.clip || n == 0 ? z1 - z0 : top;  // the bed's own height, or the window's (or the empty tube's)
+  const MeshQuality q = mesh_quality(f);
+  out.report = tb.report;
+  out.report["parameters"] = to_json(p);
+  out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
+  out.exact_volume_m3 = domain - tb.solid_volume;
+  out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
+  out.report["void_fraction_bed_section_change"] =
+      -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
+  out.report["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
+  out.report["wall_sagitta_d"] = wall_sag / d;
+  out.report["wall_edge_d"] = wall_edge / d;
+  out.report["wall_delaunay"] = {{"missing_before", splits.missing_before},
+                                 {"missing_after", splits.missing_after},
+                                 {"edges_split", splits.edges_split},
+                                 {"rounds", splits.rounds},
+                                 {"kept", splits.kept}};
+  out.report["triangles"] = f.triangles.size();
+  out.report["min_angle_deg"] = q.min_angle_deg;
+  out.report["min_edge_d"] = q.min_edge / d;
+  out.report["max_edge_d"] = q.max_edge / d;
+  return out;
+}
+
+FluidSurface build_checked_fluid_surface(const Bed& bed, const SurfaceParams& p,
+                                         const std::filesystem::path& bad_triangles_path) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto since = [&t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  FluidSurface fs = build_fluid_surface(bed, p);
+  const double built_at = since();
+  fs.check = check_surface(fs.fluid, SelfIntersectionTest::by_pieces, fs.pieces);
+  nlohmann::json& j = fs.report;
+  j["time_build_s"] = built_at;
+  j["time_check_s"] = since() - built_at;
+  j["check"] = fs.check.to_json();
+  j["fluid_volume_mesh_m3"] = fs.check.volume;
+  if (!fs.check.manifold || !fs.check.closed || fs.check.self_intersecting)
+    throw std::runtime_error(fmt::format("the fluid surface is not valid ({}); {} defective edges, first at{} please "
+                                         "report it with the bed",
+                                         fs.check.to_json().dump(), fs.check.defects.size(),
+                                         describe_defects(fs.check)));
+  j["fluid_volume_relative_error"] = (fs.check.volume - fs.exact_volume_m3) / fs.exact_volume_m3;
+  const double min_angle = j["min_angle_deg"].get<double>();
+  if (min_angle < p.min_angle_deg) {
+    // Say where the needles and slivers are: the nearest particle to each, and all of them in a
+    // file for ParaView.
+    const TriangleMesh bad = triangles_below_angle(fs.fluid, p.min_angle_deg);
+    std::vector<Eigen::Vector3d> centroids;
+    for (std::size_t v = 0; v < bad.points.size(); v += 3)
+      centroids.push_back((bad.points[v] + bad.points[v + 1] + bad.points[v + 2]) / 3.0);
+    const DefectLocations where = locate_defects(bed, centroids, "triangles");
+    write_file_atomically(bad_triangles_path, [&](std::ostream& out) {
+      write_vtp(out, bad,
+                "bedforge " + std::string(kVersion) + " surface triangles below surface.min_angle_deg, lengths in m");
+    });
+    throw ConvergenceError(fmt::format(
+        "surface: {} triangles have an angle below surface.min_angle_deg = {} deg (smallest {:.2f} deg), most near {}; "
+        "written to {}. Refine where contacts meet (surface.contact_edge_length_d), widen the gaps ([contacts]), "
+        "move the clip window, or lower surface.min_angle_deg",
+        bad.triangles.size(), p.min_angle_deg, min_angle, where.summary, bad_triangles_path.string()));
+  }
+  return fs;
+}
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,105 @@
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <nlohmann/json.hpp>
+
+#include "core/bed.hpp"
+#include "core/scene_section.hpp"
+#include "meshing/surface/gap_spacing.hpp"
+#include "meshing/surface/surface_checks.hpp"
+#include "meshing/surface/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// Contact treatment and fluid-domain surface, scene sections [contacts] and [surface]. Lengths
+// in reference diameters d (Sauter mean); `resolve` turns them into metres in one place.
+struct SurfaceParams {
+  // none: spheres as they are (no contact allowed); shrink: every sphere scaled about its
+  // centre; enlarge: every sphere grown, overlaps joined (union); bridge: a cylinder joins each
+  // pair (and sphere and wall) closer than bridge_gap_d; cap: both sides cut flat, leaving cap_gap_d.
+  enum class Treatment { none, shrink, enlarge, bridge, cap };
+  Treatment treatment = Treatment::shrink;
+  Treatment wall_treatment = Treatment::shrink;  // bridge, cap or none; shrink and enlarge act on the walls' contacts too
+  double shrink_factor = 0.99;
+  double enlarge_factor = 1.01;
+  double enlarge_join_gap_d = 0.01;     // enlarge: spheres left nearer than this to a sphere or wall are grown to join it (thin joints are, whatever it is)
+  double bridge_diameter_d = 0.2;
+  double bridge_gap_d = 0.01;           // pairs closer than this get a bridge
+  double cap_gap_d = 0.02;              // pairs closer than this are capped, leaving this gap
+  double edge_length_d = 0.1;           // target triangle edge, walls and spheres
+  double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
+  double growth = 1.5;                  // edge growth per ring away from those loops
+  // Cells across narrow gaps: where a sphere or wall faces another surface closer than
+  // cells_per_gap x edge_length_d, its edge shrinks to gap / cells_per_gap (not below
+  // contact_edge_length_d), and the volume mesh follows. 0: edge_length_d everywhere.
+  double cells_per_gap = 0.0;
+  double inlet_length_d = 1.0;          // empty section from the inlet plane to the floor
+  double outlet_length_d = 1.0;         // empty section from the top of the bed to the outlet
+  // Height window of the bed (above the floor, d) whose planes are the inlet and outlet,
+  // instead of the empty sections: the spheres crossing them are cut there.
+  bool clip = false;
+  double clip_bottom_d = 0.0, clip_top_d = 0.0;
+  double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
+  double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
+  // Quality gate: a surface with a smaller angle fails, its triangles written to
+  // bad_triangles.vtp (0 turns the gate off).
+  double min_angle_deg = 2.0;
+  // No treatment changes a sphere: the surface's spheres are the bed's own.
+  bool keeps_spheres() const { return treatment == Treatment::none && wall_treatment == Treatment::none; }
+};
+const char* treatment_name(SurfaceParams::Treatment t);
+// A scene's defaults are those of a pressure-drop run, where they differ from the struct's (the
+// plain geometry a caller of this library starts from): bridged contacts (they change the bed's
+// solid by +0.2 %, shrink by -3 %), a 0.15 d edge, a third of it at contacts and 4 cells across
+// narrow gaps, the settings whose studies on a = 5, N = 500 converge in the asymptotic range
+// (docs/defaults.md).
+inline constexpr double kSceneEdgeLengthD = 0.15, kSceneContactEdgeLengthD = 0.05, kSceneCellsPerGap = 4.0;
+SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);
+nlohmann::json to_json(const SurfaceParams& p);
+
+// The rule for edges across narrow gaps as the surface stage applies it, from `p`'s
+// cells_per_gap, contact and surface edges (d the reference diameter, m); unset when
+// p.cells_per_gap is 0. The other inputs are GapSpacing's, kept by reference.
+std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                      const std::vector<double>& radii, const std::vector<char>& kept,
+                                      const Container& container);
+
+// The fluid domain of `bed` under `p`, known before its surface is meshed: the treated bed's
+// exact fluid volume (m^3) and the tetrahedra its narrow gaps add to a mesh of the surface edge
+// everywhere (GapSpacing::added_cells with `volume_per_cell`; 0 without cells_per_gap).
+// Throws treat_contacts's InputErrors.
+struct FluidDomainSize {
+  double volume_m3 = 0.0;
+  double gap_cells = 0.0;
+};
+FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell);
+
+struct FluidSurface {
+  TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)
+  TriangleMesh bed;    // the closed treated particles, normals outward (m)
+  double exact_volume_m3 = 0.0;  // of the treated geometry's fluid domain, what the facets approximate
+  std::vector<SurfacePiece> pieces;  // of `fluid`, each meshed on its own: walls, inlet, outlet, spheres, parts
+  SurfaceCheck check;            // CGAL's verdict on `fluid` (build_checked_fluid_surface only)
+  nlohmann::json report;
+};
+
+// Treats the contacts of `bed` and builds the fluid domain's surface: patches `inlet`,
+// `outlet`, `wall` (the four sides of a box; and `inner_wall` for an annulus), `particles`. InputError, naming the
+// particles, when the treatment leaves spheres overlapping or touching a wall, or a wall gap
+// so thin that wall facets short enough to keep clear of it would be shorter than the contact
+// edge (the curved walls take a shorter edge than the spheres where their gaps need it); the
+// report holds the treatment's effect (contacts
+// treated, solid volume and area change, smallest gap) and the surface's accuracy (chordal
+// deviation, exact fluid volume, triangle quality).
+FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& params);
+
+// The surface stage: build_fluid_surface, then CGAL's check (closed, 2-manifold, no
+// self-intersection, tested by pieces; the enclosed volume against
+// the exact one, all into the report) and the angle gate. std::runtime_error locating the defects
+// when the surface is not valid (a defect of ours, not of the input); ConvergenceError naming the
+// particles nearest the triangles below params.min_angle_deg, after writing those triangles to
+// `bad_triangles_path` (VTK PolyData).
+FluidSurface build_checked_fluid_surface(const Bed& bed, const SurfaceParams& params,
+                                         const std::filesystem::path& bad_triangles_path);
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,295 @@
+#include "meshing/surface/wall_mesh.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "core/random.hpp"
+#include "meshing/surface/planar_cdt.hpp"
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/spaced_points.hpp"
+
+namespace bedforge::meshing {
+
+namespace {
+
+double wrap_2pi(double a) {
+  a = std::fmod(a, 2.0 * std::numbers::pi);
+  return a < 0.0 ? a + 2.0 * std::numbers::pi : a;
+}
+
+double wrap_pi(double a) { return wrap_2pi(a + std::numbers::pi) - std::numbers::pi; }
+
+}  // namespace
+
+WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
+                   bool outward, const std::string& patch, const SpacingField& field) {
+  const int n = ring_points(R, edge);
+  // Sites lie on a dyadic grid in s whose step divides the period, so a site's copy one period
+  // on is its exact translate: the exact predicates then see the two ends of the strip alike
+  // (with rounded copies, cocircular hole loops were triangulated differently at each end).
+  const double quantum = std::ldexp(1.0, std::ilogb(2.0 * std::numbers::pi * R) - 36);
+  auto on_grid = [quantum](Eigen::Vector2d q) {
+    q.x() = std::round(q.x() / quantum) * quantum;
+    return q;
+  };
+  const double step = 2.0 * std::numbers::pi * R / n, period = on_grid({2.0 * std::numbers::pi * R, 0.0}).x(),
+               margin = 3.0 * step;
+  const int nz = 2 * std::max(1, static_cast<int>(std::ceil((z1 - z0) / (std::sqrt(3.0) * step))));
+  auto row_z = [&](int k) { return k == nz ? z1 : z0 + (z1 - z0) * k / nz; };
+  auto row_frame = [&](int k) { return Frame::along(Eigen::Vector3d(0.0, 0.0, row_z(k)), Eigen::Vector3d::UnitZ()); };
+  const Eigen::Vector3d shift(period, 0.0, 0.0);
+
+  std::vector<Eigen::Vector3d> points;  // 3D vertices
+  std::vector<Eigen::Vector2d> uv;      // 2D sites: every vertex at s in [0, period), copies in the margins
+  std::vector<int> vertex;              // site -> 3D vertex
+  std::vector<int> copy;                // site -> 0 for the vertex itself, +1 or -1 for its copy at s +- period
+  SpacedPoints spaced(step);            // the vertices at s in [0, period)
+  auto fits = [&](const Eigen::Vector2d& q, double spacing) {
+    const Eigen::Vector3d p(q.x(), q.y(), 0.0);
+    return spaced.fits(p, spacing) && spaced.fits(p + shift, spacing) && spaced.fits(p - shift, spacing);
+  };
+  auto add_site = [&](const Eigen::Vector2d& q, int v, int shifted) {
+    uv.push_back(q), vertex.push_back(v), copy.push_back(shifted);
+  };
+  // A vertex, its site, and its copy one period away when it lies within the margin of an end.
+  auto add_vertex = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& at, double spacing, bool copies) {
+    const Eigen::Vector2d q = on_grid(at);
+    points.push_back(p);
+    const int v = static_cast<int>(points.size()) - 1;
+    add_site(q, v, 0);
+    spaced.add(Eigen::Vector3d(q.x(), q.y(), 0.0), spacing);
+    if (copies && q.x() < margin) add_site(q + Eigen::Vector2d(period, 0.0), v, 1);
+    if (copies && q.x() > period - margin) add_site(q - Eigen::Vector2d(period, 0.0), v, -1);
+  };
+  // The strip's ends (s = 0) along the lattice generator farthest from every hole's centre:
+  // faces there are matched with their copies one period on, so keep holes away from it where
+  // the wall has room.
+  std::vector<double> centres;
+  for (const auto& hole : holes) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : hole.loop) mean += Eigen::Vector2d(p.x(), p.y()).normalized();
+    centres.push_back(std::atan2(mean.y(), mean.x()));
+  }
+  int j_seam = 0;
+  double clearest = -1.0;
+  for (int j = 0; j < n && !centres.empty(); ++j) {
+    double clearance = std::numbers::pi;
+    for (double c : centres) clearance = std::min(clearance, std::abs(wrap_pi(2.0 * std::numbers::pi * j / n - c)));
+    if (clearance > clearest) clearest = clearance, j_seam = j;
+  }
+  const double seam = 2.0 * std::numbers::pi * j_seam / n;
+  // 1. Fixed vertices: the end rows and the hole loops; a hole is unrolled around its own
+  // centre, so it stays one polygon even where it crosses theta = 0.
+  for (int k : {0, nz})
+    for (int j = 0; j < n; ++j)
+      add_vertex(row_frame(k).to_world(on_circle(R, j, n, false, 0.0)),
+                 Eigen::Vector2d(R * wrap_2pi(2.0 * std::numbers::pi * j / n - seam), row_z(k)), step, true);
+  std::vector<std::vector<Eigen::Vector2d>> polygons;
+  std::vector<std::vector<int>> loop_sites;
+  std::vector<std::size_t> original;  // per hole, its polygon at offset 0
+  for (const auto& hole : holes) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : hole.loop) mean += Eigen::Vector2d(p.x(), p.y()).normalized();
+    const double centre = wrap_2pi(std::atan2(mean.y(), mean.x()) - seam);
+    std::vector<Eigen::Vector2d> poly;
+    for (const auto& p : hole.loop) {
+      const Eigen::Vector2d q = on_grid({R * (centre + wrap_pi(std::atan2(p.y(), p.x()) - seam - centre)), p.z()});
+      if (q.y() <= z0 + 0.5 * step || q.y() >= z1 - 0.5 * step)
+        throw CutConflict("a hole in the wall reaches the inlet or outlet plane");
+      poly.push_back(q);
+      points.push_back(p);
+      spaced.add(Eigen::Vector3d(wrap_2pi(q.x() / R) * R, q.y(), 0.0), std::min(hole.spacing, step));
+    }
+    const int first = static_cast<int>(points.size() - poly.size());
+    double lo = poly[0].x(), hi = lo;
+    for (const auto& q : poly) lo = std::min(lo, q.x()), hi = std::max(hi, q.x());
+    original.push_back(polygons.size());  // offset 0 comes first
+    for (double offset : {0.0, -period, period}) {
+      if (offset != 0.0 && hi + offset < -margin) continue;
+      if (offset != 0.0 && lo + offset > period + margin) continue;
+      polygons.emplace_back(), loop_sites.emplace_back();
+      for (std::size_t k = 0; k < poly.size(); ++k) {
+        polygons.back().push_back(poly[k] + Eigen::Vector2d(offset, 0.0));
+        loop_sites.back().push_back(static_cast<int>(uv.size()));
+        add_site(polygons.back().back(), first + static_cast<int>(k), offset == 0.0 ? 0 : offset > 0.0 ? 1 : -1);
+      }
+    }
+  }
+  const PolygonIndex hole_index(polygons);
+  auto in_hole = [&](const Eigen::Vector2d& q) { return hole_index.contains(q); };
+  auto on_wall = [&](const Eigen::Vector2d& q) {
+    const double theta = seam + q.x() / R;
+    return Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y());
+  };
+  // The spacing asked for at q: `spacing`, or less where the field asks for less.
+  auto try_add = [&](Eigen::Vector2d q, double spacing) {
+    q.x() = R * wrap_2pi(q.x() / R);
+    if (field) spacing = std::min(spacing, field.at(on_wall(q)));
+    if (q.y() < z0 + 0.4 * spacing || q.y() > z1 - 0.4 * spacing) return;
+    if (in_hole(q) || in_hole(q + Eigen::Vector2d(period, 0.0)) || !fits(q, spacing)) return;
+    add_vertex(on_wall(q), q, spacing, true);
+  };
+  // 2. Rings graded away from the holes (around the first copy of each).
+  std::vector<double> spacing;
+  for (const auto& hole : holes) spacing.push_back(hole.spacing);
+  graded_rings(spacing, step, growth, [&](std::size_t h, int ring, double offset, double next) {
+    for (const auto& q : offset_polygon(polygons[original[h]], offset, next, ring % 2 == 1)) try_add(q, next);
+  });
+  // 3. The staggered lattice: of the field's finest spacing where it asks for less than the
+  // step (finest first), then of the step.
+  if (field && field.finest < step) {
+    const int nf = static_cast<int>(std::ceil(period / field.finest));
+    const double row = std::sqrt(3.0) / 2.0 * field.finest;
+    offer_finest_first<Eigen::Vector2d>(
+        field, step,
+        [&](const auto& visit) {
+          for (int k = 1; z0 + k * row < z1; ++k)
+            for (int j = 0; j < nf; ++j) visit(Eigen::Vector2d(period * (j + 0.5 * (k % 2)) / nf, z0 + k * row));
+        },
+        on_wall, try_add);
+  }
+  for (int k = 1; k < nz; ++k)
+    for (int j = 0; j < n; ++j)
+      try_add(Eigen::Vector2d(R * ((j + (k % 2 == 1 ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row_z(k)), step);
+
+  // 4. Constrained Delaunay triangulation of the strip; faces inside a hole go to `inside`.
+  Cdt cdt;
+  const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, uv, step);
+  for (const auto& sites : loop_sites)
+    for (std::size_t k = 0; k < sites.size(); ++k)
+      cdt.insert_constraint(handle[sites[k]], handle[sites[(k + 1) % sites.size()]]);
+  WallMesh out;
+  out.outside.points = out.inside.points = points;
+  for (auto f : cdt.finite_face_handles()) {
+    std::array<int, 3> t;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    bool original = false, below = false;
+    for (int k = 0; k < 3; ++k) {
+      const int site = f->vertex(k)->info();
+      t[k] = vertex[site];
+      centroid += uv[site] / 3.0;
+      original |= copy[site] == 0, below |= copy[site] < 0;
+    }
+    // Across the strip's ends the same face appears twice, one period apart: keep the one
+    // with a vertex itself and none from the copies below s = 0 (exact, whatever the rounding).
+    if (!original || below) continue;
+    (in_hole(centroid) ? out.inside : out.outside).triangles.push_back(t);
+  }
+  for (TriangleMesh* m : {&out.outside, &out.inside}) {
+    m->patch.assign(m->triangles.size(), 0);
+    m->patches = {patch};
+    orient_by(*m, [&](const Eigen::Vector3d& q) {
+      const Eigen::Vector3d radial(q.x(), q.y(), 0.0);
+      return outward ? radial : Eigen::Vector3d(-radial);
+    });
+    drop_unused_points(*m);
+  }
+  return out;
+}
+
+WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch,
+                    const SpacingField& field) {
+  auto local = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - f.origin).dot(f.u), (p - f.origin).dot(f.v)); };
+  std::vector<Eigen::Vector3d> points;  // 3D vertices, one per site
+  std::vector<Eigen::Vector2d> uv;      // their sites
+  SpacedPoints spaced(edge);
+  auto add_vertex = [&](const Eigen::Vector3d& p, const Eigen::Vector2d& q, double spacing) {
+    points.push_back(p), uv.push_back(q);
+    spaced.add(Eigen::Vector3d(q.x(), q.y(), 0.0), spacing);
+  };
+  // 1. Fixed vertices: the boundary loops (with samples between their vertices, so nothing is
+  // placed too close to a boundary edge) and the hole loops.
+  std::vector<std::vector<Eigen::Vector2d>> outline, polygons;
+  std::vector<std::vector<int>> loops;  // constrained loops, as site indices
+  for (const auto& loop : boundary) {
+    outline.emplace_back(), loops.emplace_back();
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const Eigen::Vector2d a = local(loop[k]), b = local(loop[(k + 1) % loop.size()]);
+      const double spacing = std::min(edge, (b - a).norm());
+      outline.back().push_back(a);
+      loops.back().push_back(static_cast<int>(uv.size()));
+      add_vertex(loop[k], a, spacing);
+      for (double t : {0.25, 0.5, 0.75}) spaced.add(Eigen::Vector3d(a.x() + t * (b.x() - a.x()), a.y() + t * (b.y() - a.y()), 0.0), spacing);
+    }
+  }
+  auto in_region = [&](const Eigen::Vector2d& q) {
+    if (!inside_polygon(outline[0], q)) return false;
+    for (std::size_t k = 1; k < outline.size(); ++k)
+      if (inside_polygon(outline[k], q)) return false;
+    return true;
+  };
+  for (const auto& hole : holes) {
+    polygons.emplace_back(), loops.emplace_back();
+    for (const auto& p : hole.loop) {
+      const Eigen::Vector2d q = local(p);
+      if (!in_region(q)) throw CutConflict(fmt::format("a hole (particle {}) reaches the edge of the {}", hole.particle, patch));
+      polygons.back().push_back(q);
+      loops.back().push_back(static_cast<int>(uv.size()));
+      add_vertex(p, q, std::min(hole.spacing, edge));
+    }
+  }
+  const PolygonIndex hole_index(polygons);
+  // Free sites move by up to kBreakCocircular / 2 of their spacing: the lattices and rings below
+  // hold four points on a circle again and again (see kBreakCocircular).
+  Rng nudge(1);
+  auto try_add = [&](const Eigen::Vector2d& lattice, double spacing) {
+    const Eigen::Vector2d q = lattice + kBreakCocircular * spacing * Eigen::Vector2d(nudge.uniform() - 0.5, nudge.uniform() - 0.5);
+    const Eigen::Vector3d s(q.x(), q.y(), 0.0);
+    if (field) spacing = std::min(spacing, field.at(f.to_world(s)));
+    if (!in_region(q) || hole_index.contains(q) || !spaced.fits(s, spacing)) return;
+    add_vertex(f.to_world(s), q, spacing);
+  };
+  // 2. Rings graded away from the holes.
+  std::vector<double> spacing;
+  for (const auto& hole : holes) spacing.push_back(hole.spacing);
+  graded_rings(spacing, edge, growth, [&](std::size_t h, int ring, double offset, double next) {
+    for (const auto& q : offset_polygon(polygons[h], offset, next, ring % 2 == 1)) try_add(q, next);
+  });
+  // 3. The staggered lattice over the outer loop's bounding box: of the field's finest spacing
+  // where it asks for less than the edge (finest first), then of the edge.
+  Eigen::Vector2d lo = outline[0][0], hi = lo;
+  for (const auto& q : outline[0]) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  auto staggered = [&](double step, const std::function<void(const Eigen::Vector2d&)>& visit) {
+    const double row = std::sqrt(3.0) / 2.0 * step;
+    for (int k = 0; lo.y() + k * row <= hi.y(); ++k)
+      for (int j = 0; lo.x() + (j + 0.5 * (k % 2)) * step <= hi.x(); ++j)
+        visit(Eigen::Vector2d(lo.x() + (j + 0.5 * (k % 2)) * step, lo.y() + k * row));
+  };
+  if (field && field.finest < edge)
+    offer_finest_first<Eigen::Vector2d>(
+        field, edge, [&](const auto& visit) { staggered(field.finest, visit); },
+        [&](const Eigen::Vector2d& q) { return f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)); }, try_add);
+  staggered(edge, [&](const Eigen::Vector2d& q) { try_add(q, edge); });
+
+  // 4. Constrained Delaunay triangulation; faces inside a hole go to `inside`.
+  Cdt cdt;
+  const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, uv, edge);
+  for (const auto& loop : loops)
+    for (std::size_t k = 0; k < loop.size(); ++k) cdt.insert_constraint(handle[loop[k]], handle[loop[(k + 1) % loop.size()]]);
+  WallMesh out;
+  out.outside.points = out.inside.points = points;
+  for (auto fh : cdt.finite_face_handles()) {
+    std::array<int, 3> t;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      t[k] = fh->vertex(k)->info();
+      centroid += uv[t[k]] / 3.0;
+    }
+    if (!in_region(centroid)) continue;
+    (hole_index.contains(centroid) ? out.inside : out.outside).triangles.push_back(t);
+  }
+  for (TriangleMesh* m : {&out.outside, &out.inside}) {
+    m->patch.assign(m->triangles.size(), 0);
+    m->patches = {patch};
+    orient_by(*m, [&](const Eigen::Vector3d&) { return along_w ? f.w : Eigen::Vector3d(-f.w); });
+    drop_unused_points(*m);
+  }
+  return out;
+}
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,49 @@
+#pragma once
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// A hole in a container wall where the bed meets it (a bridge's end, a sphere crossing the
+// wall): a closed loop of vertices on the wall, shared exactly with the part that meets it.
+struct WallHole {
+  std::vector<Eigen::Vector3d> loop;  // m
+  double spacing = 0.0;               // distance between loop vertices (m)
+  int particle = -1;                  // for error messages
+};
+
+struct WallMesh {
+  TriangleMesh outside;  // the wall less its holes
+  TriangleMesh inside;   // what the holes cut out (closes the bed solid there)
+};
+
+// Lateral wall of the cylinder of radius R about the z axis, z0 <= z <= z1, with holes.
+// Meshed unrolled (s = R theta, z): a staggered lattice of spacing about `edge` (its end rows
+// are circle_loop(Frame at z0 or z1, R, ring_points(R, edge)), the edges of ring_mesh), the
+// hole loops, rings graded away from them by `growth`, thinned like sphere_mesh, and a CGAL
+// constrained Delaunay triangulation with the loops as constraints (no vertex is added). The
+// unrolled strip is cut along a lattice generator clear of every hole; its two sides share
+// their vertices. `outward` = normals away from the axis. CutConflict when a hole crosses the
+// strip's ends or no generator is clear of the holes. With a `field`, spacing as in sphere_mesh.
+WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
+                   bool outward, const std::string& patch, const SpacingField& field = {});
+
+// Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
+// the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the
+// plane shared with the faces next to this one, and constraints; hole loops are shared with the
+// parts that meet the face. Vertices as in wall_mesh: the loops, rings graded away from the
+// holes, a staggered lattice of spacing about `edge`, none closer than 0.8 x the mean spacing
+// to another or to a boundary edge; then a constrained Delaunay triangulation (no vertex is
+// added). Normals +w if `along_w`. CutConflict when a hole vertex lies outside the face. A
+// hole may come as close to the boundary as its own loop's chords allow (a sphere 0.005 d off
+// the wall): the triangles in that gap are as narrow as the gap.
+WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
+                    const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch,
+                    const SpacingField& field = {});
+
+}  // namespace bedforge::meshing

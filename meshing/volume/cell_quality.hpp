@@ -1,0 +1,46 @@
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+#include "meshing/volume/poly_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// Limits a volume mesh must meet, in the terms of OpenFOAM's checkMesh. checkMesh itself fails
+// a mesh at non-orthogonality >= 90 deg, skewness > 4, aspect ratio > 1000 or a volume <= 0;
+// the default non-orthogonality limit is tighter because simpleFoam's non-orthogonal
+// correction loses accuracy and robustness long before 90 deg.
+struct QualityGate {
+  double max_non_orthogonality_deg = 85.0;
+  double max_skewness = 4.0;
+  double max_aspect_ratio = 1000.0;
+  double min_volume_d3 = 1e-12;  // smallest cell volume, in reference diameters cubed
+};
+
+// Per-cell and summary quality of a PolyMesh, with OpenFOAM's definitions
+// (primitiveMeshTools): non-orthogonality of an internal face is the angle between its area
+// vector and the owner-to-neighbour centre vector; skewness is the distance from the face
+// centre to where that centre vector crosses the face, over the face's extent in that
+// direction (boundary faces: from the owner centre along the normal); aspect ratio is the
+// larger of the ratio of the cell's projected areas and (sum |S_f|)/6/V^(2/3).
+struct CellQuality {
+  std::vector<double> non_orthogonality_deg;  // per cell: worst over its internal faces
+  std::vector<double> skewness;               // per cell: worst over its faces
+  std::vector<double> aspect_ratio;           // per cell
+  std::vector<double> volume;                 // per cell, m^3
+
+  double max_non_orthogonality_deg = 0.0, mean_non_orthogonality_deg = 0.0;  // internal faces; mean as checkMesh: acos(mean cos)
+  long faces_over_70_deg = 0;                  // checkMesh's "severely non-orthogonal"
+  double max_skewness = 0.0, max_aspect_ratio = 0.0;
+  double min_volume = 0.0, total_volume = 0.0;  // m^3
+  std::vector<long> non_orthogonality_histogram;  // internal faces in 10-degree bins, 0-10 ... 80-90+
+
+  // Cells failing `gate` (d_ref in m scales the volume limit).
+  std::vector<int> bad_cells(const QualityGate& gate, double d_ref) const;
+  nlohmann::json to_json(double d_ref) const;
+};
+
+CellQuality cell_quality(const PolyMesh& mesh);
+
+}  // namespace bedforge::meshing

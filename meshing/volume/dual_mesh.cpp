@@ -1,0 +1,270 @@
+#include "meshing/volume/dual_mesh.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace bedforge::meshing {
+
+namespace {
+
+// Compressed rows: row r holds items[offsets[r]] ... items[offsets[r + 1] - 1].
+struct Rows {
+  std::vector<int> offsets, items;
+  std::span<const int> operator[](int r) const {
+    return {items.data() + offsets[r], static_cast<std::size_t>(offsets[r + 1] - offsets[r])};
+  }
+};
+
+// Rows of `n` from the (row, item) pairs `visit` hands to its callback, the same on both calls
+// (one counts, one fills): no per-row vectors, which at millions of rows cost more than the items.
+template <class Visit>
+Rows make_rows(int n, Visit visit) {
+  Rows r;
+  r.offsets.assign(n + 1, 0);
+  visit([&](int row, int) { ++r.offsets[row + 1]; });
+  std::partial_sum(r.offsets.begin(), r.offsets.end(), r.offsets.begin());
+  r.items.resize(r.offsets[n]);
+  std::vector<int> next(r.offsets.begin(), r.offsets.end() - 1);
+  visit([&](int row, int item) { r.items[next[row]++] = item; });
+  return r;
+}
+
+// Where point p sits in face f (-1 if not on it), and the points before and after it.
+int place(const Face& f, int p) {
+  for (int k = 0; k < f.size(); ++k)
+    if (f[k] == p) return k;
+  return -1;
+}
+int before(const Face& f, int k) { return f[(k + f.size() - 1) % f.size()]; }
+int after(const Face& f, int k) { return f[(k + 1) % f.size()]; }
+
+// Whether f, in its stored order, runs from a straight to b.
+bool runs(const Face& f, int a, int b) {
+  const int k = place(f, a);
+  return k >= 0 && after(f, k) == b;
+}
+
+std::string where(const Eigen::Vector3d& x) { return fmt::format("({:.6g}, {:.6g}, {:.6g}) m", x.x(), x.y(), x.z()); }
+
+}  // namespace
+
+PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& cell_centres, double feature_angle_deg) {
+  const int n_points = static_cast<int>(m.points.size());
+  const int n_cells = m.cells;
+  const int n_faces = static_cast<int>(m.faces.size());
+  const int n_internal = m.internal_faces();
+
+  std::vector<int> patch_of(n_faces - n_internal, -1);
+  for (int k = 0; k < static_cast<int>(m.patches.size()); ++k)
+    for (int f = m.patches[k].start; f < m.patches[k].start + m.patches[k].size; ++f) patch_of[f - n_internal] = k;
+
+  // Who touches whom: a cell's faces, a point's cells, a point's boundary faces.
+  const Rows cell_faces = make_rows(n_cells, [&](auto add) {
+    for (int f = 0; f < n_faces; ++f) {
+      add(m.owner[f], f);
+      if (f < n_internal) add(m.neighbour[f], f);
+    }
+  });
+  const Rows point_cells = make_rows(n_points, [&](auto add) {
+    std::array<int, 8> seen{};
+    for (int c = 0; c < n_cells; ++c) {
+      int n = 0;
+      for (int f : cell_faces[c])
+        for (int v : m.faces[f])
+          if (std::find(seen.begin(), seen.begin() + n, v) == seen.begin() + n && n < 8) seen[n++] = v;
+      for (int k = 0; k < n; ++k) add(seen[k], c);
+    }
+  });
+  const Rows point_boundary = make_rows(n_points, [&](auto add) {
+    for (int f = n_internal; f < n_faces; ++f)
+      for (int v : m.faces[f]) add(v, f);
+  });
+
+  // Dual cells numbered as their points sorted by z.
+  std::vector<int> order(n_points), rank(n_points);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.points[a].z() < m.points[b].z(); });
+  for (int i = 0; i < n_points; ++i) rank[order[i]] = i;
+
+  std::vector<FaceGeometry> boundary(n_faces - n_internal);
+  for (int f = n_internal; f < n_faces; ++f) boundary[f - n_internal] = face_geometry(m.points, m.faces[f]);
+
+  // Feature points, as polyDualMesh marks them: both ends of a boundary edge between patches,
+  // sharper than the angle, or not shared by exactly two boundary faces; and points where the
+  // boundary faces around do not form one ring (two surfaces touching at a point).
+  std::vector<char> feature(n_points, 0);
+  const double min_cos = std::cos(feature_angle_deg * std::numbers::pi / 180.0);
+  for (int p = 0; p < n_points; ++p) {
+    const auto around = point_boundary[p];
+    for (int f : around) {
+      const int q = after(m.faces[f], place(m.faces[f], p));
+      int partner = -1, partners = 0, same_way = 0;
+      for (int g : around) {
+        if (runs(m.faces[g], q, p)) partner = g, ++partners;
+        if (runs(m.faces[g], p, q)) ++same_way;
+      }
+      const bool sharp = partners == 1 && same_way == 1 &&
+                         (patch_of[f - n_internal] != patch_of[partner - n_internal] ||
+                          boundary[f - n_internal].area.normalized().dot(boundary[partner - n_internal].area.normalized()) <
+                              min_cos);
+      if (partners != 1 || same_way != 1 || sharp) feature[p] = feature[q] = 1;
+    }
+  }
+  // The boundary face around p after f, turning about the outward normal: the one whose point
+  // after p is the one before p in f (-1 if none).
+  auto next_around = [&](int p, int f) {
+    const int a = before(m.faces[f], place(m.faces[f], p));
+    for (int g : point_boundary[p])
+      if (after(m.faces[g], place(m.faces[g], p)) == a) return g;
+    return -1;
+  };
+  for (int p = 0; p < n_points; ++p) {
+    const auto around = point_boundary[p];
+    if (around.empty() || feature[p]) continue;
+    int f = around[0], steps = 0;
+    do {
+      f = next_around(p, f);
+      ++steps;
+    } while (f >= 0 && f != around[0] && steps <= static_cast<int>(around.size()));
+    if (f != around[0] || steps != static_cast<int>(around.size())) feature[p] = 1;
+  }
+
+  // The dual's points: cell centres, boundary face centres, then feature points and edge
+  // midpoints as they are first needed.
+  PolyhedralMesh d;
+  d.points = cell_centres;
+  for (const FaceGeometry& b : boundary) d.points.push_back(b.centre);
+  const int first_boundary_centre = n_cells - n_internal;  // + boundary face index
+  std::vector<int> point_at(n_points, -1);
+  for (int p : order)
+    if (feature[p]) point_at[p] = static_cast<int>(d.points.size()), d.points.push_back(m.points[p]);
+  std::unordered_map<std::uint64_t, int> midpoints;
+  auto midpoint = [&](int a, int b) {
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+    const auto [it, added] = midpoints.emplace(key, static_cast<int>(d.points.size()));
+    if (added) d.points.push_back(0.5 * (m.points[a] + m.points[b]));
+    return it->second;
+  };
+
+  // The face through which the walk about p -> q (right-handed) leaves cell c: the one that,
+  // turned to point out of c, runs from p to q (-1 if c has no such face).
+  auto exit_face = [&](int c, int p, int q) {
+    for (int f : cell_faces[c])
+      if (m.owner[f] == c ? runs(m.faces[f], p, q) : runs(m.faces[f], q, p)) return f;
+    return -1;
+  };
+  auto no_ring = [&](int p, int q) {
+    return std::runtime_error(fmt::format("dual mesh: the cells around the edge from {} to {} do not form a ring",
+                                          where(m.points[p]), where(m.points[q])));
+  };
+  // Appends to `polygon` the centres of the cells met walking about p -> q from cell c, until the
+  // walk leaves through a boundary face (returned) or comes back to c (-1); no more cells than
+  // touch p.
+  std::vector<int> polygon;
+  auto walk = [&](int c, int p, int q) {
+    const int first = c, limit = static_cast<int>(point_cells[p].size());
+    for (int steps = 1;; ++steps) {
+      polygon.push_back(c);
+      const int f = exit_face(c, p, q);
+      if (f < 0 || steps > limit) throw no_ring(p, q);
+      if (f >= n_internal) return f;
+      c = m.owner[f] == c ? m.neighbour[f] : m.owner[f];
+      if (c == first) return -1;
+    }
+  };
+
+  // Internal faces, one per edge (p, q), owned by the lower rank: by owner, then neighbour.
+  std::vector<int> ends;
+  for (int i = 0; i < n_points; ++i) {
+    const int p = order[i];
+    ends.clear();
+    for (int c : point_cells[p])
+      for (int f : cell_faces[c]) {
+        const int k = place(m.faces[f], p);
+        if (k < 0) continue;
+        for (int q : {before(m.faces[f], k), after(m.faces[f], k)})
+          if (rank[q] > i) ends.push_back(q);
+      }
+    std::sort(ends.begin(), ends.end(), [&](int a, int b) { return rank[a] < rank[b]; });
+    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    for (int q : ends) {
+      // On the boundary the walk runs from each boundary face that enters the domain (runs q -> p)
+      // to the one that leaves it; inside, once around.
+      bool on_boundary = false;
+      for (int start : point_boundary[p]) {
+        if (!runs(m.faces[start], q, p)) continue;
+        on_boundary = true;
+        polygon.assign(1, first_boundary_centre + start);
+        const int end = walk(m.owner[start], p, q);
+        if (end < 0) throw no_ring(p, q);
+        polygon.push_back(first_boundary_centre + end);
+        if (feature[p] || feature[q]) polygon.push_back(midpoint(p, q));
+        d.faces.push_back(polygon);
+        d.owner.push_back(i);
+        d.neighbour.push_back(rank[q]);
+      }
+      if (on_boundary) continue;
+      int first = -1;
+      for (int c : point_cells[p])
+        if (exit_face(c, p, q) >= 0) {
+          first = c;
+          break;
+        }
+      if (first < 0) throw no_ring(p, q);
+      polygon.clear();
+      if (walk(first, p, q) >= 0) throw no_ring(p, q);
+      d.faces.push_back(polygon);
+      d.owner.push_back(i);
+      d.neighbour.push_back(rank[q]);
+    }
+  }
+
+  // Boundary faces, patch by patch: around each boundary point, its faces' centres in turn
+  // (with the midpoints of edges to feature points), or at a feature point one quadrilateral
+  // per boundary face, the feature point at its corner.
+  for (int k = 0; k < static_cast<int>(m.patches.size()); ++k) {
+    PolyMesh::Patch patch = m.patches[k];
+    patch.start = static_cast<int>(d.faces.size());
+    for (int i = 0; i < n_points; ++i) {
+      const int p = order[i];
+      const auto around = point_boundary[p];
+      auto on_patch = [&](int f) { return patch_of[f - n_internal] == k; };
+      if (std::none_of(around.begin(), around.end(), on_patch)) continue;
+      if (feature[p]) {
+        for (int f : around) {
+          if (!on_patch(f)) continue;
+          const int at = place(m.faces[f], p);
+          const int quad[4] = {point_at[p], midpoint(p, after(m.faces[f], at)), first_boundary_centre + f,
+                               midpoint(before(m.faces[f], at), p)};
+          d.faces.push_back(quad);
+          d.owner.push_back(i);
+        }
+        continue;
+      }
+      polygon.clear();
+      int f = around[0];
+      do {
+        polygon.push_back(first_boundary_centre + f);
+        const int a = before(m.faces[f], place(m.faces[f], p));
+        if (feature[a]) polygon.push_back(midpoint(p, a));
+        f = next_around(p, f);
+      } while (f != around[0]);
+      d.faces.push_back(polygon);
+      d.owner.push_back(i);
+    }
+    patch.size = static_cast<int>(d.faces.size()) - patch.start;
+    d.patches.push_back(patch);
+  }
+  d.cells = n_points;
+  return d;
+}
+
+}  // namespace bedforge::meshing

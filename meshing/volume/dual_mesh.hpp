@@ -1,0 +1,28 @@
+#pragma once
+#include "meshing/volume/poly_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// The polyhedral dual of a volume mesh, made as OpenFOAM's `polyDualMesh <angle>` makes it
+// (meshDualiser with its simple feature marking), so that a case can be written on the dual
+// without running polyDualMesh, whose peak was about 1 kB per tetrahedron.
+//   mesh                  tetrahedra (pyramids, prisms too), m; points all used
+//   cell_centres          C x 3, m: its cells' centres as OpenFOAM computes them
+//                         (cell_geometry(mesh).centres, which the caller has already)
+//   feature_angle_deg     a boundary edge between faces whose normals differ by more than this,
+//                         or between two patches, is a feature edge: its ends stay points of the
+//                         dual, and its midpoint too
+// Returns one cell per point of `mesh`, numbered as the points sorted by z (bottom to top, a small
+// matrix bandwidth in a column). Its points: the cells' centres (OpenFOAM's), the boundary faces'
+// centres, the feature points and the midpoints of the boundary edges at a feature point. Each
+// edge of `mesh` becomes an internal face through the centres of the cells around it (and of the
+// two boundary faces, and its midpoint, when it lies on the boundary); each boundary point
+// becomes, per patch, a face through the centres of its boundary faces, or, at a feature point,
+// one quadrilateral per boundary face (the point, two edge midpoints, the face's centre).
+// Internal faces come in upper-triangular order, boundary faces patch by patch as in `mesh`.
+// std::runtime_error, with the location, when an edge's cells do not form a ring (a mesh
+// that is not a manifold there).
+PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d>& cell_centres,
+                         double feature_angle_deg);
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,47 @@
+#pragma once
+#include <filesystem>
+#include <vector>
+
+#include "core/bed.hpp"
+#include "core/progress.hpp"
+#include "meshing/surface/fluid_surface.hpp"
+#include "meshing/volume/volume_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// The fluid domain meshed in axial slabs, one gmsh run each, and the slabs joined into one
+// mesh: gmsh's peak memory (its tetrahedra, then its optimiser's connectivity) follows the
+// largest slab instead of the whole bed. Each slab is the surface stage's domain clipped to its
+// heights (build_fluid_surface with a clip window): the planes between slabs cut the spheres
+// crossing them, and both slabs triangulate a shared plane alike, so the joined cells are
+// conforming and the planes' triangles become internal faces. A plane through a treated contact
+// (bridge, cap, union) would open it, so slabs serve the shrink and none treatments only.
+
+// Whether a bed under `surface` can be meshed in slabs with `params`: contacts shrunk or left
+// alone (and walls too), and no prism layers (they would meet the planes between slabs).
+bool slabs_possible(const SurfaceParams& surface, const VolumeMeshParams& params);
+
+// How many slabs: params.slabs when set; else, when slabs_possible, one per
+// kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles makes
+// about 2.7 M cells; a = 10, N = 4000 at 0.1 d: 3.2 M triangles, 4 slabs); else 1.
+constexpr double kSurfaceTrianglesPerSlab = 1.0e6;
+int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, const VolumeMeshParams& params);
+
+// Heights above the floor (d) of the planes between `slabs` slabs: the bed cut into equal
+// heights (the empty inlet and outlet sections, or a clip window's ends, go to the first and the
+// last slab). Empty when slabs < 2.
+std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
+
+// The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
+// other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;
+// `params.layers` must be off) and joined. `d_ref` (m) scales the parameters; the report holds
+// each slab's report under "slabs". Writes the joined mesh (MSH 2.2: physical groups per patch
+// and `fluid`) to `msh_path` when not empty. std::runtime_error when two slabs' shared plane is
+// not triangulated alike (a defect of ours); ConvergenceError naming the slab when one fails
+// the gate, or naming the cells at the joins when the joined mesh does, after writing them to
+// `bad_cells_path`.
+VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
+                                     const VolumeMeshParams& params, const std::filesystem::path& msh_path,
+                                     const std::filesystem::path& bad_cells_path, Progress& progress);
+
+}  // namespace bedforge::meshing

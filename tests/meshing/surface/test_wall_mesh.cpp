@@ -1,0 +1,139 @@
+// The container wall meshed unrolled: closed with its inlet and outlet, periodic across
+// theta = 0, holes that follow their loops exactly.
+#include "meshing/surface/wall_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/surface_checks.hpp"
+
+using namespace bedforge::meshing;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+TriangleMesh container(double R, double z0, double z1, double edge, const WallMesh& wall) {
+  TriangleMesh m = wall.outside;
+  m.append(ring_mesh(Frame::along({0, 0, z0}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, false, "inlet"));
+  m.append(ring_mesh(Frame::along({0, 0, z1}, Eigen::Vector3d::UnitZ()), 0.0, R, edge, kBreakCocircular, true, "outlet"));
+  m.weld();
+  return m;
+}
+
+// A hole where a radial tube of radius rho at height z and angle theta meets the wall R.
+WallHole radial_hole(double R, double theta, double z, double rho, double spacing) {
+  const Eigen::Vector3d a(std::cos(theta), std::sin(theta), 0.0);
+  const Frame f = Frame::along(Eigen::Vector3d(0.0, 0.0, z) + 0.5 * R * a, a);
+  const GeneratorLength length = [f, R](double x, double y) {
+    const Eigen::Vector3d p = f.to_world(Eigen::Vector3d(x, y, 0.0));
+    const double b = p.x() * f.w.x() + p.y() * f.w.y(), c = p.x() * p.x() + p.y() * p.y() - R * R;
+    return -b + std::sqrt(b * b - c);
+  };
+  const int n = ring_points(rho, spacing);
+  return {tube_end_loop(f, rho, n, length, 0.05), 2 * kPi * rho / n, 0};
+}
+
+}  // namespace
+
+TEST(WallMesh, WithoutHolesClosesWithInletAndOutlet) {
+  for (double height : {1.0, 2.37}) {
+    const double R = 1.3, edge = 0.1;
+    const WallMesh w = wall_mesh(R, -0.5, height, edge, {}, 1.3, true, "wall");
+    EXPECT_TRUE(w.inside.triangles.empty());
+    const SurfaceCheck k = check_surface(container(R, -0.5, height, edge, w), SelfIntersectionTest::all_pairs);
+    ASSERT_TRUE(k.manifold && k.closed) << k.defects.size() << " defects";
+    EXPECT_FALSE(k.self_intersecting);
+    const double exact = kPi * R * R * (height + 0.5);
+    EXPECT_NEAR(k.volume, exact, 0.005 * exact);  // inscribed polygon
+    EXPECT_GT(mesh_quality(w.outside).min_angle_deg, 30.0);
+  }
+}
+
+TEST(WallMesh, HolesAreCutExactlyAndFilledByInside) {
+  const double R = 1.0, edge = 0.1;
+  // One hole at theta = 0, one elsewhere (the strip is cut along the generator farthest from both).
+  const std::vector<WallHole> holes{radial_hole(R, 0.0, 0.5, 0.1, 0.025), radial_hole(R, 2.0, 1.0, 0.2, 0.025)};
+  const WallMesh w = wall_mesh(R, 0.0, 1.5, edge, holes, 1.3, true, "wall");
+  // Wall plus what the holes cut out: the whole closed container again.
+  TriangleMesh m = container(R, 0.0, 1.5, edge, w);
+  m.append(w.inside);
+  m.weld();
+  const SurfaceCheck k = check_surface(m, SelfIntersectionTest::all_pairs);
+  for (const auto& d : k.defects) ADD_FAILURE() << d.at.transpose() << " used by " << d.triangles;
+  ASSERT_TRUE(k.manifold && k.closed) << k.defects.size() << " defects";
+  EXPECT_FALSE(k.self_intersecting);
+  EXPECT_NEAR(k.volume, kPi * R * R * 1.5, 0.005 * kPi * R * R * 1.5);
+  // Every loop vertex is a vertex of the wall, and the area cut out is about pi rho^2 each.
+  for (const auto& h : holes)
+    for (const auto& p : h.loop) EXPECT_NE(std::find(w.outside.points.begin(), w.outside.points.end(), p), w.outside.points.end());
+  double area = 0.0;
+  for (const auto& t : w.inside.triangles)
+    area += 0.5 * (w.inside.points[t[1]] - w.inside.points[t[0]]).cross(w.inside.points[t[2]] - w.inside.points[t[0]]).norm();
+  EXPECT_NEAR(area, kPi * (0.01 + 0.04), 0.03 * kPi * 0.05);
+  EXPECT_GT(mesh_quality(w.outside).min_angle_deg, 20.0);
+}
+
+TEST(WallMesh, HolesAtEveryAngleStillCloseAcrossTheSeam) {
+  // A tall wall with holes on a helix, so every generator (the seam too) passes through some:
+  // the faces at the two ends of the unrolled strip must match.
+  const double R = 1.0, edge = 0.1, height = 60.0;
+  std::vector<WallHole> holes;
+  for (int k = 0; k < 400; ++k) holes.push_back(radial_hole(R, 2.399963 * k, 0.5 + 0.147 * k, 0.08 + 0.03 * (k % 4), 0.025));
+  const WallMesh w = wall_mesh(R, 0.0, height, edge, holes, 1.3, true, "wall");
+  TriangleMesh m = container(R, 0.0, height, edge, w);
+  m.append(w.inside);
+  m.weld();
+  const SurfaceCheck k = check_surface(m, SelfIntersectionTest::skip);
+  for (const auto& d : k.defects) ADD_FAILURE() << d.at.transpose() << " used by " << d.triangles;
+  EXPECT_TRUE(k.manifold && k.closed);
+  EXPECT_NEAR(k.volume, kPi * R * R * height, 0.005 * kPi * R * R * height);
+}
+
+TEST(WallMesh, HoleReachingAnEndIsRefused) {
+  EXPECT_THROW(wall_mesh(1.0, 0.0, 1.5, 0.1, {radial_hole(1.0, 1.0, 0.05, 0.1, 0.025)}, 1.3, true, "wall"), CutConflict);
+}
+
+namespace {
+
+double area(const TriangleMesh& m, const Eigen::Vector3d& normal) {
+  double a = 0.0;
+  for (const auto& t : m.triangles) a += 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).dot(normal);
+  return a;
+}
+
+}  // namespace
+
+TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
+  // A 2 x 1 face in the plane x = 0.5 with two circular holes, one 0.002 from the edge: the
+  // outside and inside cover the face, the inside is exactly the holes' polygons, every triangle
+  // faces +w.
+  const Frame f = Frame::along({0.5, 0.0, 0.0}, Eigen::Vector3d::UnitX());
+  std::vector<Eigen::Vector3d> boundary;
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  std::vector<WallHole> holes;
+  double hole_area = 0.0;
+  for (auto [y, z, rho] : {std::tuple{-0.4, 0.5, 0.3}, std::tuple{0.5, 0.198, 0.196}}) {
+    const int n = ring_points(rho, 0.03);
+    holes.push_back({circle_loop(Frame::along({0.5, y, z}, Eigen::Vector3d::UnitX()), rho, n), 2 * kPi * rho / n, 0});
+    hole_area += 0.5 * n * rho * rho * std::sin(2 * kPi / n);
+  }
+  const WallMesh m = plane_mesh(f, {boundary}, 0.1, holes, 1.5, true, "wall");
+  EXPECT_NEAR(area(m.outside, f.w) + area(m.inside, f.w), 2.0, 1e-12);
+  EXPECT_NEAR(area(m.inside, f.w), hole_area, 1e-12);
+  for (const TriangleMesh* part : {&m.outside, &m.inside})
+    for (const auto& t : part->triangles) {
+      EXPECT_GT((part->points[t[1]] - part->points[t[0]]).cross(part->points[t[2]] - part->points[t[0]]).dot(f.w), 0.0);
+      for (int v : t) EXPECT_EQ(part->points[v].x(), 0.5) << "generated vertices lie exactly in the plane";
+    }
+  // A hole beyond the edge is refused.
+  holes[1].loop = circle_loop(Frame::along({0.5, 0.95, 0.5}, Eigen::Vector3d::UnitX()), 0.1, 21);
+  EXPECT_THROW(plane_mesh(f, {boundary}, 0.1, holes, 1.5, true, "wall"), CutConflict);
+}

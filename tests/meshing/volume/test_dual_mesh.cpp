@@ -1,0 +1,183 @@
+#include "meshing/volume/dual_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include "cases/poly_mesh_io.hpp"
+#include "support/cli.hpp"
+#include "support/tet_grid.hpp"
+
+namespace bedforge::meshing {
+namespace {
+
+// Moves the points of an n^3 box that are not on its sides by up to `by` (deterministic), so that
+// no cell of the dual is a regular one.
+void shake(std::vector<Eigen::Vector3d>& points, int n, double by) {
+  for (std::size_t v = 0; v < points.size(); ++v) {
+    Eigen::Vector3d& x = points[v];
+    if (x.minCoeff() > 0.0 && x.maxCoeff() < n)
+      x += by * Eigen::Vector3d(std::sin(7.1 * v), std::sin(3.7 * v + 1.0), std::sin(5.3 * v + 2.0));
+  }
+}
+
+// An n^3 box of Kuhn tetrahedra, shaken.
+PolyMesh shaken_box(int n) {
+  Grid g = kuhn_grid(n);
+  shake(g.points, n, 0.2);
+  return poly_mesh_from_tets(g.points, g.tets, g.boundary, g.patch, kNames, kTypes);
+}
+
+// An n^3 box of prisms (each cube cut in two along its xy diagonal), shaken: the cells of prism
+// layers, with quadrilateral faces.
+PolyMesh shaken_prisms(int n) {
+  Grid g = kuhn_grid(n);
+  shake(g.points, n, 0.1);
+  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
+  std::vector<VolumeCell> cells;
+  std::vector<Face> boundary;
+  std::vector<int> patch;
+  auto on_side = [&](const Face& f) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side)
+        if (std::all_of(f.begin(), f.end(), [&](int v) { return g.points[v][axis] == side * n; })) return 2 * axis + side;
+    return -1;
+  };
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& t : {std::array<int, 3>{id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k)},
+                              std::array<int, 3>{id(i, j, k), id(i + 1, j + 1, k), id(i, j + 1, k)}}) {
+          const int up = (n + 1) * (n + 1);
+          VolumeCell c{{t[0], t[1], t[2], t[0] + up, t[1] + up, t[2] + up}, 6};
+          cells.push_back(c);
+          for (const Face& f : {Face{t[0], t[1], t[2]}, Face{t[0] + up, t[1] + up, t[2] + up},
+                                Face{t[0], t[1], t[1] + up, t[0] + up}, Face{t[1], t[2], t[2] + up, t[1] + up},
+                                Face{t[2], t[0], t[0] + up, t[2] + up}})
+            if (const int side = on_side(f); side >= 0) boundary.push_back(f), patch.push_back(side);
+        }
+  return poly_mesh_from_cells(g.points, cells, boundary, patch, kNames, kTypes);
+}
+
+// Closed cells of positive volume that fill the n^3 box, one per point of `m`, in OpenFOAM's
+// face order, with patches on the box's sides.
+void expect_dual_fills_box(const PolyMesh& m, int n) {
+  const PolyhedralMesh d = dual_mesh(m, cell_centres(m), 80.0);
+  ASSERT_EQ(d.cells, static_cast<int>(m.points.size()));
+  // Closed cells: the outward area vectors of each cell's faces sum to zero.
+  std::vector<Eigen::Vector3d> closure(d.cells, Eigen::Vector3d::Zero());
+  std::vector<double> area(d.cells, 0.0);
+  for (int f = 0; f < static_cast<int>(d.faces.size()); ++f) {
+    const Eigen::Vector3d a = face_geometry(d.points, d.faces[f]).area;
+    closure[d.owner[f]] += a, area[d.owner[f]] += a.norm();
+    if (f < d.internal_faces()) closure[d.neighbour[f]] -= a, area[d.neighbour[f]] += a.norm();
+  }
+  for (int c = 0; c < d.cells; ++c) EXPECT_LT(closure[c].norm(), 1e-12 * area[c]) << "cell " << c;
+  // Every cell has a positive volume and together they fill the box exactly: the dual's boundary
+  // keeps the box's flat sides, its edges and corners (feature edges and points at 90 > 80 deg).
+  const CellGeometry cg = cell_geometry(d);
+  double total = 0.0;
+  for (double v : cg.volumes) {
+    EXPECT_GT(v, 0.0);
+    total += v;
+  }
+  EXPECT_NEAR(total, n * n * n, 1e-10);
+  // Internal faces in upper-triangular order, each facing from its owner's centre to its
+  // neighbour's.
+  for (int f = 0; f < d.internal_faces(); ++f) {
+    EXPECT_LT(d.owner[f], d.neighbour[f]);
+    if (f > 0) {
+      EXPECT_TRUE(d.owner[f - 1] < d.owner[f] || (d.owner[f - 1] == d.owner[f] && d.neighbour[f - 1] <= d.neighbour[f]))
+          << "face " << f;
+    }
+    EXPECT_GT(face_geometry(d.points, d.faces[f]).area.dot(cg.centres[d.neighbour[f]] - cg.centres[d.owner[f]]), 0.0)
+        << "face " << f;
+  }
+  // Each patch lies on its side of the box, faces out and covers it.
+  ASSERT_EQ(d.patches.size(), 6u);
+  EXPECT_EQ(d.patches[0].start, d.internal_faces());
+  for (int p = 0; p < 6; ++p) {
+    const auto& patch = d.patches[p];
+    EXPECT_EQ(patch.name, kNames[p]);
+    if (p > 0) {
+      EXPECT_EQ(patch.start, d.patches[p - 1].start + d.patches[p - 1].size);
+    }
+    const int axis = p / 2;
+    const double side = p % 2 ? n : 0.0, outward = p % 2 ? 1.0 : -1.0;
+    double covered = 0.0;
+    for (int f = patch.start; f < patch.start + patch.size; ++f) {
+      for (int v : d.faces[f]) EXPECT_NEAR(d.points[v][axis], side, 1e-12) << patch.name;
+      covered += outward * face_geometry(d.points, d.faces[f]).area[axis];
+    }
+    EXPECT_NEAR(covered, n * n, 1e-10) << patch.name;
+  }
+  EXPECT_EQ(d.patches.back().start + d.patches.back().size, static_cast<int>(d.faces.size()));
+}
+
+TEST(DualMesh, ItsCellsAreClosedAndFillTheBoxOnePerPoint) { expect_dual_fills_box(shaken_box(4), 4); }
+
+TEST(DualMesh, OfPrismsTooItsCellsAreClosedAndFillTheBox) { expect_dual_fills_box(shaken_prisms(3), 3); }
+
+// checkMesh's counts and geometry figures of the case in `dir`, as numbers in the order
+// printed: the mesh's statistics, the patch table, and the cells' volumes, areas and quality.
+std::vector<double> check_mesh_figures(const std::filesystem::path& dir) {
+  const cli_test::Result r =
+      cli_test::shell("cd " + dir.string() + " && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} checkMesh");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("Mesh OK."), std::string::npos) << r.output;
+  const std::regex wanted(
+      R"(^\s+(points:|faces:|internal faces:|cells:|boundary patches:|polyhedra:|x0 |x1 |y0 |y1 |z0 |z1 |Max aspect ratio|Minimum face area|Min volume|Mesh non-orthogonality|Max skewness))");
+  const std::regex number(R"([-+]?\d+(\.\d+)?([eE][-+]?\d+)?)");
+  std::vector<double> figures;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (!std::regex_search(line, wanted)) continue;
+    for (std::sregex_iterator it(line.begin(), line.end(), number), end; it != end; ++it)
+      figures.push_back(std::stod(it->str()));
+  }
+  return figures;
+}
+
+void write_case(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "system");
+  std::ofstream(dir / "system/controlDict")
+      << cases::foam_header("dictionary", "system", "controlDict", "test")
+      << "application simpleFoam;\nstartFrom startTime;\nstartTime 0;\nstopAt endTime;\nendTime 1;\n"
+         "deltaT 1;\nwriteControl timeStep;\nwriteInterval 1;\nwriteFormat binary;\nwritePrecision 17;\n";
+  // polyDualMesh reads the schemes and solution controls, though it uses none.
+  std::ofstream(dir / "system/fvSchemes") << cases::foam_header("dictionary", "system", "fvSchemes", "test")
+                                          << "ddtSchemes {}\ngradSchemes {}\ndivSchemes {}\nlaplacianSchemes {}\n"
+                                             "interpolationSchemes {}\nsnGradSchemes {}\n";
+  std::ofstream(dir / "system/fvSolution") << cases::foam_header("dictionary", "system", "fvSolution", "test");
+}
+
+// The dual is the one OpenFOAM's polyDualMesh makes from the same tetrahedra: checkMesh counts
+// the same points, faces and cells, the same faces per patch, and measures the same volumes, face
+// areas, non-orthogonality and skewness (to one unit of the sixth digit it prints).
+void expect_polydualmesh_agrees(const PolyMesh& m) {
+  const auto theirs = cli_test::fresh_dir("dual_theirs"), ours = cli_test::fresh_dir("dual_ours");
+  write_case(theirs);
+  write_case(ours);
+  cases::write_poly_mesh(theirs / "constant/polyMesh", m, true, "test");
+  cases::write_poly_mesh(ours / "constant/polyMesh", dual_mesh(m, cell_centres(m), 80.0), true, "test");
+  const cli_test::Result r = cli_test::shell("cd " + theirs.string() +
+                                             " && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} "
+                                             "polyDualMesh -overwrite 80");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::vector<double> expected = check_mesh_figures(theirs), got = check_mesh_figures(ours);
+  ASSERT_EQ(got.size(), expected.size());
+  ASSERT_GT(got.size(), 20u);
+  for (std::size_t k = 0; k < got.size(); ++k)
+    EXPECT_NEAR(got[k], expected[k], 1e-5 * std::abs(expected[k])) << "figure " << k;
+}
+
+TEST(DualMesh, IsTheOnePolyDualMeshMakes) {
+  if (cli_test::shell("command -v polyDualMesh").status != 0) GTEST_SKIP() << "OpenFOAM (polyDualMesh) not on PATH";
+  expect_polydualmesh_agrees(shaken_box(4));
+  expect_polydualmesh_agrees(shaken_prisms(3));
+}
+
+}  // namespace
+}  // namespace bedforge::meshing
