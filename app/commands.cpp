@@ -1,8 +1,11 @@
 #include "app/commands.hpp"
 
 #include <CLI/CLI.hpp>
+#include <fmt/chrono.h>
 #include <fmt/format.h>
 
+#include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -15,6 +18,7 @@
 #include "pipeline/directory_stages.hpp"
 #include "pipeline/run_scene.hpp"
 #include "pipeline/scene.hpp"
+#include "pipeline/scene_reference.hpp"
 
 namespace bedforge {
 
@@ -33,7 +37,8 @@ toml::table load_table(const std::string& scene_file) {
 int run_command_line(int argc, char** argv) {
   CLI::App app{fmt::format("bedforge {}: packed beds of spheres, from a scene file to a bed, its analysis, the "
                            "fluid-domain surface, a volume mesh and an OpenFOAM case.\n"
-                           "Exit status: 0 done, 2 bad input, 3 did not converge, 1 internal error.",
+                           "Exit status: 0 done, 2 bad input, 3 did not converge, 4 case written but not solved (no "
+                           "OpenFOAM), 1 internal error.",
                            kVersion),
                "bedforge"};
   app.require_subcommand(1);
@@ -101,6 +106,9 @@ int run_command_line(int argc, char** argv) {
   case_cmd->add_flag("--overwrite", overwrite, "replace DIR/case when it exists");
 #endif
 
+  CLI::App* keys = app.add_subcommand("scene-keys", "print every scene key with its type, unit, default, allowed "
+                                                    "values and meaning, as Markdown (docs/scene_reference.md)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -108,6 +116,11 @@ int run_command_line(int argc, char** argv) {
   }
   if (no_progress) console.progress = false;
 
+  if (*keys) {
+    const std::string today = fmt::format("{:%Y-%m-%d}", fmt::gmtime(std::time(nullptr)));
+    std::fputs(pipeline::scene_reference_page(kVersion, today).c_str(), stdout);
+    return 0;
+  }
   if (*run || *pack || *imp) {
     toml::table table = load_table(scene_file);
     std::vector<Override> overrides;

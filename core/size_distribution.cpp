@@ -178,12 +178,13 @@ SizeDistribution read_size_distribution(SceneSection& p) {
     s.number_fractions = f;
   } else {
     s.kind = kind == "normal" ? SizeDistribution::Kind::normal : SizeDistribution::Kind::lognormal;
-    s.mean_m = p.number("mean_m", 0.0, positive);
-    s.std_m = p.number("std_m", 0.0, positive);
+    s.mean_m = p.number("mean_m", 0.0, positive, "none (required)");
+    s.std_m = p.number("std_m", 0.0, positive, "none (required)");
     if (!p.has("mean_m") || !p.has("std_m"))
       throw InputError(fmt::format("{}: a {} distribution needs mean_m and std_m (metres, > 0)", p.name(), kind));
-    s.min_m = p.number("min_m", std::max(s.mean_m - 3 * s.std_m, 0.1 * s.mean_m), positive);
-    s.max_m = p.number("max_m", s.mean_m + 3 * s.std_m, positive);
+    s.min_m = p.number("min_m", std::max(s.mean_m - 3 * s.std_m, 0.1 * s.mean_m), positive,
+                       "mean_m - 3 std_m, at least 0.1 mean_m");
+    s.max_m = p.number("max_m", s.mean_m + 3 * s.std_m, positive, "mean_m + 3 std_m");
     if (s.min_m >= s.max_m)
       throw InputError(fmt::format("{}: min_m = {} is not below max_m = {}; allowed: 0 < min_m < max_m", p.name(),
                                    s.min_m, s.max_m));

@@ -16,8 +16,6 @@ namespace {
 
 const std::vector<std::string> kOutputs = {"positions", "vtp", "analysis", "stl", "mesh", "case"};
 const std::vector<std::string> kDefaultOutputs = {"positions", "vtp", "analysis"};
-const std::vector<std::string> kSections = {"container", "particles", "packing", "analysis",
-                                            "contacts",  "surface",   "mesh",     "case", "outputs"};
 
 double unit_to_metres(const std::string& unit) {
   if (unit == "m") return 1.0;
@@ -48,7 +46,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection root(&table, "", schema);  // top level: keys are named from their section down
   for (const auto& [k, v] : table) {
     const std::string key(k.str());
-    if (std::find(kSections.begin(), kSections.end(), key) == kSections.end())
+    if (std::find(scene_sections().begin(), scene_sections().end(), key) == scene_sections().end())
       throw InputError(fmt::format("unknown section [{}] in {}; allowed: [container], [particles], [packing], "
                                    "[analysis], [contacts], [surface], [mesh], [case], [outputs]",
                                    key, source));
@@ -152,15 +150,29 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
   return read_scene_into(table, source, base_dir, nullptr);
 }
 
+const std::vector<std::string>& scene_sections() {
+  static const std::vector<std::string> sections = {"container", "particles", "packing", "analysis", "contacts",
+                                                    "surface",   "mesh",      "case",    "outputs"};
+  return sections;
+}
+
 SceneSchema scene_schema() {
-  // Scenes that between them take every branch of the readers: each container type, and an
-  // import (which stops at its missing file after its own keys are recorded).
+  // Scenes that between them take every branch of the readers: each container type, an import
+  // (which stops at its missing file after its own keys are recorded), each kind of size
+  // distribution and a Monte Carlo mixture.
   SceneSchema schema;
   const char* scenes[] = {"container = {diameter_d = 5.0}\nparticles = {count = 1}",
                           ("container = {type = \"annulus\", diameter_d = 5.0, inner_diameter_d = 2.0}\n"
                            "particles = {count = 1}"),
                           "container = {type = \"box\", size_x_d = 5.0, size_y_d = 5.0}\nparticles = {count = 1}",
-                          "packing = {algorithm = \"import\"}"};
+                          "packing = {algorithm = \"import\"}",
+                          ("container = {diameter_d = 5.0}\nparticles = {count = 1, distribution = \"discrete\", "
+                           "diameters_m = [0.001, 0.002], number_fractions = [0.5, 0.5]}\n"
+                           "packing = {algorithm = \"monte-carlo\", monte_carlo = {particle_densities = [1000.0, 2000.0]}}"),
+                          ("container = {diameter_d = 5.0}\nparticles = {count = 1, distribution = \"discrete\", "
+                           "diameters_m = [0.001, 0.002], volume_fractions = [0.5, 0.5]}"),
+                          ("container = {diameter_d = 5.0}\nparticles = {count = 1, distribution = \"normal\", "
+                           "mean_m = 0.001, std_m = 0.0001}")};
   for (const char* text : scenes) {
     try {
       read_scene_into(toml::parse(text), "schema", {}, &schema);

@@ -82,8 +82,11 @@ Scene read_scene(const toml::table& table, const std::string& source, const std:
 Scene read_scene_file(const std::filesystem::path& path);
 
 // Every key a scene can hold, with its type, range and default, as the section readers ask for
-// them (for the command line's help).
+// them (for the command line's help and docs/scene_reference.md).
 SceneSchema scene_schema();
+
+// The top-level sections of a scene, in the order a scene is read.
+const std::vector<std::string>& scene_sections();
 
 // The table that holds `dotted.key` (created if missing); `leaf` receives the last part. For a
 // length key (ending in _m or _d) the key in the other unit is removed, so an override wins.
