@@ -270,7 +270,10 @@ std::string answer_svg(const PressureDropAnswer& a) {
                        right - 265, y - 7, y + 7),
            fmt::format("band {:.4g} to {:.4g} Pa/m (GCI {:.1f} %)", *a.band_low_pa_m, *a.band_high_pa_m, 100.0 * a.gci_fine));
   } else {
-    legend("", "no best estimate: " + std::string(a.levels.size() < 3 ? "too few levels" : "not in the asymptotic range"));
+    // The reason in full is in summary.txt; the legend has room for its gist only.
+    legend("", "no best estimate: " + std::string(!a.finest_converged ? "the finest solve did not converge"
+                                                  : a.levels.size() < 3 ? "too few levels"
+                                                                        : "the study gives none (summary.txt)"));
   }
   legend(fmt::format("<line x1=\"{}\" x2=\"{}\" y1=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#3060a0\" stroke-dasharray=\"6 4\"/>",
                      right - 275, right - 255, y, y),
