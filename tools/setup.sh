@@ -7,10 +7,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(g++ cmake make pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libcgal-dev libtbb-dev
-          libgoogle-perftools-dev gmsh libgmsh-dev openfoam libgtest-dev python3-numpy python3-matplotlib time)
-# The test suite also builds the fuzz targets: clang, its libFuzzer runtime and its OpenMP.
-if [ "${1:-}" = test ]; then packages+=(clang libclang-rt-14-dev libomp-dev); fi
+# What the program needs to build and run a scene to its answer; the demo installs only these.
+packages=(g++ cmake make ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+          libcgal-dev libtbb-dev libgoogle-perftools-dev gmsh libgmsh-dev openfoam time)
+# The rest builds the test suite (GoogleTest; the fuzz targets: clang, its libFuzzer runtime and
+# its OpenMP) and runs the tools' plots (numpy, matplotlib).
+if [ "${1:-}" != demo ]; then
+  packages+=(libgtest-dev python3-numpy python3-matplotlib)
+  if [ "${1:-}" = test ]; then packages+=(clang libclang-rt-14-dev libomp-dev); fi
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -34,10 +39,12 @@ if [ "${1:-}" = test ]; then
     command -v "$program" >/dev/null || { echo "setup: $program is not on PATH; the case tests need OpenFOAM (apt-get install openfoam)" >&2; exit 1; }
   done
 fi
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DBEDFORGE_REQUIRE_ALL_STAGES=$require
-# The demo needs the program only; the test suite, everything.
-target=()
-[ "${1:-}" = demo ] && target=(--target bedforge)
+# The demo needs the program only; the test suite, everything. Ninja for a new build directory
+# (an existing one keeps the generator it was made with).
+tests=ON target=() generator=()
+if [ "${1:-}" = demo ]; then tests=OFF target=(--target bedforge); fi
+if [ ! -f build/CMakeCache.txt ]; then generator=(-G Ninja); fi
+cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DBEDFORGE_REQUIRE_ALL_STAGES=$require -DBEDFORGE_BUILD_TESTS=$tests
 cmake --build build -j"$(nproc)" "${target[@]}"
 
 case "${1:-}" in
