@@ -261,6 +261,9 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   const ClipOpening* opening = placed.opening.contacts.empty() ? nullptr : &placed.opening;
   TreatedBed out =
       contact_parts::ContactTreatment(bed, p, placed.planes, {.surveyed = &survey.extents(), .opening = opening}).run();
+  // The curved walls' edge follows their narrowest gap: taken over the whole bed, every window
+  // of one bed (the slabs of one mesh) rims a plane they share with the same vertices.
+  out.min_concave_wall_gap = std::min(out.min_concave_wall_gap, whole.min_concave_wall_gap);
   out.report["clip"] = placed.report;
   return out;
 }

@@ -33,6 +33,7 @@ struct TreatedBed {
   double solid_volume = 0.0;                      // exact volume of the treated solid (m^3)
   // Narrowest gap left between a sphere and a cylinder wall around the fluid (m): that wall's
   // facets lie inside it, towards the spheres (an annulus's inner wall's lie away from them).
+  // With clip planes, the narrower of the window's and the whole bed's.
   double min_concave_wall_gap = 0.0;
   nlohmann::json report;                          // contacts treated, volume and area change, gaps, angles
 };

@@ -531,6 +531,38 @@ TEST(FluidSurface, AClipPlaneMovesOffBridgedContacts) {
   }
 }
 
+// Two windows of one bed that meet at a plane (the slabs of one mesh) must give that plane the
+// same triangles. The tube's wall edge shortens to keep its facets clear of the narrowest wall
+// gap; here that gap (0.002 d, spheres shrunk to 0.495 d) lies in the lower window only, and
+// each window once took its own, so the upper one rimmed the plane with fewer vertices (slabs
+// then failed to join, exit status 1).
+TEST(FluidSurface, TwoWindowsThatMeetAtAPlaneMeshItAlike) {
+  const Bed b = column(std::make_shared<Cylinder>(1.0), {{0.503, 0.0, 0.6}, {0.3, 0.0, 2.5}});
+  auto plane = [&](double bottom, double top, const std::string& patch) {
+    SurfaceParams p;
+    p.clip = true;
+    p.clip_bottom_d = bottom;
+    p.clip_top_d = top;
+    const FluidSurface fs = valid_surface(b, p, "window " + patch);
+    std::vector<std::array<double, 9>> triangles;
+    for (std::size_t t = 0; t < fs.fluid.triangles.size(); ++t) {
+      if (fs.fluid.patches[fs.fluid.patch[t]] != patch) continue;
+      std::array<Eigen::Vector3d, 3> q;
+      for (int k = 0; k < 3; ++k) q[k] = fs.fluid.points[fs.fluid.triangles[t][k]];
+      std::sort(q.begin(), q.end(), [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+        return std::lexicographical_compare(u.begin(), u.end(), v.begin(), v.end());
+      });
+      triangles.push_back({q[0].x(), q[0].y(), q[0].z(), q[1].x(), q[1].y(), q[1].z(), q[2].x(), q[2].y(), q[2].z()});
+    }
+    std::sort(triangles.begin(), triangles.end());
+    return triangles;
+  };
+  const auto below = plane(0.0, 1.5, "outlet"), above = plane(1.5, 3.5, "inlet");
+  EXPECT_GT(below.size(), 100u);
+  EXPECT_EQ(below.size(), above.size());
+  EXPECT_TRUE(below == above) << "the windows triangulate their shared plane differently";
+}
+
 TEST(FluidSurface, AClipPlaneWithNoRoomOpensTheContactsItCuts) {
   // The outlet asked at 2.004 d, next to the four vertical contacts at z = 2.0, with room to
   // move 0.01 d only: those contacts reach 0.0101 d above and below (the cap each cuts off its
