@@ -44,12 +44,11 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   sc.table = table;
   sc.source = source;
   SceneSection root(&table, "", schema);  // top level: keys are named from their section down
+  const std::vector<std::string>& sections = scene_sections();
   for (const auto& [k, v] : table) {
     const std::string key(k.str());
-    if (std::find(scene_sections().begin(), scene_sections().end(), key) == scene_sections().end())
-      throw InputError(fmt::format("unknown section [{}] in {}; allowed: [container], [particles], [packing], "
-                                   "[analysis], [contacts], [surface], [mesh], [case], [outputs]",
-                                   key, source));
+    if (std::find(sections.begin(), sections.end(), key) == sections.end())
+      throw InputError(fmt::format("unknown section [{}] in {}; allowed: [{}]", key, source, fmt::join(sections, "], [")));
   }
 
   SceneSection packing = root.sub("packing");
