@@ -6,6 +6,10 @@
 # apt-get runs only when a package is absent. Run as root, or as a user with sudo.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+case "${1:-}" in
+  demo|test|"") ;;
+  *) echo "setup: unknown action '$1'; allowed: demo, test, or nothing" >&2; exit 2 ;;
+esac
 
 # What the program needs to build and run a scene to its answer; the demo installs only these.
 packages=(g++ cmake make ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev
@@ -59,6 +63,5 @@ case "${1:-}" in
           -DBEDFORGE_WITH_CGAL=OFF -DBEDFORGE_WITH_GMSH=OFF -DBEDFORGE_BUILD_TESTS=OFF >/dev/null
     cmake --build build-fuzz -j"$(nproc)"
     ctest --test-dir build-fuzz --output-on-failure ;;
-  "") ;;
-  *) echo "setup: unknown action '$1'; allowed: demo, test, or nothing" >&2; exit 2 ;;
+  *) ;;
 esac
