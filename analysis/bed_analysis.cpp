@@ -32,8 +32,35 @@ struct Slab {
   bool valid;
 };
 Slab central_slab(const Bed& bed, const AnalysisParams& p, double d_ref) {
+  // A periodic section has no floor or top to keep away from: the whole period is central.
+  if (bed.container->axial_period() > 0.0) return {0.0, bed.container->axial_period(), true};
   const double h = bed_height(bed), cut = p.exclude_d * d_ref;
   return {cut, h - cut, h - cut > cut};
+}
+
+// Along a periodic axis: the bed with centres wrapped into [0, H) (sphere i stays sphere i),
+// then, appended, the images (z +- H) of the spheres that cross z = 0 or z = H, so that volume
+// measures over [0, H] count every sphere's whole volume once. Otherwise the bed itself.
+Bed wrapped(const Bed& bed) {
+  Bed out = bed;
+  const Periodicity per = bed.container->periodicity();
+  for (auto& c : out.centres) c = per.wrapped(c);
+  return out;
+}
+Bed with_axial_images(const Bed& wrapped_bed) {
+  const double period = wrapped_bed.container->axial_period();
+  Bed out = wrapped_bed;
+  if (period == 0.0) return out;
+  for (std::size_t i = 0; i < wrapped_bed.size(); ++i) {
+    const Eigen::Vector3d& c = wrapped_bed.centres[i];
+    const double r = 0.5 * wrapped_bed.diameters[i];
+    for (double shift : {period, -period})
+      if ((shift > 0.0 && c.z() < r) || (shift < 0.0 && c.z() + r > period)) {
+        out.centres.push_back(c + Eigen::Vector3d(0.0, 0.0, shift));
+        out.diameters.push_back(wrapped_bed.diameters[i]);
+      }
+  }
+  return out;
 }
 
 }  // namespace
@@ -62,18 +89,23 @@ nlohmann::json void_fraction_summary(const Bed& bed, const AnalysisParams& p) {
   const Scales sc = scales_of(bed);
   const double h = bed_height(bed);
   const Slab slab = central_slab(bed, p, sc.d_ref);
+  const Bed whole = with_axial_images(wrapped(bed));
   nlohmann::json j{{"bed_height_m", h},
                    {"bed_height_d", h / sc.d_ref},
-                   {"whole_bed", void_fraction(bed, 0.0, h)},
+                   {"whole_bed", void_fraction(whole, 0.0, h)},
                    {"central_slab", nullptr},
                    {"central_slab_m", {slab.lo, slab.hi}}};
-  if (slab.valid) j["central_slab"] = void_fraction(bed, slab.lo, slab.hi);
+  if (bed.container->axial_period() > 0.0) j["axial_period_m"] = bed.container->axial_period();
+  if (slab.valid) j["central_slab"] = void_fraction(whole, slab.lo, slab.hi);
   return j;
 }
 
-AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
+AnalysisResult analyse_bed(const Bed& given, const AnalysisParams& p) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (bed.size() == 0) throw InputError("the bed has no spheres to analyse");
+  if (given.size() == 0) throw InputError("the bed has no spheres to analyse");
+  // Per-sphere measures on `bed`, volume measures on `whole` (the same unless the axis is periodic).
+  const Bed bed = wrapped(given), whole = with_axial_images(bed);
+  const bool periodic_axis = bed.container->axial_period() > 0.0;
   const Scales sc = scales_of(bed);
   const double d = sc.d_ref;
   const double h = bed_height(bed);
@@ -126,15 +158,15 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
     const Periodicity per = box->periodicity();
     if (per.lx == 0.0)
       add_wall_profile("wall_profile_x",
-                       wall_void_fraction(bed, 0, 0.5 * box->size_x(), box->size_y(), p.radial_bin_d * d, z1, z2),
+                       wall_void_fraction(whole, 0, 0.5 * box->size_x(), box->size_y(), p.radial_bin_d * d, z1, z2),
                        "from the walls at x = +-size_x/2, both folded together");
     if (per.ly == 0.0)
       add_wall_profile("wall_profile_y",
-                       wall_void_fraction(bed, 1, 0.5 * box->size_y(), box->size_x(), p.radial_bin_d * d, z1, z2),
+                       wall_void_fraction(whole, 1, 0.5 * box->size_y(), box->size_x(), p.radial_bin_d * d, z1, z2),
                        "from the walls at y = +-size_y/2, both folded together");
   }
   for (const Wall& w : walls) {
-    const Profile radial = radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2);
+    const Profile radial = radial_void_fraction(whole, w.radius, w.end, p.radial_bin_d * d, z1, z2);
     add_wall_profile(w.name, radial, fmt::format("radial, from the wall at r = {} m", w.radius));
     const CentreDistribution centres = radial_centre_distribution(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, reachable);
     std::string csv = "# radial distribution of sphere centres between z = " + fmt::format("{} and {} m", z1, z2) +
@@ -148,7 +180,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
     out.csv_files[stem + ".csv"] = csv;
     if (p.line_intersection) {
       // The same bins by line intersection, and how far the two methods differ.
-      const Profile line = line_radial_void_fraction(bed, w.radius, w.end, p.radial_bin_d * d, z1, z2, p.line_step_d * d);
+      const Profile line = line_radial_void_fraction(whole, w.radius, w.end, p.radial_bin_d * d, z1, z2, p.line_step_d * d);
       csv = "# radial void fraction by line intersection (circle at the bin's middle radius), z from " +
             fmt::format("{} to {} m", z1, z2) + "\nwall_distance_d,wall_distance_m,void_fraction\n";
       double worst = 0.0, mean = 0.0;
@@ -161,7 +193,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
       j[w.name]["line_intersection"] = {{"max_abs_difference_to_volume", worst}, {"mean_abs_difference_to_volume", mean}};
     }
   }
-  const Profile axial = axial_void_fraction(bed, p.axial_bin_d * d, h);
+  const Profile axial = axial_void_fraction(whole, p.axial_bin_d * d, h);
   std::string csv = "# axial void fraction over the whole cross-section\nz_d,z_m,void_fraction\n";
   for (std::size_t k = 0; k < axial.position.size(); ++k)
     csv += fmt::format("{:.6g},{:.9g},{:.9g}\n", axial.position[k] / d, axial.position[k], axial.void_fraction[k]);
@@ -169,7 +201,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
 
   // Segregation of a mixture of a few sizes: per-species axial profiles and an index.
   const double d_max = *std::max_element(bed.diameters.begin(), bed.diameters.end());
-  const Segregation seg = axial_segregation(bed, d_max, h);
+  const Segregation seg = axial_segregation(whole, d_max, h);
   if (!seg.diameters.empty()) {
     csv = "# solid volume fraction of each species per layer of one largest diameter\nz_d,z_m";
     for (double ds : seg.diameters) csv += fmt::format(",species_d_{:.6g}_m", ds);
@@ -203,7 +235,7 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
     const auto& c = bed.centres[i];
     WallContact probe[Container::kMaxWallContacts];
     const bool near_wall = bed.container->wall_contacts(c, cut, probe) > 0;
-    if (!near_wall && c.z() > cut && c.z() < h - cut) {
+    if (!near_wall && (periodic_axis || (c.z() > cut && c.z() < h - cut))) {
       if (rattler) ++bulk_rattlers;
       else ++bulk_n, bulk_sum += cs.sphere_contacts[i];
     }
@@ -234,6 +266,9 @@ AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p) {
   j["force_residual"] = {{"rms", cs.residual_rms},
                          {"max", cs.residual_max},
                          {"definition", "net force / own weight at the best-fit linear contact stiffness"}};
+  if (periodic_axis)
+    j["force_residual"] = {{"rms", nullptr}, {"max", nullptr},
+                           {"definition", "not measured: a periodic section is packed without gravity"}};
   const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   j["time_s"] = time;
   const auto& vf = j["void_fraction"];

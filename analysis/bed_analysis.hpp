@@ -22,7 +22,8 @@ AnalysisParams read_analysis_params(SceneSection& section);
 nlohmann::json to_json(const AnalysisParams& p);
 
 // Void fraction of the whole bed (floor to the top of the highest sphere) and of the central
-// slab, with the slab's bounds; the slab is null when the bed is shorter than 2 exclude_d.
+// slab, with the slab's bounds; the slab is null when the bed is shorter than 2 exclude_d. A
+// periodic section (container.axial_period() = H) has no ends: both are over one period, [0, H].
 nlohmann::json void_fraction_summary(const Bed& bed, const AnalysisParams& p);
 
 struct AnalysisResult {
@@ -34,7 +35,9 @@ struct AnalysisResult {
 // Everything the analysis measures: void fractions, radial (central slab) and axial profiles,
 // radial centre distribution, coordination numbers (all spheres; bulk spheres more than
 // exclude_d from walls, floor and top, rattlers with fewer than 4 contacts set apart), wall and
-// floor contacts, maximum overlaps and the force residual.
+// floor contacts, maximum overlaps and the force residual. A periodic section: profiles over
+// the whole period with every sphere's images, contacts through the period, no floor and no
+// force residual (packed without gravity).
 AnalysisResult analyse_bed(const Bed& bed, const AnalysisParams& p);
 
 }  // namespace bedforge::analysis

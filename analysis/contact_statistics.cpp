@@ -49,14 +49,18 @@ ContactStatistics contact_statistics(const Bed& bed, double gap_tolerance) {
         p += overlap * w[k].normal;
       }
     }
-    st.floor_contact[i] = xi.z() - r[i] <= gap_tolerance;
-    max_floor = std::max(max_floor, r[i] - xi.z());
+    if (per.lz == 0.0) {  // a periodic axis has no floor
+      st.floor_contact[i] = xi.z() - r[i] <= gap_tolerance;
+      max_floor = std::max(max_floor, r[i] - xi.z());
+    }
     push[i] = p;
     weight[i] = r[i] * r[i] * r[i];
   }
   st.max_pair_overlap = max_pair;
   st.max_wall_overlap = max_wall;
   st.max_floor_penetration = std::max(0.0, max_floor);
+
+  if (per.lz > 0.0) return st;  // packed without gravity: no weight to balance, no residual
 
   // Best-fit stiffness k: minimise sum |F_i / w_i|^2 with F_i = k push_i - w_i z, leaving out
   // the vertical component of spheres on the floor (the floor supplies it), then measure.

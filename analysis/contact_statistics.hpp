@@ -11,14 +11,14 @@ namespace bedforge::analysis {
 struct ContactStatistics {
   std::vector<int> sphere_contacts;  // per sphere: contacts with other spheres
   std::vector<int> wall_contacts;    // per sphere: contacts with the lateral walls
-  std::vector<char> floor_contact;   // per sphere: 1 when touching the floor
+  std::vector<char> floor_contact;   // per sphere: 1 when touching the floor (never along a periodic axis)
   double max_pair_overlap = 0;       // m
   double max_wall_overlap = 0;       // m
   double max_floor_penetration = 0;  // m (centre closer to the floor than its radius)
   // Net force on each sphere relative to its weight when contact forces are linear in the
   // overlap with the stiffness that best balances the bed (least squares), the floor carrying
   // what presses on it. A measure of static balance that needs no knowledge of how the bed
-  // was made.
+  // was made. 0 along a periodic axis (no floor, packed without gravity: nothing to balance).
   double residual_rms = 0, residual_max = 0;
 };
 

@@ -40,8 +40,10 @@ inline double largest_diameter(const Bed& bed) {
   return bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) : bed.empty_reference_diameter;
 }
 
-// Height of the bed: the top of its highest sphere (m); 0 for an empty bed.
+// Height of the bed: the top of its highest sphere (m), 0 for an empty bed; along a periodic
+// axis, one period.
 inline double bed_height(const Bed& bed) {
+  if (bed.container && bed.container->axial_period() > 0.0) return bed.container->axial_period();
   double h = 0.0;
   for (std::size_t i = 0; i < bed.size(); ++i) h = std::max(h, bed.centres[i].z() + 0.5 * bed.diameters[i]);
   return h;

@@ -9,6 +9,18 @@
 
 namespace bedforge {
 
+std::unique_ptr<Container> Container::scaled(double factor) const {
+  std::unique_ptr<Container> c = scaled_section(factor);
+  c->axial_period_ = axial_period_ * factor;
+  return c;
+}
+
+nlohmann::json Container::to_json() const {
+  nlohmann::json j = section_json();
+  if (axial_period_ > 0.0) j["period_z"] = axial_period_;
+  return j;
+}
+
 double Cylinder::cross_section_area() const { return std::numbers::pi * radius_ * radius_; }
 double Cylinder::wall_perimeter() const { return 2.0 * std::numbers::pi * radius_; }
 
@@ -34,9 +46,11 @@ Eigen::Vector2d Cylinder::sample_centre(Rng& rng, double r) const {
   return {rho * std::cos(theta), rho * std::sin(theta)};
 }
 
-std::unique_ptr<Container> Cylinder::scaled(double factor) const { return std::make_unique<Cylinder>(radius_ * factor); }
+std::unique_ptr<Container> Cylinder::scaled_section(double factor) const {
+  return std::make_unique<Cylinder>(radius_ * factor);
+}
 
-nlohmann::json Cylinder::to_json() const { return {{"type", "cylinder"}, {"diameter", 2.0 * radius_}}; }
+nlohmann::json Cylinder::section_json() const { return {{"type", "cylinder"}, {"diameter", 2.0 * radius_}}; }
 
 double Annulus::cross_section_area() const { return std::numbers::pi * (outer_ * outer_ - inner_ * inner_); }
 double Annulus::wall_perimeter() const { return 2.0 * std::numbers::pi * (outer_ + inner_); }
@@ -59,11 +73,11 @@ Eigen::Vector2d Annulus::sample_centre(Rng& rng, double r) const {
   return {rho * std::cos(theta), rho * std::sin(theta)};
 }
 
-std::unique_ptr<Container> Annulus::scaled(double factor) const {
+std::unique_ptr<Container> Annulus::scaled_section(double factor) const {
   return std::make_unique<Annulus>(outer_ * factor, inner_ * factor);
 }
 
-nlohmann::json Annulus::to_json() const {
+nlohmann::json Annulus::section_json() const {
   return {{"type", "annulus"}, {"diameter", 2.0 * outer_}, {"inner_diameter", 2.0 * inner_}};
 }
 
@@ -92,11 +106,11 @@ double Box::max_radius() const {
   return std::min(px_ ? lx_ / 6.0 : 0.5 * lx_, py_ ? ly_ / 6.0 : 0.5 * ly_);
 }
 
-std::unique_ptr<Container> Box::scaled(double factor) const {
+std::unique_ptr<Container> Box::scaled_section(double factor) const {
   return std::make_unique<Box>(lx_ * factor, ly_ * factor, px_, py_);
 }
 
-nlohmann::json Box::to_json() const {
+nlohmann::json Box::section_json() const {
   return {{"type", "box"}, {"size_x", lx_}, {"size_y", ly_}, {"periodic_x", px_}, {"periodic_y", py_}};
 }
 
@@ -144,11 +158,23 @@ std::unique_ptr<Container> read_container(SceneSection& s, double d_ref_m, doubl
                                  fit_key, d_max_m, d_max_m / d_ref_m, type, 2.0 * c->max_radius(),
                                  2.0 * c->max_radius() / d_ref_m,
                                  type == "annulus" ? "gap" : type == "box" ? "side" : "diameter",
-                                 c->periodicity().any() ? " (3 diameters for a periodic side)" : ""));
+                                 c->periodicity().lateral() ? " (3 diameters for a periodic side)" : ""));
+  if (const auto period = s.optional_length("period_z", Range::positive())) {
+    // The minimum-image rule of the packers and the analysis needs a period of 3 largest diameters.
+    c->set_axial_period(period->metres(d_ref_m));
+    if (c->axial_period() < 3.0 * d_max_m * (1.0 - 1e-12))
+      throw InputError(fmt::format("{}: an axial period of {:.4g} m ({:.4g} d) is shorter than 3 largest diameters "
+                                   "({:.4g} m); allowed: a period of at least that",
+                                   length_key(s, "period_z"), c->axial_period(), c->axial_period() / d_ref_m,
+                                   3.0 * d_max_m));
+  }
   return c;
 }
 
-std::unique_ptr<Container> container_from_json(const nlohmann::json& j) {
+namespace {
+
+// The cross-section of a container record.
+std::unique_ptr<Container> section_from_json(const nlohmann::json& j) {
   auto positive = [&](const char* key) {
     return j.contains(key) && j[key].is_number() && j[key].get<double>() > 0 ? j[key].get<double>() : -1.0;
   };
@@ -162,8 +188,21 @@ std::unique_ptr<Container> container_from_json(const nlohmann::json& j) {
   throw InputError(fmt::format("unrecognised container record {}; allowed: {{\"type\":\"cylinder\",\"diameter\":D}}, "
                                "{{\"type\":\"annulus\",\"diameter\":D,\"inner_diameter\":Di<D}}, "
                                "{{\"type\":\"box\",\"size_x\":Lx,\"size_y\":Ly,\"periodic_x\":bool,"
-                               "\"periodic_y\":bool}}, lengths > 0",
+                               "\"periodic_y\":bool}}, optionally \"period_z\":H; lengths > 0",
                                j.dump()));
+}
+
+}  // namespace
+
+std::unique_ptr<Container> container_from_json(const nlohmann::json& j) {
+  std::unique_ptr<Container> c = section_from_json(j);
+  if (j.contains("period_z")) {
+    if (!j["period_z"].is_number() || !(j["period_z"].get<double>() > 0.0))
+      throw InputError(fmt::format("container record {}: period_z = {}; allowed: a length > 0", j.dump(),
+                                   j["period_z"].dump()));
+    c->set_axial_period(j["period_z"].get<double>());
+  }
+  return c;
 }
 
 }  // namespace bedforge

@@ -51,17 +51,22 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
   const double r_max = *std::max_element(r.begin(), r.end());
   const double h = 2.0 * r_max + skin_;
   const Eigen::Vector4d b = container.lateral_bounds();
-  double z_lo = x[0].z(), z_hi = x[0].z();
-  for (const auto& p : x) z_lo = std::min(z_lo, p.z()), z_hi = std::max(z_hi, p.z());
+  const Periodicity per = container.periodicity();
+  // Along a periodic axis the grid spans one period (centres are wrapped into [0, L)).
+  double z_lo = per.lz > 0.0 ? 0.0 : x[0].z(), z_hi = per.lz > 0.0 ? per.lz : x[0].z();
+  if (per.lz == 0.0)
+    for (const auto& p : x) z_lo = std::min(z_lo, p.z()), z_hi = std::max(z_hi, p.z());
   const long nx = std::max(1L, static_cast<long>((b[2] - b[0]) / h)), ny = std::max(1L, static_cast<long>((b[3] - b[1]) / h));
   const double hx = (b[2] - b[0]) / static_cast<double>(nx), hy = (b[3] - b[1]) / static_cast<double>(ny);
   // Cap the number of layers so a bed thrown apart (before a divergence is caught) cannot ask
   // for an unbounded grid; cells then grow taller, which only costs time.
   const long max_nz = std::max(1L, static_cast<long>(4 * n / static_cast<std::size_t>(nx * ny)) + 1);
-  const long nz = std::clamp(static_cast<long>((z_hi - z_lo) / h) + 1, 1L, max_nz);
-  const double hz = std::max(h, (z_hi - z_lo) / static_cast<double>(nz) * (1.0 + 1e-12));
+  // A periodic axis has whole cells of at least h across the period, as the sides have.
+  const long nz = per.lz > 0.0 ? std::max(1L, static_cast<long>(per.lz / h))
+                               : std::clamp(static_cast<long>((z_hi - z_lo) / h) + 1, 1L, max_nz);
+  const double hz = per.lz > 0.0 ? per.lz / static_cast<double>(nz)
+                                 : std::max(h, (z_hi - z_lo) / static_cast<double>(nz) * (1.0 + 1e-12));
   auto clampi = [](double v, long hi) { return std::clamp(static_cast<long>(std::floor(v)), 0L, hi - 1); };
-  const Periodicity per = container.periodicity();
   auto cell_of = [&](const Eigen::Vector3d& p, long& cx, long& cy, long& cz) {  // p wrapped
     cx = clampi((p.x() - b[0]) / hx, nx);
     cy = clampi((p.y() - b[1]) / hy, ny);
@@ -131,7 +136,7 @@ void NeighbourList::build(const std::vector<Eigen::Vector3d>& x, const std::vect
         return m;
       };
       long zs[3], ys[3], xs[3];
-      const long mz = around(cz, nz, false, zs), my = around(cy, ny, per.ly > 0.0, ys), mx = around(cx, nx, per.lx > 0.0, xs);
+      const long mz = around(cz, nz, per.lz > 0.0, zs), my = around(cy, ny, per.ly > 0.0, ys), mx = around(cx, nx, per.lx > 0.0, xs);
       for (long kz = 0; kz < mz; ++kz)
         for (long ky = 0; ky < my; ++ky) {
           const long row = zs[kz] * ny + ys[ky];

@@ -71,7 +71,7 @@ void evaluate_contacts(const Spheres& s, const NeighbourList& nl, const Containe
   out.push.resize(n);
   std::vector<double> energy(n);
   const Periodicity per = c.periodicity();
-  const bool periodic = per.lx > 0.0 || per.ly > 0.0;
+  const bool periodic = per.any();
   struct Largest {
     double pair = 0.0, wall = 0.0;
   };

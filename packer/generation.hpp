@@ -9,6 +9,7 @@ namespace bedforge::packer {
 // initial bed height follows from the initial void fraction eps0 (Eq. 6 generalised:
 // L0 = total sphere volume / (cross-section area (1 - eps0))), and each centre is drawn
 // uniformly in the cross-section (container's sample_centre) and at z = L0 Rnd + r_i.
+// Along a periodic axis (container.axial_period() = H > 0) eps0 is unused: z = H Rnd, one period.
 // Overlaps are allowed; the packer removes them.
 // Inputs: s.r (radii, packing units), container in packing units, eps0 in (0, 1).
 // Output: s.x, and s reordered by height (indices follow z). Returns L0 and the reordering:

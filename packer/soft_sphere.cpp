@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.hpp"
 #include "packer/contact_forces.hpp"
@@ -87,11 +88,20 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
     s.r.push_back(0.5 * di / d_ref);
     s.w.push_back(std::pow(di / d_ref, 3));
   }
+  // A periodic section starts in a period long enough for the initial void fraction and is
+  // compressed to its own.
+  const double period = box->axial_period();
+  if (period > 0.0) {
+    double volume = 0.0;
+    for (double r : s.r) volume += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    box->set_axial_period(
+        std::max(period, volume / (box->cross_section_area() * (1.0 - params.initial_void_fraction))));
+  }
   const Generated gen = generate_initial_bed(s, *box, params.initial_void_fraction, rng);
 
   RunLog log(params.max_iterations, progress);
   const nlohmann::json end = params.mode == SoftSphereParams::Mode::faithful ? run_faithful(s, *box, p, log)
-                                                                              : run_accelerated(s, *box, p, log);
+                                                                              : run_accelerated(s, *box, period, p, log);
   progress.finish();
 
   // Check what the bed promises before anyone sees it.
@@ -99,18 +109,20 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
   nl.build(s.x, s.r, *box);
   Contacts con;
   evaluate_contacts(s, nl, *box, con);
+  const bool periodic_axis = box->axial_period() > 0.0;
   double floor_gap = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!s.x[i].allFinite()) throw ConvergenceError(fmt::format("sphere {} has a non-finite position", i));
-    floor_gap = std::max(floor_gap, s.r[i] - s.x[i].z());
+    if (!periodic_axis) floor_gap = std::max(floor_gap, s.r[i] - s.x[i].z());
   }
   if (!(con.max_pair_overlap < p.tolerance && con.max_wall_overlap < p.tolerance && floor_gap < p.tolerance))
     throw ConvergenceError(fmt::format("packed bed fails its tolerance {} d: pair overlap {:.3g} d, wall overlap "
                                        "{:.3g} d, floor penetration {:.3g} d",
                                        params.overlap_tolerance_d, con.max_pair_overlap / p.d_min,
                                        con.max_wall_overlap / p.d_min, floor_gap / p.d_min));
+  // Without gravity (a periodic section) there is no weight to balance: the residual is 0 by definition.
   const double kappa = end.value("stiffness_ratio", 0.0);
-  const auto [res_rms, res_max] = force_residual(s, con, kappa);
+  const auto [res_rms, res_max] = periodic_axis ? std::pair{0.0, 0.0} : force_residual(s, con, kappa);
 
   PackResult out;
   out.bed.container = container.scaled(1.0);

@@ -32,8 +32,14 @@ namespace bedforge::packer {
 // contacts (1e4 spheres, a = 14: rms 0.41 weights with one contact, 0.22 with four; 0.20 in
 // the bulk, 0.10-0.11 within 2 d of the floor and in the top 5 d). Divergence (non-finite
 // values) returns to the last good window with a halved step, as in the faithful mode.
-// Input: s with x from the generation stage. Output: s.x packed; returns {"stiffness_ratio",
-// "smallest_C_k"} (the smallest C_k the stability limit allowed).
-nlohmann::json run_accelerated(Spheres& s, const Container& container, const SoftSphereSettings& p, RunLog& log);
+// A periodic section (`period` > 0, packing units; the container's axial period is then the
+// longer one the spheres were generated in) has no floor and no gravity: one stage, compression,
+// parts the spheres and shortens the period in steps of 0.2 % down to `period`, parting them
+// again after each; a ConvergenceError says where they jammed when they cannot be parted.
+// Input: s with x from the generation stage. Output: s.x packed (the container's period is
+// `period`); returns {"stiffness_ratio", "smallest_C_k"} (the smallest C_k the stability limit
+// allowed).
+nlohmann::json run_accelerated(Spheres& s, Container& container, double period, const SoftSphereSettings& p,
+                               RunLog& log);
 
 }  // namespace bedforge::packer

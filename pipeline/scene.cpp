@@ -24,6 +24,39 @@ double unit_to_metres(const std::string& unit) {
   return 1e-6;  // "um"
 }
 
+// What a periodic section (container.period_z) can be given today: the accelerated soft-sphere
+// packer or an imported bed; positions and analysis; no floor-bound packer, no surface yet.
+void check_periodic_section(const Scene& sc, const toml::table& table) {
+  const std::string key = !table.contains("container")    ? "the bed file's container record, period_z,"
+                          : table["container"]["period_z_m"] ? "container.period_z_m"
+                                                            : "container.period_z_d";
+  if (sc.algorithm == "monte-carlo")
+    throw InputError(fmt::format("{} is set, but packing.algorithm = \"monte-carlo\" settles spheres on a floor; "
+                                 "allowed with an axial period: \"soft-sphere\" (accelerated) or \"import\"",
+                                 key));
+  if (sc.algorithm == "soft-sphere" && sc.soft_sphere.mode == packer::SoftSphereParams::Mode::faithful)
+    throw InputError(fmt::format("{} is set, but packing.soft_sphere.mode = \"faithful\" follows Salvat et al.'s "
+                                 "schedule, which settles the bed on a floor; allowed with an axial period: "
+                                 "\"accelerated\"",
+                                 key));
+  if (sc.needs_surface())
+    throw InputError(fmt::format("{} is set, but outputs.files asks for \"stl\", \"mesh\" or \"case\": a "
+                                 "periodic section's surface, mesh and cyclic case are not made yet; allowed: "
+                                 "\"positions\", \"vtp\", \"analysis\"",
+                                 key));
+  if (sc.algorithm == "soft-sphere" && sc.sizes.smallest() == sc.sizes.largest()) {
+    // Equal spheres packed from random positions without friction jam at random close packing.
+    const double solid = static_cast<double>(sc.count) * sc.sizes.mean_volume() /
+                         (sc.container->cross_section_area() * sc.container->axial_period());
+    if (solid > 0.64)
+      throw InputError(fmt::format("{}: {} equal spheres in one period fill {:.3f} of it, beyond random close "
+                                   "packing (0.64, Scott & Kilgour 1969), which a packing from random positions "
+                                   "does not pass; allowed: a solid fraction up to 0.64 (a longer period or "
+                                   "fewer spheres, particles.count)",
+                                   key, sc.count, solid));
+  }
+}
+
 }  // namespace
 
 bool Scene::wants(const std::string& output) const {
@@ -107,6 +140,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection outputs = root.sub("outputs");
   sc.outputs = outputs.strings("files", kDefaultOutputs, kOutputs);
   outputs.finish();
+  if (sc.container->axial_period() > 0.0) check_periodic_section(sc, table);
   if (sc.count == 0 && sc.wants("analysis"))
     throw InputError("outputs.files has \"analysis\", but particles.count = 0 (the empty container) has no spheres to "
                      "analyse; allowed: \"positions\", \"vtp\", \"stl\", \"mesh\", \"case\"");

@@ -48,6 +48,13 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"container.size_y_m", {"the same in metres"}},
       {"container.periodic_x", {"the box's two sides normal to x are periodic instead of walls"}},
       {"container.periodic_y", {"the box's two sides normal to y are periodic instead of walls"}},
+      {"container.period_z_d",
+       {"axial period: the bed repeats along z every period, with neither floor nor top (a periodic section of a long "
+        "bed; `particles.count` in one period sets its void fraction); at least 3 largest diameters; packed by the "
+        "accelerated soft-sphere packer, which compresses a longer period down to this one without gravity and "
+        "stops with an error where the spheres jam first; analysed, not meshed (its surface and cyclic case are not "
+        "made yet)"}},
+      {"container.period_z_m", {"the same in metres"}},
       // [particles]
       {"particles.count",
        {"number of spheres; 0 is the empty container, whose case is compared with the exact laminar flow through it "

@@ -17,7 +17,7 @@ std::vector<Wall> walls_of(const Container& c) {
   if (const auto* ann = dynamic_cast<const Annulus*>(&c))
     return {Wall{"wall", 0, false, ann->outer_radius()}, Wall{"inner wall", 1, false, ann->inner_radius(), true}};
   if (const auto* box = dynamic_cast<const Box*>(&c)) {
-    if (box->periodicity().any())
+    if (box->periodicity().lateral())
       throw InputError("container.periodic_x/periodic_y = true: the surface stage meshes walled boxes only (a periodic "
                        "fluid domain needs matching periodic patches, not made here); allowed: a box with walls on "
                        "every side, a cylinder or an annulus");

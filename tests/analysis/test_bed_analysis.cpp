@@ -83,3 +83,24 @@ TEST(BedAnalysis, VoidFractionAndCoordinationAreThoseOfARandomDenseBed) {
   EXPECT_GT(touching, 300);  // seeds 1-6 of this bed: 436-454 (2026-11-24)
   EXPECT_EQ(j["wall_contacts"]["spheres_touching_lateral_wall"].get<int>(), touching);
 }
+
+TEST(BedAnalysis, PeriodicSectionCountsSpheresThroughItsEnds) {
+  // A tube of radius 3 periodic along z every 4; unit spheres, two of them crossing z = 0 or
+  // z = H and one given below the period. Each sphere's whole volume counts once, so the void
+  // fraction is exactly 1 - N (pi/6) / (pi 9 x 4); two spheres touch only through the period;
+  // nothing rests on a floor.
+  Bed bed;
+  auto tube = std::make_shared<Cylinder>(3.0);
+  tube->set_axial_period(4.0);
+  bed.container = tube;
+  bed.centres = {{0, 0, 0.1}, {1.5, 0, 3.8}, {-1.5, 0, -2.0}, {0, 0, 3.1}};
+  bed.diameters = {1, 1, 1, 1};
+  const auto r = analysis::analyse_bed(bed, {});
+  const double expected = 1.0 - 4.0 * (1.0 / 6.0) / (9.0 * 4.0);
+  EXPECT_NEAR(r.report["void_fraction"]["whole_bed"].get<double>(), expected, 1e-12);
+  EXPECT_NEAR(r.report["void_fraction"]["central_slab"].get<double>(), expected, 1e-12);  // no ends to leave out
+  EXPECT_EQ(r.report["void_fraction"]["bed_height_m"].get<double>(), 4.0);
+  EXPECT_EQ(r.report["coordination"]["mean_all"].get<double>(), 0.5);  // spheres 0 and 3, through z = 0
+  EXPECT_EQ(r.report["wall_contacts"]["spheres_touching_floor"].get<long>(), 0);
+  EXPECT_TRUE(r.report["force_residual"]["rms"].is_null());
+}

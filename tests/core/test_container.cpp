@@ -110,6 +110,25 @@ TEST(Box, WallsOnlyOnNonPeriodicSides) {
   EXPECT_DOUBLE_EQ(corner.wall_perimeter(), 14.0);
 }
 
+TEST(Containers, AxialPeriodWrapsAlongTheAxis) {
+  Cylinder c(2.0);
+  EXPECT_FALSE(c.periodicity().any());
+  c.set_axial_period(5.0);
+  const Periodicity p = c.periodicity();
+  EXPECT_TRUE(p.any());
+  EXPECT_FALSE(p.lateral());
+  EXPECT_NEAR(p.separation({0, 0, 4.8}, {0, 0, 0.1}).z(), -0.3, 1e-12);  // through the period
+  EXPECT_NEAR(p.wrapped({1, 0, -0.5}).z(), 4.5, 1e-12);                   // into [0, H)
+  EXPECT_NEAR(p.wrapped({1, 0, 5.0}).z(), 0.0, 1e-12);
+  Box b(4.0, 4.0, true, false);
+  b.set_axial_period(3.0);
+  EXPECT_EQ(b.periodicity().lx, 4.0);
+  EXPECT_EQ(b.periodicity().lz, 3.0);
+  EXPECT_EQ(b.scaled(2.0)->axial_period(), 6.0);  // a change of unit keeps the period
+  EXPECT_EQ(container_from_json(b.to_json())->to_json(), b.to_json());
+  EXPECT_EQ(container_from_json(b.to_json())->axial_period(), 3.0);
+}
+
 TEST(Containers, HydraulicDiameterOfCircularShapesIsTheirWidth) {
   // 4 A / P: the diameter of a cylinder, the gap's width twice over for an annulus.
   const Cylinder c(1.5);
@@ -143,6 +162,10 @@ TEST(Containers, ReadWithClearErrors) {
   EXPECT_NE(message("[container]\ntype = \"box\"\nsize_x_d = 2.5\nsize_y_d = 9\nperiodic_x = true").find("3 diameters"),
             std::string::npos);
   EXPECT_NE(message("[container]\ntype = \"sphere\"\ndiameter_d = 5").find("cylinder"), std::string::npos);
+  EXPECT_EQ(read("[container]\ndiameter_d = 5\nperiod_z_d = 3")->axial_period(), 0.003);
+  const std::string short_period = message("[container]\ndiameter_d = 5\nperiod_z_d = 2.5");
+  EXPECT_NE(short_period.find("container.period_z_d"), std::string::npos) << short_period;
+  EXPECT_NE(short_period.find("3 largest diameters"), std::string::npos) << short_period;
 }
 
 TEST(Containers, JsonRoundTripOfEveryKind) {

@@ -93,6 +93,30 @@ TEST(NeighbourList, FindsPairsAcrossPeriodicSides) {
     }
 }
 
+TEST(NeighbourList, FindsPairsAcrossAnAxialPeriod) {
+  // A tube periodic along z, periods of 1 to about 10 cells, centres given up to a period below
+  // or above [0, H); and a box periodic on every side.
+  for (double period : {1.1, 3.0, 3.7, 9.0}) {
+    Cylinder tube(3.0);
+    tube.set_axial_period(period);
+    Box box(3.3, 4.0, true, true);
+    box.set_axial_period(period);
+    for (const Container* c : {static_cast<const Container*>(&tube), static_cast<const Container*>(&box)}) {
+      Rng rng(5);
+      std::vector<Eigen::Vector3d> x;
+      std::vector<double> r;
+      for (int i = 0; i < 300; ++i) {
+        const auto p = c->sample_centre(rng, 0.5);
+        x.emplace_back(p.x(), p.y(), period * (rng.uniform() + (i % 3 - 1)));
+        r.push_back(i % 4 == 0 ? 0.5 : 0.35);
+      }
+      NeighbourList nl(0.2);
+      nl.build(x, r, *c);
+      EXPECT_EQ(listed(nl, x.size()), brute_force(x, r, 0.2, c->periodicity())) << c->kind() << ", H = " << period;
+    }
+  }
+}
+
 TEST(NeighbourList, FindsSpheresPushedThroughTheWall) {
   // Soft walls let a sphere's centre leave the cross-section; it is kept in the grid's edge
   // cells, which must still be searched as far as it reaches.

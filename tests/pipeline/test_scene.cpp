@@ -131,3 +131,28 @@ TEST(Scene, SlabsAreRefusedWhereTheirPlanesWouldChangeTheBed) {
   EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"bridge\"\n[mesh]\nslabs = 1\n").mesh.slabs, 1);
 }
 #endif
+
+TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
+  auto message = [](const std::string& text) {
+    try {
+      read(text);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string section = "[container]\ndiameter_d = 5\nperiod_z_d = 5\n[particles]\ncount = 105\n";
+  EXPECT_EQ(read(section).container->axial_period(), 0.005);
+  // A packer that settles on a floor, a surface not made yet, and more spheres than a random
+  // packing holds (0.70 solid); each names the period's key and what is allowed.
+  for (const std::string& extra : {std::string("[packing]\nalgorithm = \"monte-carlo\"\n"),
+                                   std::string("[packing.soft_sphere]\nmode = \"faithful\"\n"),
+                                   std::string("[outputs]\nfiles = [\"case\"]\n")}) {
+    const std::string m = message(section + extra);
+    EXPECT_NE(m.find("container.period_z_d is set"), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed"), std::string::npos) << m;
+  }
+  const std::string full = message("[container]\ndiameter_d = 5\nperiod_z_m = 0.004\n[particles]\ncount = 105\n");
+  EXPECT_NE(full.find("container.period_z_m"), std::string::npos) << full;
+  EXPECT_NE(full.find("0.64"), std::string::npos) << full;
+}
