@@ -14,9 +14,10 @@ namespace {
 
 std::string header_lines(const Bed& bed, const Provenance& p, const char* prefix) {
   std::string h;
+  const bool periodic_axis = bed.container && bed.container->axial_period() > 0.0;
   h += fmt::format("{}bedforge bed: sphere centres and diameters in metres; container axis z through the origin, "
-                   "floor z = 0\n",
-                   prefix);
+                   "{}\n",
+                   prefix, periodic_axis ? "periodic along z, centres in [0, period_z)" : "floor z = 0");
   h += fmt::format("{}version: {}\n", prefix, p.version);
   if (p.seed) h += fmt::format("{}seed: {}\n", prefix, *p.seed);
   if (bed.container) h += fmt::format("{}container_m: {}\n", prefix, bed.container->to_json().dump());

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -100,6 +101,7 @@ ImportedBed read_lammps_dump(const std::filesystem::path& path, double to_metres
   bool have_atoms_count = false;
   Eigen::Matrix<double, 3, 2> box = Eigen::Matrix<double, 3, 2>::Zero();
   bool triclinic = false;
+  std::array<bool, 3> periodic{};  // boundary flags "pp" of the box bounds
   auto line_after = [&](std::size_t i, const char* item) -> const std::string& {
     if (i + 1 >= lines.text.size())
       throw InputError(fmt::format("{}:{}: the file ends after 'ITEM: {}'", rows.path(), i + 1, item));
@@ -119,6 +121,10 @@ ImportedBed read_lammps_dump(const std::filesystem::path& path, double to_metres
       have_atoms_count = true;
     } else if (item == "BOX") {
       triclinic = words.size() > 2 && words[2] == "xy";
+      // `ITEM: BOX BOUNDS [xy xz yz] xx yy zz`: the last three words, when given, are the
+      // boundary flags (p periodic; f, s, m not).
+      for (int k = 0; k < 3; ++k)
+        periodic[k] = words.size() >= 5 && words[words.size() - 3 + k] == "pp";
       for (int k = 0; k < 3; ++k) {
         if (i + 1 + k >= lines.text.size())
           throw InputError(fmt::format("{}:{}: the box bounds end early", rows.path(), i + 1));
@@ -181,6 +187,22 @@ ImportedBed read_lammps_dump(const std::filesystem::path& path, double to_metres
                                  "LIGGGHTS text dump?",
                                  rows.path()));
   last.header = {{"format", "lammps-dump"}, {"snapshots", snapshots}, {"timestep", timestep}};
+  if (periodic[0] || periodic[1] || periodic[2]) {
+    // A periodic box is the bed's container: a box with walls on its non-periodic sides, its
+    // frame bedforge's (centred in x and y, z from the lower bound), and an axial period when z
+    // is periodic.
+    if (triclinic)
+      throw InputError(fmt::format("{}: a periodic triclinic box; allowed: an orthogonal box ('ITEM: BOX BOUNDS pp "
+                                   "pp pp')",
+                                   rows.path()));
+    const Eigen::Vector3d size = (box.col(1) - box.col(0)) * to_metres;
+    const Eigen::Vector3d shift(0.5 * (box(0, 0) + box(0, 1)), 0.5 * (box(1, 0) + box(1, 1)), box(2, 0));
+    for (auto& c : last.bed.centres) c -= shift * to_metres;
+    auto container = std::make_shared<Box>(size.x(), size.y(), periodic[0], periodic[1]);
+    if (periodic[2]) container->set_axial_period(size.z());
+    last.bed.container = container;
+    last.header["periodic"] = {periodic[0], periodic[1], periodic[2]};
+  }
   return last;
 }
 

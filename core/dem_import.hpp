@@ -16,7 +16,9 @@ namespace bedforge {
 //   lammps-dump  a LAMMPS or LIGGGHTS text dump (`dump custom ... id type x y z radius`): the
 //                LAST snapshot in the file is read, the settled bed; columns x|xu|xs|xsu
 //                (scaled coordinates of an orthogonal box are unscaled with its bounds) and
-//                radius or diameter
+//                radius or diameter; a box periodic on some side (`ITEM: BOX BOUNDS pp pp pp`)
+//                becomes the bed's container, a box with those sides periodic (and an axial
+//                period when z is), in bedforge's frame: centred in x and y, z from its lower bound
 //   yade         yade.export.text / textExt output: an optional `#format x_y_z_r` line
 //                (x_y_z_r, x_y_z_r_matId, x_y_z_r_attrs or id_x_y_z_r_matId), then rows with
 //                the RADIUS in the fourth place
@@ -25,7 +27,7 @@ namespace bedforge {
 //   to_metres  the file's length unit in metres (1e-3 for millimetres)
 //   origin_m   the point of the file's frame, in metres, that becomes bedforge's origin (a
 //              point on the container axis at the floor); subtracted from every centre
-// Output: the bed (container null unless the file is bedforge's own CSV) and a header with what
+// Output: the bed (container null unless the file is bedforge's own CSV or a periodic dump) and a header with what
 // the file said about itself (LAMMPS: the timestep and snapshot count; Yade: the format).
 // InputError names the file, the line and what was expected.
 enum class BedFileFormat { xyzd, lammps_dump, yade };

@@ -25,11 +25,12 @@ nlohmann::json check_imported(const Bed& bed, const std::string& file) {
     double worst = 0.0;
     for (int k = 0; k < nw; ++k) worst = std::max(worst, walls[k].overlap);
     const auto& c = bed.centres[i];
-    if (worst > r || c.z() < 0.0)
+    const bool below_floor = c.z() < 0.0 && bed.container->axial_period() == 0.0;  // a periodic axis has none
+    if (worst > r || below_floor)
       throw InputError(fmt::format("{}: sphere {} (centre {:.6g}, {:.6g}, {:.6g} m) lies {} the {}; allowed: centres "
                                    "inside the container, above the floor at z = 0 (check packing.units, "
                                    "packing.origin_m and [container])",
-                                   file, i + 1, c.x(), c.y(), c.z(), c.z() < 0.0 ? "below the floor of" : "outside",
+                                   file, i + 1, c.x(), c.y(), c.z(), below_floor ? "below the floor of" : "outside",
                                    bed.container->kind()));
   }
   const analysis::ContactStatistics cs = analysis::contact_statistics(bed, 0.0);

@@ -195,6 +195,48 @@ TEST(CommandLine, LiggghtsDumpIsImportedIntoTheSameBed) {
   EXPECT_FALSE(fs::exists(wrong / "bed.csv"));
 }
 
+// A bed periodic on every side (a box section, 1 mm spheres), written as a LAMMPS dump of a
+// periodic box [0, 5] mm in each direction with every third centre unwrapped a period below,
+// comes back as the same bed: the container from the dump's box, the same void fraction and
+// overlaps; no centre is refused as below a floor the section does not have.
+TEST(CommandLine, PeriodicLammpsBoxIsImportedIntoTheSameBed) {
+  const fs::path packed = fresh_dir("periodic_to_dump"), out = fresh_dir("periodic_from_dump");
+  const fs::path box = scene("periodic_box.toml", "[container]\ntype = \"box\"\nsize_x_d = 5\nsize_y_d = 5\nperiodic_x = true\n"
+                          "periodic_y = true\nperiod_z_d = 5\n[particles]\ncount = 120\ndiameter_m = 0.001\n");
+  const Result run = bedforge("run " + box.string() + " -o " + packed.string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  std::ifstream in(packed / "bed.csv");
+  const fs::path dump = out.parent_path() / "periodic.dump";
+  std::ofstream d(dump);
+  std::vector<std::string> atoms;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 'x') continue;
+    std::array<double, 4> v;
+    char comma;
+    std::stringstream(line) >> v[0] >> comma >> v[1] >> comma >> v[2] >> comma >> v[3];
+    std::ostringstream row;
+    row.precision(17);
+    const double unwrap = atoms.size() % 3 == 0 ? 5.0 : 0.0;
+    row << atoms.size() + 1 << " 1 " << v[0] * 1e3 + 2.5 << ' ' << v[1] * 1e3 + 2.5 << ' ' << v[2] * 1e3 - unwrap << ' '
+        << v[3] * 0.5e3;
+    atoms.push_back(row.str());
+  }
+  d << "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n" << atoms.size() << "\nITEM: BOX BOUNDS pp pp pp\n0 5\n0 5\n0 5\n"
+    << "ITEM: ATOMS id type x y z radius\n";
+  for (const auto& a : atoms) d << a << '\n';
+  d.close();
+  const Result r = bedforge("import " + dump.string() + " --format lammps-dump --units mm -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto original = nlohmann::json::parse(read(packed / "report.json"))["stages"]["pack"];
+  const auto imported = nlohmann::json::parse(read(out / "report.json"))["stages"]["pack"];
+  EXPECT_EQ(imported["spheres"], 120);
+  EXPECT_NEAR(imported["void_fraction"]["whole_bed"].get<double>(), original["void_fraction"]["whole_bed"].get<double>(),
+              1e-9);
+  EXPECT_NEAR(imported["void_fraction"]["axial_period_m"].get<double>(), 0.005, 1e-15);
+  EXPECT_NEAR(imported["overlaps"]["max_pair_overlap_d"].get<double>(), original["max_pair_overlap_d"].get<double>(),
+              1e-6);
+}
+
 // The sphere rows of a bed.csv (its header records the scene, which may differ).
 std::string bed_rows(const fs::path& csv) {
   std::ifstream in(csv);

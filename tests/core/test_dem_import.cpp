@@ -63,6 +63,27 @@ TEST(DemImport, ScaledCoordinatesAreMappedThroughTheBox) {
   EXPECT_NEAR(in.bed.centres[1].x(), 2.0, 1e-12);
 }
 
+TEST(DemImport, APeriodicBoxBecomesTheContainer) {
+  // A box periodic on every side, [0, 8] x [2, 10] x [-1, 7] mm: the container is a box of 8 mm
+  // periodic in x and y with an axial period of 8 mm, in bedforge's frame (centred in x and y,
+  // z from the lower bound); a box with walls (flags ff) keeps no container, as before.
+  const std::string dump = "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp pp\n0 8\n2 10\n-1 7\n"
+                           "ITEM: ATOMS id type x y z radius\n1 1 1 3 0 0.5\n";
+  const ImportedBed in = read_lammps_dump(write("periodic.dump", dump), 1e-3);
+  ASSERT_NE(in.bed.container, nullptr);
+  const Periodicity per = in.bed.container->periodicity();
+  EXPECT_NEAR(per.lx, 8e-3, 1e-15);
+  EXPECT_NEAR(per.ly, 8e-3, 1e-15);
+  EXPECT_NEAR(per.lz, 8e-3, 1e-15);
+  EXPECT_NEAR(in.bed.centres[0].x(), -3e-3, 1e-15);
+  EXPECT_NEAR(in.bed.centres[0].y(), -3e-3, 1e-15);
+  EXPECT_NEAR(in.bed.centres[0].z(), 1e-3, 1e-15);
+  EXPECT_EQ(read_lammps_dump(write("walled.dump", snapshot(1, 0.0, false)), 1.0).bed.container, nullptr);
+  std::string tilted = dump;
+  tilted.replace(tilted.find("BOUNDS pp pp pp\n0 8\n2 10\n-1 7"), 29, "BOUNDS xy xz yz pp pp pp\n0 8 0\n2 10 0\n-1 7 0");
+  EXPECT_NE(error_of([&] { read_lammps_dump(write("tilted.dump", tilted), 1.0); }).find("triclinic"), std::string::npos);
+}
+
 TEST(DemImport, LammpsDiameterColumnIsTakenAsIs) {
   const std::string dump =
       "ITEM: TIMESTEP\n7\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp ff\n-1 1\n-1 1\n0 2\n"
