@@ -130,13 +130,17 @@ double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, c
   return lambda;
 }
 
+double hashed_uniform(std::uint64_t i, std::uint64_t salt) {
+  std::uint64_t h = (i + 1) * 0x9E3779B97F4A7C15ULL ^ (salt + 1) * 0xBF58476D1CE4E5B9ULL;
+  h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
 std::size_t lift_floor_spheres(Spheres& s, double height, std::uint64_t salt) {
   std::size_t lifted = 0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     if (!on_floor(s, i)) continue;
-    std::uint64_t h = (static_cast<std::uint64_t>(i) + 1) * 0x9E3779B97F4A7C15ULL ^ (salt + 1) * 0xBF58476D1CE4E5B9ULL;
-    h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
-    s.x[i].z() += height * static_cast<double>(h >> 11) * 0x1.0p-53;
+    s.x[i].z() += height * hashed_uniform(i, salt);
     ++lifted;
   }
   return lifted;

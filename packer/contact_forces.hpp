@@ -41,6 +41,10 @@ inline bool on_floor(const Spheres& s, std::size_t i) { return s.x[i].z() <= s.r
 // A lower estimate that converges from below; callers keep a margin.
 double contact_stiffness_eigenvalue(const Spheres& s, const NeighbourList& nl, const Container& c, int iterations = 40);
 
+// A fixed hash of (i, salt) as a number in [0, 1): perturbations that keep runs reproducible
+// whatever the thread count.
+double hashed_uniform(std::uint64_t i, std::uint64_t salt);
+
 // Plain descent cannot leave an unstable equilibrium: spheres clamped to the floor share one
 // height exactly, so two of them squeezed together by a narrow wall push each other only
 // sideways and nothing lifts either (the net push on each is zero). Lifts every sphere resting

@@ -135,22 +135,28 @@ class AcceleratedDescent {
   }
 };
 
-}  // namespace
-
-namespace {
+// Scales the z coordinates with the period, from the container's period to `next`.
+void set_period(Spheres& s, Container& container, double next) {
+  const double ratio = next / container.axial_period();
+  for (auto& x : s.x) x.z() *= ratio;
+  container.set_axial_period(next);
+}
 
 // A periodic section: no floor and no gravity. The spheres, generated loose in a longer period,
 // are parted, then the period is shortened in small steps (the z coordinates scaled with it) and
 // the spheres parted again after each, down to the period asked for. A period shortened at once
 // jams looser: at a = 5 a single quench stalled with overlaps at void fraction 0.429 and parted
-// at 0.44 (docs/findings.md, 2026-11-28, session 37).
+// at 0.44 (docs/findings.md, 2026-11-28, session 37). Where the spheres jam before the period
+// asked for, the period is let out by 1 %, every sphere moved by up to 0.1 d in a fixed
+// pseudo-random direction (a tap), and the compression resumed, up to max_recoveries taps.
 nlohmann::json compress_period(Spheres& s, Container& container, double period, const SoftSphereSettings& p,
                                RunLog& log) {
   constexpr double kStep = 0.002;  // relative shortening of the period per round
+  constexpr double kLetOut = 0.01, kTap = 0.1;
   const double tol = p.tolerance;
   AcceleratedDescent descent(s, container, p, log);
   log.begin_stage("compression");
-  for (;;) {
+  for (int taps = 0;;) {
     const Relaxed e = descent.relax(1.0, false, 0.5 * p.band_upper, 0.0, [&](const Relaxed& q) {
       return (q.contacts.max_pair_overlap < tol && q.contacts.max_wall_overlap < tol) || q.settled;
     });
@@ -158,17 +164,28 @@ nlohmann::json compress_period(Spheres& s, Container& container, double period, 
     if (e.contacts.max_pair_overlap >= tol || e.contacts.max_wall_overlap >= tol) {
       double solid = 0.0;
       for (double r : s.r) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
-      throw ConvergenceError(fmt::format(
-          "the spheres jammed before the period reached the one asked for: at {:.4g} d (asked {:.4g} d, void "
-          "fraction {:.4f}) overlaps of {:.3g} d (pair) and {:.3g} d (wall) stayed above the tolerance {} d; fewer "
-          "spheres (particles.count) or a longer container.period_z",
-          h, period, 1.0 - solid / (container.cross_section_area() * h), e.contacts.max_pair_overlap / p.d_min,
-          e.contacts.max_wall_overlap / p.d_min, p.given.overlap_tolerance_d));
+      const double eps = 1.0 - solid / (container.cross_section_area() * h);
+      if (taps == p.given.max_recoveries)
+        throw ConvergenceError(fmt::format(
+            "the spheres jammed before the period reached the one asked for: at {:.4g} d (asked {:.4g} d, void "
+            "fraction {:.4f}) overlaps of {:.3g} d (pair) and {:.3g} d (wall) stayed above the tolerance {} d after "
+            "{} taps; fewer spheres (particles.count) or a longer container.period_z",
+            h, period, eps, e.contacts.max_pair_overlap / p.d_min, e.contacts.max_wall_overlap / p.d_min,
+            p.given.overlap_tolerance_d, taps));
+      log.recovery({{"reason", "jammed before the period asked for: let out and tapped"},
+                    {"period_d", h},
+                    {"void_fraction", eps}});
+      set_period(s, container, h * (1.0 + kLetOut));
+      ++taps;
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        const std::uint64_t salt = 3 * static_cast<std::uint64_t>(taps);
+        const Eigen::Vector3d u(hashed_uniform(i, salt), hashed_uniform(i, salt + 1), hashed_uniform(i, salt + 2));
+        s.x[i] += kTap * p.d_min * (2.0 * u - Eigen::Vector3d::Ones());
+      }
+      continue;
     }
     if (h <= period) break;
-    const double next = std::max(period, h * (1.0 - kStep));
-    for (auto& x : s.x) x.z() *= next / h;
-    container.set_axial_period(next);
+    set_period(s, container, std::max(period, h * (1.0 - kStep)));
   }
   return {{"stiffness_ratio", 0.0},
           {"smallest_C_k", descent.smallest_stiffness_step()},

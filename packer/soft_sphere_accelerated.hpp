@@ -35,7 +35,8 @@ namespace bedforge::packer {
 // A periodic section (`period` > 0, packing units; the container's axial period is then the
 // longer one the spheres were generated in) has no floor and no gravity: one stage, compression,
 // parts the spheres and shortens the period in steps of 0.2 % down to `period`, parting them
-// again after each; a ConvergenceError says where they jammed when they cannot be parted.
+// again after each; where they jam first it lets the period out by 1 % and taps them (up to
+// max_recoveries times), and a ConvergenceError says where they jammed last.
 // Input: s with x from the generation stage. Output: s.x packed (the container's period is
 // `period`); returns {"stiffness_ratio", "smallest_C_k"} (the smallest C_k the stability limit
 // allowed).
