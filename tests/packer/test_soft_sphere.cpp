@@ -37,6 +37,14 @@ packer::PackResult pack(double a, long n, std::uint64_t seed, const SoftSpherePa
   return packer::pack_soft_sphere(p, sizes, Cylinder(0.5 * a * sizes.sauter_mean()), n, seed, quiet);
 }
 
+// A tube of a = 5 (unit spheres) periodic along its axis every `period`, holding `count` spheres.
+packer::PackResult pack_section(double period, long count, std::uint64_t seed, const SoftSphereParams& p = {}) {
+  Progress quiet("test", false);
+  Cylinder tube(2.5);
+  tube.set_axial_period(period);
+  return packer::pack_soft_sphere(p, equal_spheres(), tube, count, seed, quiet);
+}
+
 // Every promise a packed bed makes: finite, inside the wall and above the floor, overlaps below
 // the tolerance (relative to the smallest diameter), checked independently of the packer.
 void expect_valid(const packer::PackResult& r, double tol_d = 1e-4) {
@@ -50,7 +58,9 @@ void expect_valid(const packer::PackResult& r, double tol_d = 1e-4) {
     WallContact w[Container::kMaxWallContacts];
     const int nw = b.container->wall_contacts(c, ri, w);
     for (int k = 0; k < nw; ++k) EXPECT_LE(w[k].overlap, tol_d * d_min) << "sphere " << i << " crosses a wall";
-    if (per.lz == 0.0) EXPECT_GE(c.z() - ri, -tol_d * d_min) << "sphere " << i << " below the floor";
+    if (per.lz == 0.0) {  // a periodic axis has no floor
+      EXPECT_GE(c.z() - ri, -tol_d * d_min) << "sphere " << i << " below the floor";
+    }
     for (size_t j = i + 1; j < b.size(); ++j) {
       const double overlap = 0.5 * (b.diameters[i] + b.diameters[j]) - per.separation(c, b.centres[j]).norm();
       EXPECT_LT(overlap, tol_d * d_min) << "spheres " << i << " and " << j;
@@ -126,10 +136,7 @@ TEST(SoftSphere, PeriodicSectionOfATube) {
   // A tube periodic along its axis (a = 5, period 5 d, 102 spheres: void fraction 0.456, which
   // seeds 1-6 all reach; at 0.443 a section this short can jam first, docs/findings.md): no
   // floor, and pairs act across the period.
-  Progress quiet("test", false);
-  Cylinder tube(2.5);
-  tube.set_axial_period(5.0);
-  const auto r = packer::pack_soft_sphere(SoftSphereParams{}, equal_spheres(), tube, 102, 3, quiet);
+  const auto r = pack_section(5.0, 102, 3);
   expect_valid(r);
   const Periodicity per = r.bed.container->periodicity();
   ASSERT_EQ(per.lz, 5.0);
@@ -143,7 +150,7 @@ TEST(SoftSphere, PeriodicSectionOfATube) {
   }
   EXPECT_GT(across, 5);
   // The same seed gives the same section.
-  const auto again = packer::pack_soft_sphere(SoftSphereParams{}, equal_spheres(), tube, 102, 3, quiet);
+  const auto again = pack_section(5.0, 102, 3);
   EXPECT_EQ(again.bed.centres, r.bed.centres);
 }
 
@@ -151,10 +158,7 @@ TEST(SoftSphere, PeriodicSectionThatJamsFirstIsTapped) {
   // a = 5, period 10 d, 212 spheres (void fraction 0.435, that of full a = 5 beds' central
   // slab): with seed 2 the compression jams first (it stopped there before taps existed,
   // docs/findings.md); tapped, it reaches the period with every overlap within the tolerance.
-  Progress quiet("test", false);
-  Cylinder tube(2.5);
-  tube.set_axial_period(10.0);
-  const auto r = packer::pack_soft_sphere(SoftSphereParams{}, equal_spheres(), tube, 212, 2, quiet);
+  const auto r = pack_section(10.0, 212, 2);
   expect_valid(r);
   EXPECT_GE(r.info["recoveries"].size(), 1u);
   EXPECT_EQ(r.bed.container->axial_period(), 10.0);
@@ -163,13 +167,10 @@ TEST(SoftSphere, PeriodicSectionThatJamsFirstIsTapped) {
 TEST(SoftSphere, PeriodicSectionThatCannotHoldItsSpheres) {
   // 0.70 solid in the period, beyond random close packing: the packer says so instead of
   // returning overlapping spheres (the scene reader refuses it earlier, for equal spheres).
-  Progress quiet("test", false);
   SoftSphereParams p;
   p.max_iterations = 400'000;
-  Cylinder tube(2.5);
-  tube.set_axial_period(4.0);
   try {
-    packer::pack_soft_sphere(p, equal_spheres(), tube, 105, 1, quiet);
+    pack_section(4.0, 105, 1, p);
     ADD_FAILURE() << "a period 0.70 full was packed";
   } catch (const ConvergenceError& e) {
     SUCCEED() << e.what();
