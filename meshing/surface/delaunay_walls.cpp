@@ -11,15 +11,12 @@
 #include <unordered_set>
 #include <utility>
 
+#include "core/edge_key.hpp"
 #include "meshing/surface/spaced_points.hpp"
 
 namespace bedforge::meshing {
 
 namespace {
-
-std::uint64_t edge_key(int a, int b) {
-  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-}
 
 // Whether some sphere through the corners of triangle t holds none of the points within
 // `reach` of it: then t is a facet of their Delaunay tetrahedra. The spheres through the corners

@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "core/edge_key.hpp"
 #include "core/random.hpp"
 #include "meshing/surface/planar_cdt.hpp"
 #include "meshing/surface/spaced_points.hpp"
@@ -179,8 +180,6 @@ bool insert_into_hull(std::vector<std::array<int, 3>>& faces, const std::vector<
   return true;
 }
 
-long edge_key(int a, int b) { return static_cast<long>(std::min(a, b)) << 32 | static_cast<long>(std::max(a, b)); }
-
 }  // namespace
 
 Frame Frame::along(const Eigen::Vector3d& origin, const Eigen::Vector3d& axis) {
@@ -342,7 +341,7 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     added_from = before;
   }
   m.points = pts.points;
-  std::unordered_set<long> edges;
+  std::unordered_set<std::uint64_t> edges;
   for (const auto& t : m.triangles)
     for (int e = 0; e < 3; ++e) edges.insert(edge_key(t[e], t[(e + 1) % 3]));
   for (int first = 0, k = 0; k < static_cast<int>(cuts.size()); first += static_cast<int>(cuts[k].loop.size()), ++k) {

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "core/edge_key.hpp"
+
 namespace bedforge::meshing {
 
 namespace {
@@ -148,8 +150,7 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
     if (feature[p]) point_at[p] = static_cast<int>(d.points.size()), d.points.push_back(m.points[p]);
   std::unordered_map<std::uint64_t, int> midpoints;
   auto midpoint = [&](int a, int b) {
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-    const auto [it, added] = midpoints.emplace(key, static_cast<int>(d.points.size()));
+    const auto [it, added] = midpoints.emplace(edge_key(a, b), static_cast<int>(d.points.size()));
     if (added) d.points.push_back(0.5 * (m.points[a] + m.points[b]));
     return it->second;
   };
