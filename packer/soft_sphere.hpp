@@ -29,7 +29,7 @@ struct SoftSphereParams {
   double final_momentum_bound = 100;         // accelerated: cap on Nesterov's t in the final stage at the default
                                              // tolerance, scaled by 1e-4 d / tolerance below it (0: none)
   long max_iterations = 5'000'000;           // all stages together
-  int max_recoveries = 8;                    // step halvings allowed after detected divergence
+  int max_recoveries = 8;                    // step halvings allowed after detected divergence; taps of a periodic section
   double neighbour_skin_d = 0.2;             // Verlet skin
 };
 
