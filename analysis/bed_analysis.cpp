@@ -38,15 +38,16 @@ Slab central_slab(const Bed& bed, const AnalysisParams& p, double d_ref) {
   return {cut, h - cut, h - cut > cut};
 }
 
-// Along a periodic axis: the bed with centres wrapped into [0, H) (sphere i stays sphere i),
-// then, appended, the images (z +- H) of the spheres that cross z = 0 or z = H, so that volume
-// measures over [0, H] count every sphere's whole volume once. Otherwise the bed itself.
+// The bed with centres wrapped into the container's periodic cell (sphere i stays sphere i).
 Bed wrapped(const Bed& bed) {
   Bed out = bed;
   const Periodicity per = bed.container->periodicity();
   for (auto& c : out.centres) c = per.wrapped(c);
   return out;
 }
+// Along a periodic axis of period H: a wrapped bed with, appended, the images (z +- H) of the
+// spheres that cross z = 0 or z = H, so that volume measures over [0, H] count every sphere's
+// whole volume once. Otherwise the bed itself.
 Bed with_axial_images(const Bed& wrapped_bed) {
   const double period = wrapped_bed.container->axial_period();
   Bed out = wrapped_bed;

@@ -27,8 +27,9 @@ namespace bedforge {
 //   to_metres  the file's length unit in metres (1e-3 for millimetres)
 //   origin_m   the point of the file's frame, in metres, that becomes bedforge's origin (a
 //              point on the container axis at the floor); subtracted from every centre
-// Output: the bed (container null unless the file is bedforge's own CSV or a periodic dump) and a header with what
-// the file said about itself (LAMMPS: the timestep and snapshot count; Yade: the format).
+// Output: the bed (container null unless the file is bedforge's own CSV or a periodic dump)
+// and a header with what the file said about itself (LAMMPS: the timestep and snapshot count;
+// Yade: the format).
 // InputError names the file, the line and what was expected.
 enum class BedFileFormat { xyzd, lammps_dump, yade };
 BedFileFormat bed_file_format(const std::string& name);  // "xyzd" | "lammps-dump" | "yade"

@@ -1,6 +1,7 @@
 #pragma once
 #include <Eigen/Core>
 
+#include <numbers>
 #include <vector>
 
 #include "core/container.hpp"
@@ -16,6 +17,13 @@ struct Spheres {
   std::vector<double> w;           // weights (d_i / d)^3, N
   std::size_t size() const { return x.size(); }
 };
+
+// Total volume of the spheres (length^3, packing units).
+inline double total_volume(const Spheres& s) {
+  double v = 0.0;
+  for (double r : s.r) v += 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  return v;
+}
 
 // Linear-spring contact state of a configuration, per unit stiffness (Salvat et al. 2005,
 // Eqs. 2a-2b with k = 1): push[i] = sum over sphere and wall contacts of overlap * unit normal

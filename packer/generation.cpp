@@ -2,17 +2,14 @@
 
 #include <cmath>
 #include <algorithm>
-#include <numbers>
 #include <numeric>
 
 namespace bedforge::packer {
 
 Generated generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng) {
-  double volume = 0.0;
-  for (double r : s.r) volume += 4.0 / 3.0 * std::numbers::pi * r * r * r;
   // Along a periodic axis the spheres fill one period; their density is the period's.
   const double period = container.axial_period();
-  const double L0 = period > 0.0 ? period : volume / (container.cross_section_area() * (1.0 - eps0));
+  const double L0 = period > 0.0 ? period : initial_height(s, container, eps0);
   s.x.resize(s.r.size());
   for (std::size_t i = 0; i < s.r.size(); ++i) {
     const Eigen::Vector2d xy = container.sample_centre(rng, s.r[i]);

@@ -20,4 +20,9 @@ struct Generated {
 };
 Generated generate_initial_bed(Spheres& s, const Container& container, double eps0, Rng& rng);
 
+// Eq. (6) generalised: the height L0 the spheres s fill in `container` at void fraction eps0.
+inline double initial_height(const Spheres& s, const Container& container, double eps0) {
+  return total_volume(s) / (container.cross_section_area() * (1.0 - eps0));
+}
+
 }  // namespace bedforge::packer

@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <numbers>
 
 #include "core/error.hpp"
 #include "packer/contact_forces.hpp"
@@ -91,12 +90,7 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
   // A periodic section starts in a period long enough for the initial void fraction and is
   // compressed to its own.
   const double period = box->axial_period();
-  if (period > 0.0) {
-    double volume = 0.0;
-    for (double r : s.r) volume += 4.0 / 3.0 * std::numbers::pi * r * r * r;
-    box->set_axial_period(
-        std::max(period, volume / (box->cross_section_area() * (1.0 - params.initial_void_fraction))));
-  }
+  if (period > 0.0) box->set_axial_period(std::max(period, initial_height(s, *box, params.initial_void_fraction)));
   const Generated gen = generate_initial_bed(s, *box, params.initial_void_fraction, rng);
 
   RunLog log(params.max_iterations, progress);

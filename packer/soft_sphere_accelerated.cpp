@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <numbers>
 
 #include "core/parallel.hpp"
 #include "packer/mass_centre_monitor.hpp"
@@ -162,9 +161,7 @@ nlohmann::json compress_period(Spheres& s, Container& container, double period, 
     });
     const double h = container.axial_period();
     if (e.contacts.max_pair_overlap >= tol || e.contacts.max_wall_overlap >= tol) {
-      double solid = 0.0;
-      for (double r : s.r) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
-      const double eps = 1.0 - solid / (container.cross_section_area() * h);
+      const double eps = 1.0 - total_volume(s) / (container.cross_section_area() * h);
       if (taps == p.given.max_recoveries)
         throw ConvergenceError(fmt::format(
             "the spheres jammed before the period reached the one asked for: at {:.4g} d (asked {:.4g} d, void "
@@ -177,8 +174,8 @@ nlohmann::json compress_period(Spheres& s, Container& container, double period, 
                     {"void_fraction", eps}});
       set_period(s, container, h * (1.0 + kLetOut));
       ++taps;
+      const std::uint64_t salt = 3 * static_cast<std::uint64_t>(taps);
       for (std::size_t i = 0; i < s.size(); ++i) {
-        const std::uint64_t salt = 3 * static_cast<std::uint64_t>(taps);
         const Eigen::Vector3d u(hashed_uniform(i, salt), hashed_uniform(i, salt + 1), hashed_uniform(i, salt + 2));
         s.x[i] += kTap * p.d_min * (2.0 * u - Eigen::Vector3d::Ones());
       }
@@ -221,9 +218,7 @@ nlohmann::json run_accelerated(Spheres& s, Container& container, double period, 
   // measured overlap then corrects it.
   log.begin_stage("compaction");
   const double band_mid = 0.5 * (p.band_lower + p.band_upper);
-  double solid = 0.0;
-  for (double r : s.r) solid += 4.0 / 3.0 * std::numbers::pi * r * r * r;
-  const double height = solid / (0.6 * container.cross_section_area());
+  const double height = total_volume(s) / (0.6 * container.cross_section_area());
   double kappa = 5.0 * std::max(1.0, height) / band_mid;
   Relaxed r;
   for (int round = 0;; ++round) {

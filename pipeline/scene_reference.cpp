@@ -97,7 +97,8 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"packing.soft_sphere.final_momentum_bound",
        {"accelerated: cap on the momentum parameter t in the final stage, 0 for none", "1"}},
       {"packing.soft_sphere.max_iterations", {"iteration cap over all stages: the run stops with exit status 3 past it"}},
-      {"packing.soft_sphere.max_recoveries", {"times a diverging stage is restarted with a smaller step before it fails; for a periodic section "
+      {"packing.soft_sphere.max_recoveries",
+       {"times a diverging stage is restarted with a smaller step before it fails; for a periodic section "
         "(`container.period_z_d`), also the taps allowed where the spheres jam before the period"}},
       {"packing.soft_sphere.neighbour_skin_d", {"Verlet list skin"}},
       // [packing.monte_carlo]
