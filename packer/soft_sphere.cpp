@@ -38,6 +38,9 @@ SoftSphereParams read_soft_sphere_params(SceneSection& s) {
   p.max_recoveries = static_cast<int>(s.integer("max_recoveries", p.max_recoveries, 0, 60));
   // At most half a diameter, so a periodic side of 3 diameters holds each pair once.
   p.neighbour_skin_d = s.number("neighbour_skin_d", p.neighbour_skin_d, Range{0.0, 0.5, true, false});
+  // Random close packing (0.36) is as far as compression from random positions goes.
+  p.target_void_fraction = s.number("target_void_fraction", p.target_void_fraction, Range{0.36, 1.0, false, true},
+                                    "none (the period is container.period_z_d)");
   if (p.overlap_band_lower_d >= p.overlap_band_upper_d)
     throw InputError(fmt::format("{}: overlap_band_lower_d = {} is not below overlap_band_upper_d = {}; allowed: "
                                  "lower < upper",
@@ -64,7 +67,8 @@ nlohmann::json to_json(const SoftSphereParams& p) {
           {"final_momentum_bound", p.final_momentum_bound},
           {"max_iterations", p.max_iterations},
           {"max_recoveries", p.max_recoveries},
-          {"neighbour_skin_d", p.neighbour_skin_d}};
+          {"neighbour_skin_d", p.neighbour_skin_d},
+          {"target_void_fraction", p.target_void_fraction > 0.0 ? nlohmann::json(p.target_void_fraction) : nullptr}};
 }
 
 SoftSphereSettings resolve(const SoftSphereParams& p, double d_ref_m, double d_min_m) {
@@ -88,8 +92,10 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
     s.w.push_back(std::pow(di / d_ref, 3));
   }
   // A periodic section starts in a period long enough for the initial void fraction and is
-  // compressed to its own.
-  const double period = box->axial_period();
+  // compressed to its own, or to the one that gives the spheres drawn the target void fraction.
+  const double period = params.target_void_fraction > 0.0
+                            ? total_volume(s) / ((1.0 - params.target_void_fraction) * box->cross_section_area())
+                            : box->axial_period();
   if (period > 0.0) box->set_axial_period(std::max(period, initial_height(s, *box, params.initial_void_fraction)));
   const Generated gen = generate_initial_bed(s, *box, params.initial_void_fraction, rng);
 
@@ -119,7 +125,9 @@ PackResult pack_soft_sphere(const SoftSphereParams& params, const SizeDistributi
   const auto [res_rms, res_max] = periodic_axis ? std::pair{0.0, 0.0} : force_residual(s, con, kappa);
 
   PackResult out;
-  out.bed.container = container.scaled(1.0);
+  std::unique_ptr<Container> packed = container.scaled(1.0);
+  if (params.target_void_fraction > 0.0) packed->set_axial_period(period * d_ref);
+  out.bed.container = std::move(packed);
   for (std::size_t i = 0; i < s.size(); ++i) {
     out.bed.centres.push_back(box->periodicity().wrapped(s.x[i]) * d_ref);
     out.bed.diameters.push_back(d[gen.order[i]]);

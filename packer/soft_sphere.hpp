@@ -31,6 +31,9 @@ struct SoftSphereParams {
   long max_iterations = 5'000'000;           // all stages together
   int max_recoveries = 8;                    // step halvings allowed after detected divergence; taps of a periodic section
   double neighbour_skin_d = 0.2;             // Verlet skin
+  // A periodic section's void fraction (0: unset): its period is then set from the spheres drawn,
+  // total volume / ((1 - target) x cross-section), and they are compressed to it.
+  double target_void_fraction = 0.0;
 };
 
 // Reads [packing.soft_sphere]; unknown keys and out-of-range values are InputErrors.

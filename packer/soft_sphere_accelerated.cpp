@@ -166,9 +166,13 @@ nlohmann::json compress_period(Spheres& s, Container& container, double period, 
         throw ConvergenceError(fmt::format(
             "the spheres jammed before the period reached the one asked for: at {:.4g} d (asked {:.4g} d, void "
             "fraction {:.4f}) overlaps of {:.3g} d (pair) and {:.3g} d (wall) stayed above the tolerance {} d after "
-            "{} taps; fewer spheres (particles.count) or a longer container.period_z",
+            "{} taps; {}",
             h, period, eps, e.contacts.max_pair_overlap / p.d_min, e.contacts.max_wall_overlap / p.d_min,
-            p.given.overlap_tolerance_d, taps));
+            p.given.overlap_tolerance_d, taps,
+            p.given.target_void_fraction > 0.0
+                ? fmt::format("a packing.soft_sphere.target_void_fraction above {} (the void fraction it jammed at)",
+                              p.given.target_void_fraction)
+                : "fewer spheres (particles.count) or a longer container.period_z"));
       log.recovery({{"reason", "jammed before the period asked for: let out and tapped"},
                     {"period_d", h},
                     {"void_fraction", eps}});

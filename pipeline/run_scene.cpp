@@ -96,7 +96,8 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   } else {
     if (plan.load_bed) {  // bed.csv keeps 17 digits: the bed read back is the bed packed
       bed = read_bed_text(dir / "bed.csv", 1.0).bed;
-      bed.container = scene.container;
+      // A period set by a target void fraction is the spheres', which bed.csv records.
+      if (scene.soft_sphere.target_void_fraction == 0.0) bed.container = scene.container;
     }
     reuse("pack", plan.pack,
           fmt::format("the bed in {} (container, particles and packing unchanged; --force redoes it)", dir.string()));

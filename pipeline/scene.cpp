@@ -24,12 +24,37 @@ double unit_to_metres(const std::string& unit) {
   return 1e-6;  // "um"
 }
 
+// packing.soft_sphere.target_void_fraction makes the container a periodic section whose period
+// the spheres set: here the period their mean volume gives, for the checks made before packing
+// (the packer sets it from the spheres it draws).
+void set_period_from_void_fraction(const Scene& sc, Container& c, double d_max) {
+  const double eps = sc.soft_sphere.target_void_fraction;
+  const std::string key = fmt::format("packing.soft_sphere.target_void_fraction = {}", eps);
+  if (sc.algorithm != "soft-sphere" || sc.soft_sphere.mode != packer::SoftSphereParams::Mode::accelerated)
+    throw InputError(fmt::format("{}: a target void fraction is reached by compressing a periodic section, which "
+                                 "the accelerated soft-sphere packer does; allowed with packing.algorithm = "
+                                 "\"soft-sphere\" and packing.soft_sphere.mode = \"accelerated\"",
+                                 key));
+  if (c.axial_period() > 0.0)
+    throw InputError(fmt::format("{} and container.period_z_d (or _m) are both set; allowed: one of them (the target "
+                                 "sets the period from the spheres)",
+                                 key));
+  if (sc.count == 0)
+    throw InputError(fmt::format("{} with particles.count = 0; allowed: at least one sphere", key));
+  c.set_axial_period(static_cast<double>(sc.count) * sc.sizes.mean_volume() / ((1.0 - eps) * c.cross_section_area()));
+  if (c.axial_period() < 3.0 * d_max)
+    throw InputError(fmt::format("{}: {} spheres give a period of {:.4g} m, shorter than 3 largest diameters ({:.4g} "
+                                 "m); allowed: more spheres (particles.count) or a lower target",
+                                 key, sc.count, c.axial_period(), 3.0 * d_max));
+}
+
 // What a periodic section (container.period_z) can be given today: the accelerated soft-sphere
 // packer or an imported bed; positions and analysis; no floor-bound packer, no surface yet.
 void check_periodic_section(const Scene& sc, const toml::table& table) {
-  const std::string key = !table.contains("container")    ? "the bed file's container record, period_z,"
-                          : table["container"]["period_z_m"] ? "container.period_z_m"
-                                                            : "container.period_z_d";
+  const std::string key = sc.soft_sphere.target_void_fraction > 0.0 ? "packing.soft_sphere.target_void_fraction"
+                          : !table.contains("container")             ? "the bed file's container record, period_z,"
+                          : table["container"]["period_z_m"]          ? "container.period_z_m"
+                                                                     : "container.period_z_d";
   if (sc.algorithm == "monte-carlo")
     throw InputError(fmt::format("{} is set, but packing.algorithm = \"monte-carlo\" settles spheres on a floor; "
                                  "allowed with an axial period: \"soft-sphere\" (accelerated) or \"import\"",
@@ -127,7 +152,9 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
 
   SceneSection container = root.sub("container");
   if (table.contains("container") || !sc.import.bed || !sc.import.bed->bed.container) {
-    sc.container = read_container(container, d_ref, d_max);
+    std::unique_ptr<Container> c = read_container(container, d_ref, d_max);
+    if (sc.soft_sphere.target_void_fraction > 0.0) set_period_from_void_fraction(sc, *c, d_max);
+    sc.container = std::move(c);
   } else {
     sc.container = sc.import.bed->bed.container;
   }

@@ -101,6 +101,10 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"times a diverging stage is restarted with a smaller step before it fails; for a periodic section "
         "(`container.period_z_d`), also the taps allowed where the spheres jam before the period"}},
       {"packing.soft_sphere.neighbour_skin_d", {"Verlet list skin"}},
+      {"packing.soft_sphere.target_void_fraction",
+       {"makes the bed a periodic section (along z, no floor) whose period is set from the spheres drawn so "
+        "that its void fraction is this, exactly: total sphere volume / ((1 - target) x cross-section); instead of "
+        "`container.period_z_d`; compression jams near random close packing (0.36 for equal spheres)", "1"}},
       // [packing.monte_carlo]
       {"packing.monte_carlo.temperature", {"kT / (m* g d): the barometric height in d", "d"}},
       {"packing.monte_carlo.particle_density", {"the spheres' density", "kg/m³"}},

@@ -531,3 +531,20 @@ TEST(RunScene, TheMeshEstimateWithGapsIsLowButNear) {
   EXPECT_GT(cells, estimate);
   EXPECT_LT(cells, 1.6 * estimate);
 }
+
+// A target void fraction sets a periodic section's period from the spheres drawn (a normal size
+// distribution, so not from the scene's mean): the analysis, which integrates each sphere and
+// its image across the period, measures the target; the bed read back for a later stage keeps
+// the spheres' period, not the scene's estimate.
+TEST(RunScene, ATargetVoidFractionIsTheSectionsVoidFraction) {
+  const std::string text =
+      "[container]\ndiameter_d = 4\n[particles]\ncount = 150\ndistribution = \"normal\"\nmean_m = 0.002\n"
+      "std_m = 0.0002\n[packing.soft_sphere]\ntarget_void_fraction = 0.45\n[outputs]\nfiles = [";
+  const fs::path dir = test_support::fresh_dir("target_void_fraction");
+  const RunOutcome packed = run(read_scene(parse_scene_text(text + "\"positions\"]\n", "t.toml"), "t.toml"), dir);
+  EXPECT_NEAR(packed.stages["pack"]["void_fraction"]["whole_bed"].get<double>(), 0.45, 1e-9);
+  const RunOutcome analysed =
+      run(read_scene(parse_scene_text(text + "\"positions\", \"analysis\"]\n", "t.toml"), "t.toml"), dir);
+  ASSERT_FALSE(analysed.built("pack"));
+  EXPECT_NEAR(analysed.stages["analysis"]["void_fraction"]["whole_bed"].get<double>(), 0.45, 1e-9);
+}

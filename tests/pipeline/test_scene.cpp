@@ -156,3 +156,35 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   EXPECT_NE(full.find("container.period_z_m"), std::string::npos) << full;
   EXPECT_NE(full.find("0.64"), std::string::npos) << full;
 }
+
+TEST(Scene, ATargetVoidFractionMakesAPeriodicSection) {
+  auto message = [](const std::string& text) {
+    try {
+      read(text);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  // 212 unit spheres in a = 5 at 0.4347: the period of scenes/examples/periodic_section.toml, 10 d.
+  const std::string target = "[container]\ndiameter_m = 0.01\n[particles]\ncount = 212\ndiameter_m = 0.002\n"
+                             "[packing.soft_sphere]\ntarget_void_fraction = 0.4347\n";
+  EXPECT_NEAR(read(target).container->axial_period(), 0.02, 1e-5);
+  // With a period as well, another packer, too few spheres for 3 diameters, a target below random
+  // close packing: each refused naming the key and what is allowed.
+  for (const auto& [text, says] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"[container]\ndiameter_m = 0.01\nperiod_z_d = 10\n" + target.substr(target.find("[particles]")), "both set"},
+           {target + "[packing]\nalgorithm = \"monte-carlo\"\n", "accelerated soft-sphere packer"},
+           {"[container]\ndiameter_d = 5\n[particles]\ncount = 20\n[packing.soft_sphere]\n"
+            "target_void_fraction = 0.45\n",
+            "shorter than 3 largest diameters"},
+           {"[container]\ndiameter_d = 5\n[particles]\ncount = 200\n[packing.soft_sphere]\n"
+            "target_void_fraction = 0.3\n",
+            "[0.36, 1)"}}) {
+    const std::string m = message(text);
+    EXPECT_NE(m.find("target_void_fraction"), std::string::npos) << m;
+    EXPECT_NE(m.find(says), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed"), std::string::npos) << m;
+  }
+}
