@@ -29,7 +29,9 @@ struct FlowResult {
   long iterations = 0;
   bool converged = false;                // SIMPLE's own verdict at the residual targets
   double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
-  double pressure_gradient_bed_pa_m = 0.0;    // over the bed section
+  // Over the bed section; in a periodic section the driving gradient, scaled to the flow rate set
+  // (case_runner.cpp says why).
+  double pressure_gradient_bed_pa_m = 0.0;
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;

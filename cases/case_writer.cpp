@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <random>
 
@@ -14,6 +15,7 @@
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "meshing/volume/cyclic_patches.hpp"
 #include "meshing/volume/dual_mesh.hpp"
 
 namespace bedforge::cases {
@@ -49,8 +51,9 @@ CaseGeometry case_geometry(const std::vector<Eigen::Vector3d>& points, const Bed
   g.outlet_z = -g.inlet_z;
   for (const auto& x : points) g.inlet_z = std::min(g.inlet_z, x.z()), g.outlet_z = std::max(g.outlet_z, x.z());
   const bool empty = bed.size() == 0;
-  g.bed_bottom = empty ? g.inlet_z : 0.0;
-  g.bed_top = empty ? g.outlet_z : bed_height(bed);
+  g.periodic = c.axial_period() > 0.0;
+  g.bed_bottom = empty || g.periodic ? g.inlet_z : 0.0;
+  g.bed_top = empty || g.periodic ? g.outlet_z : bed_height(bed);
   return g;
 }
 
@@ -114,7 +117,8 @@ nlohmann::json CaseInfo::to_json() const {
           {"d_ref_m", d_ref_m},
           {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
           {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
-          {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr}};
+          {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr},
+          {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr}};
 }
 
 namespace {
@@ -144,6 +148,16 @@ std::string boundary_field(const std::string& inlet, const std::string& outlet, 
                      "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n{}}}\n",
                      inlet, outlet, solids);
 }
+
+// The spheres' volume (m^3).
+double solid_volume(const Bed& bed) {
+  double v = 0.0;
+  for (double d : bed.diameters) v += std::numbers::pi / 6.0 * d * d * d;
+  return v;
+}
+
+// A periodic section's inlet and outlet: one cyclic pair.
+const char* kCyclic = "        type            cyclic;\n";
 
 std::string surface_value(const std::string& name, const std::string& region, const std::string& operation,
                           const std::string& field) {
@@ -182,7 +196,7 @@ std::string plane_region(const std::string& name, double z) {
 // simpleFoam, on N processes with -np N. snappyHexMesh's cells stay decomposed for the solver,
 // and its results with them: gathering them would take one process the whole mesh's memory.
 // It ends by printing the bed's pressure gradient over `section`, as run_case reads it.
-std::string allrun(const CaseParams& p, const BedSection& section) {
+std::string allrun(const CaseParams& p, const BedSection& section, bool periodic) {
   const bool flag = p.snappy && !p.snappy_cells;  // gmsh's cells, snappyHexMesh's on request
   std::string s = "#!/bin/sh\n";
   s += p.snappy_cells
@@ -254,6 +268,20 @@ std::string allrun(const CaseParams& p, const BedSection& section) {
        "else\n"
        "    run simpleFoam\n"
        "fi\n";
+  if (periodic) {
+    // The result: the mean pressure gradient meanVelocityForce applied at the last iteration.
+    s += fmt::format(
+        "# The bed's pressure gradient: the one meanVelocityForce applied at the last iteration to hold the\n"
+        "# cells' mean velocity (kinematic, times rho = {0:.12g} kg/m3), at the flow rate solved; bedforge\n"
+        "# scales it to the flow rate set (postProcessing/flowRate).\n"
+        "awk -v rho={0:.12g} '/pressure gradient = / {{ g = $NF; n++ }}\n"
+        "    END {{\n"
+        "        if (!n) {{ print \"no pressure gradient in log.simpleFoam\" > \"/dev/stderr\"; exit 1 }}\n"
+        "        printf \"dp/L over the periodic section: %.6g Pa/m\\n\", rho * g\n"
+        "    }}' log.simpleFoam || exit 1\n",
+        p.density_kg_m3);
+    return s;
+  }
   // The result: the kinematic pressure the solver averaged over each section plane at its last
   // iteration, their difference times the density over the planes' distance.
   s += fmt::format(
@@ -286,7 +314,7 @@ const char* kAllclean =
 // from the inlet at the superficial velocity `u` (m/s), out at zero pressure; walls and
 // particles without slip unless the walls slip.
 void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu, double d_ref,
-                  const std::string& note) {
+                  std::optional<double> ubar, const std::string& note) {
   auto field_dict = [&](const std::string& cls, const std::string& object, const std::string& body) {
     return foam_header(cls, "0", object, note, false) + body;
   };
@@ -294,22 +322,34 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
              field_dict("volVectorField", "U",
                         fmt::format("// superficial velocity {:.6g} m/s: Re_p = {} with d = {:.6g} m, nu = {:.6g} m2/s\n"
                                     "dimensions      [0 1 -1 0 0 0 0];\n\ninternalField   uniform (0 0 {:.12g});\n\n",
-                                    u, p.reynolds, d_ref, nu, u) +
-                            boundary_field(fmt::format("        type            fixedValue;\n"
-                                                       "        value           uniform (0 0 {:.12g});\n",
-                                                       u),
-                                           "        type            inletOutlet;\n"
-                                           "        inletValue      uniform (0 0 0);\n"
-                                           "        value           uniform (0 0 0);\n",
+                                    u, p.reynolds, d_ref, nu, ubar.value_or(u)) +
+                            boundary_field(ubar ? kCyclic
+                                                : fmt::format("        type            fixedValue;\n"
+                                                              "        value           uniform (0 0 {:.12g});\n",
+                                                              u),
+                                           ubar ? kCyclic
+                                                : "        type            inletOutlet;\n"
+                                                  "        inletValue      uniform (0 0 0);\n"
+                                                  "        value           uniform (0 0 0);\n",
                                            p.slip_walls ? "        type            slip;\n" : "        type            noSlip;\n",
                                            p.slip_walls ? "        type            noSlip;\n" : "")));
   write_text(tmp / "0/p", field_dict("volScalarField", "p",
                                      "// kinematic pressure p/rho\ndimensions      [0 2 -2 0 0 0 0];\n\n"
                                      "internalField   uniform 0;\n\n" +
-                                         boundary_field("        type            zeroGradient;\n",
-                                                        "        type            fixedValue;\n"
-                                                        "        value           uniform 0;\n",
+                                         boundary_field(ubar ? kCyclic : "        type            zeroGradient;\n",
+                                                        ubar ? kCyclic
+                                                             : "        type            fixedValue;\n"
+                                                               "        value           uniform 0;\n",
                                                         "        type            zeroGradient;\n")));
+  // A periodic section is driven by the mean pressure gradient that holds the fluid's volume-mean
+  // velocity at ubar, the superficial velocity over the meshed void fraction.
+  if (ubar)
+    write_text(tmp / "system/fvOptions",
+               dict("dictionary", "system", "fvOptions", note,
+                    fmt::format("momentumSource\n{{\n    type            meanVelocityForce;\n"
+                                "    selectionMode   all;\n    fields          (U);\n"
+                                "    Ubar            (0 0 {:.12g});  // superficial {:.6g} m/s over the cells' void fraction\n}}\n",
+                                *ubar, u)));
   write_text(tmp / "constant/transportProperties",
              dict("dictionary", "constant", "transportProperties", note,
                   fmt::format("transportModel  Newtonian;\n\nnu              {:.12g};  // mu/rho = {} / {}\n", nu,
@@ -321,17 +361,21 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
 // controlDict: the iteration cap and, as function objects, the pressure averaged over the inlet,
 // the outlet and the section's planes, the flow rate and the forces on every solid patch.
 void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSection& section, bool particles,
-                        const std::string& note) {
+                        bool periodic, const std::string& note) {
   const std::string fmt_word = p.binary ? "binary" : "ascii";
+  // A periodic section's pressure is periodic: the gradient is meanVelocityForce's, and the
+  // cyclic patches carry no force.
   const std::string functions =
-      surface_value("pInlet", patch_region("inlet"), "areaAverage", "p") +
-      surface_value("pOutlet", patch_region("outlet"), "areaAverage", "p") +
-      surface_value("pBedBottom", plane_region("bedBottom", section.z_low), "areaAverage", "p") +
-      surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p") +
+      (periodic ? std::string()
+                : surface_value("pInlet", patch_region("inlet"), "areaAverage", "p") +
+                      surface_value("pOutlet", patch_region("outlet"), "areaAverage", "p") +
+                      surface_value("pBedBottom", plane_region("bedBottom", section.z_low), "areaAverage", "p") +
+                      surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p")) +
       surface_value("flowRate", patch_region("outlet"), "sum", "phi") +
       forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) +
       (particles ? forces("forceParticles", "particles", p.density_kg_m3) : std::string()) +
-      forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3);
+      (periodic ? std::string()
+                : forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3));
   write_text(tmp / "system/controlDict",
              dict("dictionary", "system", "controlDict", note,
                   fmt::format("application     simpleFoam;\nstartFrom       startTime;\nstartTime       0;\n"
@@ -351,7 +395,7 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
 // flows fast. Gradients: least squares on the polyhedral dual, with which the empty tube's
 // pressure drop converges to the exact one and with Gauss linear it does not; on tetrahedra least
 // squares does not help, so they keep Gauss linear (docs/defaults.md).
-void write_solver_settings(const fs::path& tmp, const CaseParams& p, const std::string& note) {
+void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool periodic, const std::string& note) {
   const std::string grad = p.polyhedra ? "leastSquares" : "Gauss linear";
   write_text(tmp / "system/fvSchemes",
              dict("dictionary", "system", "fvSchemes", note,
@@ -369,11 +413,13 @@ void write_solver_settings(const fs::path& tmp, const CaseParams& p, const std::
                               "        tolerance       1e-8;\n        relTol          0.05;\n    }}\n"
                               "    U\n    {{\n        solver          smoothSolver;\n        smoother        symGaussSeidel;\n"
                               "        tolerance       1e-9;\n        relTol          0.1;\n    }}\n}}\n\n"
-                              "SIMPLE\n{{\n    nNonOrthogonalCorrectors 1;\n    consistent      yes;\n"
+                              "SIMPLE\n{{\n    nNonOrthogonalCorrectors 1;\n    consistent      yes;\n{}"
                               "    residualControl\n    {{\n        p               {};\n        U               {};\n    }}\n}}\n\n"
                               "relaxationFactors\n{{\n    equations\n    {{\n        U               0.9;\n    }}\n"
                               "    fields\n    {{\n        p               1;\n    }}\n}}\n",
-                              p.residual_p, *p.residual_u)));
+                              // With cyclic inlet and outlet no boundary fixes the pressure's level.
+                              periodic ? "    pRefCell        0;\n    pRefValue       0;\n" : "", p.residual_p,
+                              *p.residual_u)));
   write_text(tmp / "system/decomposeParDict",
              dict("dictionary", "system", "decomposeParDict", note,
                   fmt::format("numberOfSubdomains {};\n\nmethod          {};\n\n"
@@ -466,23 +512,40 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
   const std::optional<meshing::CellGeometry> geometry =
       mesh ? std::optional(meshing::cell_geometry(*mesh)) : std::nullopt;
-  BedSection section = bed_section(geometry ? &*geometry : nullptr, g, p.section_exclude_d);
-  section.void_fraction_bed = analysis::void_fraction(bed, section.z_low, section.z_high);
+  // A periodic section's bed section is its whole period, its void fraction the spheres' over it.
+  BedSection section = bed_section(geometry ? &*geometry : nullptr, g, g.periodic ? 0.0 : p.section_exclude_d);
+  section.void_fraction_bed =
+      g.periodic ? 1.0 - solid_volume(bed) / (g.cross_section_area * bed.container->axial_period())
+                 : analysis::void_fraction(bed, section.z_low, section.z_high);
+  std::optional<double> fluid_volume;
+  if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
+  std::optional<double> ubar;
+  if (g.periodic) {
+    if (!mesh || p.snappy)
+      throw InputError("a periodic section's case needs gmsh's cells; allowed: case.mesher \"gmsh\" without the "
+                       "snappyHexMesh set-up");
+    ubar = u * g.cross_section_area * (g.outlet_z - g.inlet_z) / *fluid_volume;
+  }
   long cells = mesh ? mesh->cells : 0;  // as written
   try {
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
     if (mesh && p.polyhedra && !p.snappy_cells) {
-      const meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, geometry->centres, kDualFeatureAngleDeg);
+      meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, geometry->centres, kDualFeatureAngleDeg);
+      if (g.periodic) meshing::match_cyclic_patches(dual, "inlet", "outlet");
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
+    } else if (mesh && g.periodic) {
+      meshing::PolyMesh cyclic = *mesh;
+      meshing::match_cyclic_patches(cyclic, "inlet", "outlet");
+      write_poly_mesh(tmp / "constant/polyMesh", cyclic, p.binary, note);
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
-    write_fields(tmp, p, u, nu, g.d_ref, note);
-    write_control_dict(tmp, p, section, bed.size() > 0, note);
-    write_solver_settings(tmp, p, note);
-    write_text(tmp / "Allrun", allrun(p, section), true);
+    write_fields(tmp, p, u, nu, g.d_ref, ubar, note);
+    write_control_dict(tmp, p, section, bed.size() > 0, g.periodic, note);
+    write_solver_settings(tmp, p, g.periodic, note);
+    write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
     write_text(tmp / "Allclean", kAllclean, true);
     write_text(tmp / "case.foam", "");  // for ParaView
     write_text(tmp / "bedforge/scene.toml", scene_toml);
@@ -495,11 +558,10 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     fs::remove_all(tmp, ec);
     throw;
   }
-  std::optional<double> fluid_volume;
-  if (geometry) fluid_volume = std::accumulate(geometry->volumes.begin(), geometry->volumes.end(), 0.0);
   CaseInfo info{case_dir, p, u, nu, cells, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;
+  info.mean_velocity_m_s = ubar;
   if (!info.particles && !p.slip_walls)
     info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance

@@ -28,6 +28,9 @@ struct CaseGeometry {
   Eigen::Vector4d lateral_bounds = Eigen::Vector4d::Zero();  // xmin, ymin, xmax, ymax of the cross-section
   double inlet_z = 0.0, outlet_z = 0.0;
   double bed_bottom = 0.0, bed_top = 0.0;  // the floor and the top sphere; an empty container's inlet and outlet
+  // A section periodic along z: its inlet and outlet are one period apart and become cyclic
+  // patches, and the bed section is the whole period between them.
+  bool periodic = false;
 };
 
 // The case geometry of a bed (m) and the points of its fluid domain (the volume mesh's or the
@@ -76,13 +79,17 @@ struct CaseInfo {
   // other beds, which are compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
   bool particles = false;                // the bed has spheres (a particles patch)
+  // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
+  // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
+  std::optional<double> mean_velocity_m_s;
   nlohmann::json to_json() const;        // its report.json entry
 };
 
 // Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
 // an existing case is replaced (only with `overwrite`) once the new one is complete:
 // constant/polyMesh (from `mesh`, gmsh's cells, or their dual with p.polyhedra; null when
-// p.snappy_cells), 0/U, 0/p, transport and turbulence properties, controlDict with pressure and
+// p.snappy_cells; a periodic section's inlet and outlet made cyclic, cyclic_patches.hpp), 0/U, 0/p,
+// system/fvOptions for a periodic section, transport and turbulence properties, controlDict with pressure and
 // flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, the records
 // `bedforge/scene.toml` and `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
 // (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).

@@ -105,6 +105,11 @@ void write_mesh(const std::filesystem::path& dir, const Mesh& m, bool binary, co
   for (const auto& p : m.patches) {
     out << fmt::format("    {}\n    {{\n        type            {};\n", p.name, p.type);
     if (p.type == "wall") out << "        inGroups        List<word> 1(wall);\n";
+    if (p.type == "cyclic")
+      out << fmt::format("        inGroups        List<word> 1(cyclic);\n        matchTolerance  0.0001;\n"
+                         "        transform       translational;\n        neighbourPatch  {};\n"
+                         "        separationVector ({:.17g} {:.17g} {:.17g});\n",
+                         p.neighbour, p.separation.x(), p.separation.y(), p.separation.z());
     out << fmt::format("        nFaces          {};\n        startFace       {};\n    }}\n", p.size, p.start);
   }
   out << ")\n";

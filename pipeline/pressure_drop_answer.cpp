@@ -74,6 +74,7 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
   PressureDropAnswer a;
   a.section_low_m = entry["section"]["z_low_m"].get<double>();
   a.section_high_m = entry["section"]["z_high_m"].get<double>();
+  a.periodic = !entry.value("periodic_mean_velocity_m_s", nlohmann::json()).is_null();
   a.d_ref_m = entry["d_ref_m"].get<double>();
   a.reynolds = entry["parameters"]["reynolds"].get<double>();
   a.finest_pa_m = flow["pressure_gradient_bed_pa_m"].get<double>();
@@ -127,8 +128,11 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
 
 std::vector<std::string> PressureDropAnswer::lines() const {
   std::vector<std::string> out;
-  const std::string where = fmt::format("dp/L over the bed section, {:.3g} d to {:.3g} d above the floor, at Re_p = {:g}",
-                                        section_low_m / d_ref_m, section_high_m / d_ref_m, reynolds);
+  const std::string where =
+      periodic ? fmt::format("dp/L over one period of the periodic section (z = {:.3g} d to {:.3g} d), at Re_p = {:g}",
+                             section_low_m / d_ref_m, section_high_m / d_ref_m, reynolds)
+               : fmt::format("dp/L over the bed section, {:.3g} d to {:.3g} d above the floor, at Re_p = {:g}",
+                             section_low_m / d_ref_m, section_high_m / d_ref_m, reynolds);
   const std::string reference =
       reference_accuracy
           ? fmt::format("  {}: {:.4g} Pa/m +- {:.0f} % (its stated accuracy, docs/reference.md), at the section's void "

@@ -23,6 +23,7 @@ namespace bedforge::pipeline {
 //                  empty tube's, a simple cubic array's), exact.
 struct PressureDropAnswer {
   double section_low_m = 0.0, section_high_m = 0.0;  // the section's planes
+  bool periodic = false;                              // the section is one period of a periodic bed
   double reynolds = 0.0;
   double finest_pa_m = 0.0;                          // level 1, the scene's own mesh
   long finest_cells = 0;

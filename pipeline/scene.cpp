@@ -64,11 +64,7 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
                                  "schedule, which settles the bed on a floor; allowed with an axial period: "
                                  "\"accelerated\"",
                                  key));
-  if (sc.needs_surface())
-    throw InputError(fmt::format("{} is set, but outputs.files asks for \"stl\", \"mesh\" or \"case\": a "
-                                 "periodic section's surface, mesh and cyclic case are not made yet; allowed: "
-                                 "\"positions\", \"vtp\", \"analysis\"",
-                                 key));
+
   if (sc.algorithm == "soft-sphere" && sc.sizes.smallest() == sc.sizes.largest()) {
     // Equal spheres packed from random positions without friction jam at random close packing.
     const double solid = static_cast<double>(sc.count) * sc.sizes.mean_volume() /
@@ -81,6 +77,32 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
                                    key, sc.count, solid));
   }
 }
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+// What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
+// periodic planes, no treated contact crossing them, one piece.
+void check_periodic_surface(const Scene& sc) {
+  using Treatment = meshing::SurfaceParams::Treatment;
+  for (auto [t, key] : {std::pair{sc.surface.treatment, "contacts.treatment"},
+                        std::pair{sc.surface.wall_treatment, "contacts.wall_treatment"}})
+    if (sc.count > 0 && t != Treatment::none && t != Treatment::shrink)
+      throw InputError(fmt::format("{} = \"{}\" on a periodic section: its surface's periodic planes cut spheres, "
+                                   "not yet bridges, caps or unions; allowed: \"shrink\" or \"none\" (or outputs "
+                                   "without \"stl\", \"mesh\" and \"case\")",
+                                   key, meshing::treatment_name(t)));
+  if (sc.surface.clip)
+    throw InputError("surface.clip_window_d on a periodic section: its planes are the period's; allowed: no clip window");
+  if (sc.mesh.slabs > 1)
+    throw InputError(fmt::format("mesh.slabs = {} on a periodic section; allowed: 0 or 1 (one piece)", sc.mesh.slabs));
+  if (sc.wants("case") && sc.case_params.snappy)
+    throw InputError("case.mesher = \"snappy\" (or case.snappy) on a periodic section: its cyclic patches are made "
+                     "from gmsh's cells; allowed: case.mesher = \"gmsh\"");
+  if (sc.mesh.layers.count > 0)
+    throw InputError(fmt::format("mesh.layers.count = {} on a periodic section: layers beside the periodic planes are "
+                                 "not matched yet; allowed: 0",
+                                 sc.mesh.layers.count));
+}
+#endif
 
 }  // namespace
 
@@ -199,6 +221,9 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
                      "libcgal-dev and rebuild");
 #endif
   sc.case_params = cases::read_case_params(case_section);
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
+#endif
   mesh.finish();
   case_section.finish();
   return sc;

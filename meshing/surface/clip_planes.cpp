@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "core/error.hpp"
@@ -101,6 +102,93 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
   if (!(planes.z1 > planes.z0))
     throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
   out.planes = planes;
+  return out;
+}
+
+UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p) {
+  using Treatment = SurfaceParams::Treatment;
+  for (auto [t, key] : {std::pair{p.treatment, "contacts.treatment"}, std::pair{p.wall_treatment, "contacts.wall_treatment"}})
+    if (bed.size() > 0 && t != Treatment::none && t != Treatment::shrink)
+      throw InputError(fmt::format("{} = \"{}\" on a periodic section (container.period_z): its bridges, caps and "
+                                   "unions would cross the periodic planes, which cut spheres only so far; allowed: "
+                                   "\"shrink\" or \"none\"",
+                                   key, treatment_name(t)));
+  const double H = bed.container->axial_period(), d = reference_diameter(bed);
+  const double scale = p.treatment == Treatment::shrink ? p.shrink_factor : 1.0;
+  auto radius = [&](std::size_t i) { return 0.5 * scale * bed.diameters[i]; };
+  // Candidate heights: the middles of the intervals between the spheres' ends over one period
+  // (round it), the 64 widest.
+  std::vector<double> ends;
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    for (double e : {bed.centres[i].z() - radius(i), bed.centres[i].z() + radius(i)})
+      ends.push_back(e - H * std::floor(e / H));
+  std::sort(ends.begin(), ends.end());
+  std::vector<std::pair<double, double>> candidates;  // clearance, height
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    const double next = k + 1 < ends.size() ? ends[k + 1] : ends.front() + H;
+    const double z = 0.5 * (ends[k] + next);
+    candidates.push_back({0.5 * (next - ends[k]), z >= H ? z - H : z});
+  }
+  if (candidates.empty()) candidates.push_back({0.5 * H, 0.0});
+  std::sort(candidates.begin(), candidates.end(), std::greater<>());
+  candidates.resize(std::min<std::size_t>(candidates.size(), 64));
+  if (!(candidates.front().first >= p.clip_clearance_d * d))
+    throw InputError(fmt::format("surface.clip_clearance_d = {}: no height of the periodic section lies that clear of "
+                                 "every sphere's top and bottom (at best {:.3g} d); allowed: a smaller clearance",
+                                 p.clip_clearance_d, candidates.front().first / d));
+  // Of those clear enough, the one whose cut circles keep widest apart from each other and from
+  // the walls: the triangles of the periodic faces in those gaps are as narrow as they are.
+  auto narrowest_gap = [&](double z) {
+    std::vector<std::pair<Eigen::Vector3d, double>> circles;
+    for (std::size_t i = 0; i < bed.size(); ++i) {
+      double dz = bed.centres[i].z() - z;
+      dz -= H * std::nearbyint(dz / H);
+      if (std::abs(dz) < radius(i))
+        circles.push_back({{bed.centres[i].x(), bed.centres[i].y(), z}, std::sqrt(radius(i) * radius(i) - dz * dz)});
+    }
+    double gap = HUGE_VAL;
+    for (std::size_t a = 0; a < circles.size(); ++a) {
+      // The wall gap of a circle is its sphere's, grown by d, less what that overlaps the wall.
+      WallContact w[Container::kMaxWallContacts];
+      const int nw = bed.container->wall_contacts(circles[a].first, circles[a].second + d, w);
+      for (int k = 0; k < nw; ++k) gap = std::min(gap, d - w[k].overlap);
+      for (std::size_t b = a + 1; b < circles.size(); ++b)
+        gap = std::min(gap, (circles[a].first - circles[b].first).norm() - circles[a].second - circles[b].second);
+    }
+    return gap;
+  };
+  double z0 = candidates.front().second, best = -HUGE_VAL;
+  UnwrappedSection out;
+  out.clearance = candidates.front().first;
+  for (const auto& [clearance, z] : candidates) {
+    if (clearance < p.clip_clearance_d * d) break;
+    if (const double g = narrowest_gap(z); g > best) best = g, z0 = z, out.clearance = clearance;
+  }
+  out.narrowest_gap = best;
+  const double z1 = z0 + H;
+  out.planes = {z0, z1, true};
+  std::unique_ptr<Container> plain = bed.container->scaled(1.0);
+  plain->set_axial_period(0.0);
+  out.bed.container = std::move(plain);
+  out.bed.empty_reference_diameter = bed.empty_reference_diameter;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    Eigen::Vector3d c = bed.centres[i];
+    if (c.z() < z0) c.z() += H;
+    out.bed.centres.push_back(c);
+    out.bed.diameters.push_back(bed.diameters[i]);
+  }
+  const std::size_t n = bed.size();
+  out.twin.assign(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d c = out.bed.centres[i];
+    const bool below = c.z() - radius(i) < z0, above = c.z() + radius(i) > z1;
+    if (!below && !above) continue;
+    const int copy = static_cast<int>(out.bed.centres.size());
+    out.bed.centres.push_back(c + Eigen::Vector3d(0.0, 0.0, above ? -H : H));
+    out.bed.diameters.push_back(bed.diameters[i]);
+    out.twin.push_back(below ? static_cast<int>(i) : -1);  // the copy crosses the upper plane
+    if (above) out.twin[i] = copy;
+  }
   return out;
 }
 

@@ -47,4 +47,24 @@ struct ClipPlacement {
 ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes asked,
                                 const std::vector<double>& radius, const ContactExtents& extents);
 
+// A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
+// planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between
+// the spheres' ends (at their radius under `p`'s treatment) over one period that lie
+// surface.clip_clearance_d clear of them, the one whose cut circles keep the widest gap between
+// each other and to the walls (the periodic faces' triangles are as narrow); each centre moved by
+// a period into [z0, z0 + H), then a copy a period away of each sphere crossing a plane. The
+// bed's container has no period (the copies are its images); copies count in its Sauter mean.
+// twin[i]: for a sphere crossing the upper plane, the index of its copy crossing the lower one,
+// whose cut loop it takes (-1 for the others). Treatments none and shrink only (a bridge, cap or
+// union would cross the planes); InputError naming the key when they are asked for, or when no
+// height lies surface.clip_clearance_d clear of every sphere's end.
+struct UnwrappedSection {
+  Bed bed;
+  DomainPlanes planes;
+  std::vector<int> twin;
+  double clearance = 0.0;      // of the planes from the nearest sphere end (m)
+  double narrowest_gap = 0.0;  // between the cut circles on the planes, and from them to the walls (m)
+};
+UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p);
+
 }  // namespace bedforge::meshing

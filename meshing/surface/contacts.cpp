@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "core/error.hpp"
+#include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/contact_treatment.hpp"
 
 namespace bedforge::meshing {
@@ -265,6 +267,28 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   // of one bed (the slabs of one mesh) rims a plane they share with the same vertices.
   out.min_concave_wall_gap = std::min(out.min_concave_wall_gap, whole.min_concave_wall_gap);
   out.report["clip"] = placed.report;
+  return out;
+}
+
+TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p) {
+  TreatedBed out = contact_parts::ContactTreatment(section.bed, p, section.planes).run();
+  // A sphere crossing the upper plane takes its twin's loop on the lower one, moved up a period:
+  // the outlet's holes are then the inlet's, bit for bit in x and y, as a cyclic patch needs.
+  auto plane_cut = [&](std::size_t i, const char* name) -> SphereCut& {
+    for (std::size_t k = 0; k < out.cuts[i].size(); ++k)
+      if (out.cut_names[i][k] == name) return out.cuts[i][k];
+    throw std::logic_error(fmt::format("sphere {} crosses a periodic plane but has no {} cut", i, name));
+  };
+  for (std::size_t i = 0; i < section.twin.size(); ++i) {
+    if (section.twin[i] < 0) continue;
+    SphereCut& upper = plane_cut(i, "outlet clip plane");
+    upper.loop = plane_cut(static_cast<std::size_t>(section.twin[i]), "inlet clip plane").loop;
+    for (Eigen::Vector3d& q : upper.loop) q.z() = section.planes.z1;
+  }
+  out.outlet_holes.clear();  // the outlet is the inlet's mesh, moved up a period
+  out.report["periodic_planes_m"] = {{"lower", section.planes.z0}, {"upper", section.planes.z1},
+                                     {"clearance_d", section.clearance / reference_diameter(section.bed)},
+                                     {"narrowest_gap_d", section.narrowest_gap / reference_diameter(section.bed)}};
   return out;
 }
 

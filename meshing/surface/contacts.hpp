@@ -55,4 +55,10 @@ struct TreatedBed {
 // overlapping, cuts on one sphere that overlap, a periodic box.
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes);
 
+struct UnwrappedSection;  // clip_planes.hpp
+// The same for a periodic section laid out by unwrap_periodic_section: its spheres cut by the
+// two planes, and each loop on the upper plane its twin's on the lower one moved up a period
+// (outlet_holes left empty: the outlet is meshed as a copy of the inlet).
+TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p);
+
 }  // namespace bedforge::meshing

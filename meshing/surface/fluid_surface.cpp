@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "meshing/surface/defect_locations.hpp"
+#include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/contacts.hpp"
 #include "meshing/surface/delaunay_walls.hpp"
 #include "meshing/surface/gap_spacing.hpp"
@@ -147,10 +148,40 @@ DomainPlanes asked_planes(const Bed& bed, const SurfaceParams& p) {
   return {-p.inlet_length_d * d, bed_height(bed) + p.outlet_length_d * d, false};
 }
 
+// A flat face at the lower plane as the face at `z` above it, facing the other way, its
+// triangles labelled `patch`: the same vertices in x and y, bit for bit.
+WallMesh moved_up(const WallMesh& lower, double z, const std::string& patch) {
+  WallMesh m = lower;
+  for (TriangleMesh* t : {&m.outside, &m.inside}) {
+    for (Eigen::Vector3d& q : t->points) q.z() = z;
+    for (auto& tri : t->triangles) std::swap(tri[1], tri[2]);
+    for (std::string& name : t->patches) name = patch;
+  }
+  return m;
+}
+
+// The bed as its surface is meshed, treated: a periodic section unwrapped between its planes
+// a period apart (clip_planes.hpp), any other bed as it is.
+struct LaidOut {
+  Bed bed;
+  TreatedBed treated;
+  bool periodic = false;
+};
+LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
+  if (bed.container->axial_period() > 0.0) {
+    UnwrappedSection u = unwrap_periodic_section(bed, p);
+    TreatedBed tb = treat_periodic_section(u, p);
+    return {std::move(u.bed), std::move(tb), true};
+  }
+  return {bed, treat_contacts(bed, p, asked_planes(bed, p)), false};
+}
+
 }  // namespace
 
-FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell) {
-  const TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
+FluidDomainSize fluid_domain_size(const Bed& given, const SurfaceParams& p, double volume_per_cell) {
+  const LaidOut laid = lay_out(given, p);
+  const Bed& bed = laid.bed;
+  const TreatedBed& tb = laid.treated;
   FluidDomainSize s;
   s.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
   const std::optional<GapSpacing> gaps = gap_spacing(p, reference_diameter(bed), bed.centres, tb.radius, tb.kept,
@@ -159,10 +190,12 @@ FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double
   return s;
 }
 
-FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
+FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
+  const double top = bed_height(given);
+  LaidOut laid = lay_out(given, p);
+  const Bed& bed = laid.bed;
+  TreatedBed& tb = laid.treated;
   const double d = reference_diameter(bed), edge = p.edge_length_d * d;
-  const double top = bed_height(bed);
-  TreatedBed tb = treat_contacts(bed, p, asked_planes(bed, p));
   const double z0 = tb.planes.z0, z1 = tb.planes.z1;
   const Container& c = *bed.container;
   const auto* ann = dynamic_cast<const Annulus*>(&c);
@@ -275,14 +308,23 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
     if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, wall_edge)));
     return boundary;
   };
+  WallMesh inlet;  // a periodic section's outlet is its copy a period up, so the two are cyclic patches
   for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
-    if (!box && !p.clip) {  // nothing cuts it: the structured ring
+    if (!box && !p.clip && !laid.periodic) {  // nothing cuts it: the structured ring
       f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
       piece(Shape::plane);
       continue;
     }
-    add(patch, Shape::plane, 0.0, [&] { return plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch); });
+    if (laid.periodic && up) {
+      add(patch, Shape::plane, 0.0, [&] { return moved_up(inlet, z1, patch); });
+      continue;
+    }
+    add(patch, Shape::plane, 0.0, [&] {
+      WallMesh m = plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch);
+      if (laid.periodic) inlet = m;
+      return m;
+    });
   }
   spheres_meshed.get();
   for (const auto& message : failure)
@@ -320,7 +362,8 @@ FluidSurface build_fluid_surface(const Bed& bed, const SurfaceParams& p) {
   out.bed.weld();
 
   const double domain = c.cross_section_area() * (z1 - z0);
-  const double section = p.clip || n == 0 ? z1 - z0 : top;  // the bed's own height, or the window's (or the empty tube's)
+  // The bed's own height, or the window's or period's (or the empty tube's).
+  const double section = p.clip || laid.periodic || n == 0 ? z1 - z0 : top;
   const MeshQuality q = mesh_quality(f);
   out.report = tb.report;
   out.report["parameters"] = to_json(p);

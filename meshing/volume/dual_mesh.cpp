@@ -143,7 +143,20 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
   // midpoints as they are first needed.
   PolyhedralMesh d;
   d.points = cell_centres;
-  for (const FaceGeometry& b : boundary) d.points.push_back(b.centre);
+  // A boundary triangle's centre from its points in the order of their coordinates, so that a
+  // triangle and its copy on a cyclic patch (points the same in x and y, listed the other way
+  // round) give the same x and y bit for bit; on a flat face the same z as its points.
+  for (int f = n_internal; f < n_faces; ++f) {
+    if (m.faces[f].size() != 3) {
+      d.points.push_back(boundary[f - n_internal].centre);
+      continue;
+    }
+    std::array<Eigen::Vector3d, 3> t{m.points[m.faces[f][0]], m.points[m.faces[f][1]], m.points[m.faces[f][2]]};
+    std::sort(t.begin(), t.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    });
+    d.points.push_back(t[0] + ((t[1] - t[0]) + (t[2] - t[0])) / 3.0);
+  }
   const int first_boundary_centre = n_cells - n_internal;  // + boundary face index
   std::vector<int> point_at(n_points, -1);
   for (int p : order)

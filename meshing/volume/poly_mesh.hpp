@@ -40,8 +40,11 @@ struct VolumeCell {
 struct PolyMesh {
   struct Patch {
     std::string name;
-    std::string type;  // OpenFOAM patch type: "patch" (inlet, outlet) or "wall"
+    std::string type;  // OpenFOAM patch type: "patch" (inlet, outlet), "wall" or "cyclic"
     int start = 0, size = 0;
+    // cyclic only (cyclic_patches.hpp): the other patch, and the translation from this one to it (m)
+    std::string neighbour;
+    Eigen::Vector3d separation = Eigen::Vector3d::Zero();
   };
   std::vector<Eigen::Vector3d> points;  // m
   std::vector<Face> faces;

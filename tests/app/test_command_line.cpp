@@ -121,7 +121,8 @@ TEST(CommandLine, EveryShippedSceneRuns) {
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // A new example that makes a case needs a test of its own there.
   EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml",
-                                                "empty_tube_verification.toml", "simple_cubic_verification.toml"}));
+                                                "empty_tube_verification.toml", "simple_cubic_verification.toml",
+                                                "periodic_section_flow.toml"}));
 #endif
 }
 

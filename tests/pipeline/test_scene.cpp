@@ -143,11 +143,10 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   };
   const std::string section = "[container]\ndiameter_d = 5\nperiod_z_d = 5\n[particles]\ncount = 105\n";
   EXPECT_EQ(read(section).container->axial_period(), 0.005);
-  // A packer that settles on a floor, a surface not made yet, and more spheres than a random
-  // packing holds (0.70 solid); each names the period's key and what is allowed.
+  // A packer that settles on a floor and more spheres than a random packing holds (0.70 solid);
+  // each names the period's key and what is allowed.
   for (const std::string& extra : {std::string("[packing]\nalgorithm = \"monte-carlo\"\n"),
-                                   std::string("[packing.soft_sphere]\nmode = \"faithful\"\n"),
-                                   std::string("[outputs]\nfiles = [\"case\"]\n")}) {
+                                   std::string("[packing.soft_sphere]\nmode = \"faithful\"\n")}) {
     const std::string m = message(section + extra);
     EXPECT_NE(m.find("container.period_z_d is set"), std::string::npos) << m;
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
@@ -155,6 +154,21 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   const std::string full = message("[container]\ndiameter_d = 5\nperiod_z_m = 0.004\n[particles]\ncount = 105\n");
   EXPECT_NE(full.find("container.period_z_m"), std::string::npos) << full;
   EXPECT_NE(full.find("0.64"), std::string::npos) << full;
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // Its cyclic case: from spheres cut by the periodic planes, in one piece.
+  const std::string meshed = section + "[contacts]\ntreatment = \"shrink\"\n[outputs]\nfiles = [\"case\"]\n";
+  EXPECT_EQ(read(meshed).container->axial_period(), 0.005);
+  for (const auto& [extra, key] : std::vector<std::pair<std::string, std::string>>{
+           {"[mesh]\nslabs = 2\n", "mesh.slabs = 2"},
+           {"[mesh.layers]\ncount = 2\n", "mesh.layers.count = 2"},
+           {"[case]\nmesher = \"snappy\"\n", "case.mesher"}}) {
+    const std::string m = message(meshed + extra);
+    EXPECT_NE(m.find(key), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed"), std::string::npos) << m;
+  }
+  const std::string bridged = message(section + "[outputs]\nfiles = [\"case\"]\n");  // bridged by default
+  EXPECT_NE(bridged.find("contacts.treatment = \"bridge\""), std::string::npos) << bridged;
+#endif
 }
 
 TEST(Scene, ATargetVoidFractionMakesAPeriodicSection) {
