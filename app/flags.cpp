@@ -114,7 +114,7 @@ const std::vector<Flag>& table() {
        static_cast<unsigned>(Command::case_)},
       {"--mesher", {"case.mesher"},
        "what makes the cells solved on: gmsh (the mesh stage) or snappy (snappyHexMesh in Allrun, on every "
-       "process, and no gmsh mesh)",
+       "process, and no gmsh mesh; not validated, check its cells)",
        static_cast<unsigned>(Command::case_)},
       {"--run", {"case.run"}, "run Allrun and add the pressure drop to the report",
        static_cast<unsigned>(Command::case_)},

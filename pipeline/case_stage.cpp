@@ -25,7 +25,9 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                                fluid_stl, spheres_as_packed);
   if (!mesh) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
-  std::string line = !mesh ? fmt::format("case: snappyHexMesh's set-up in {}", case_dir.string())
+  std::string line = !mesh ? fmt::format("case: snappyHexMesh's set-up in {} (not a validated route: check its "
+                                         "cells, docs/mesh_case_benchmark.md)",
+                                         case_dir.string())
                      : p.polyhedra
                          ? fmt::format("case: {} polyhedra (the dual of {} cells) in {}", out.info.cells, mesh->cells,
                                        case_dir.string())

@@ -235,7 +235,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "with the simple cubic array's Stokes drag instead (`scenes/examples/simple_cubic_verification.toml`)"}},
       {"case.mesher",
        {"what makes the cells solved on: gmsh, the mesh stage; or snappyHexMesh in the case's Allrun, from the fluid "
-        "surface, on every process (no gmsh mesh; no process holds the whole volume mesh, each holds the surface). Its "
+        "surface, on every process (no gmsh mesh). Not validated: at its defaults on the a = 14, N = 1e4 bridged bed "
+        "its cells lost 19.5 % of the fluid, failed checkMesh and gave dp/L 3.5 x Eisfeld & Schnitzlein "
+        "(docs/mesh_case_benchmark.md); a set-up to start snappyHexMesh from, whose cells you must check. Its "
         "cells keep only the fluid connected to the inside point: the report's `flow.mesh.volume_lost` says how much "
         "they miss, and a run whose cells miss the inlet or outlet stops with exit status 3"}},
       {"case.snappy",
