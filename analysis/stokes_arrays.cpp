@@ -24,7 +24,7 @@ std::optional<double> zick_homsy_simple_cubic(double solid_fraction) {
 std::optional<double> simple_cubic_column_gradient(const Bed& bed, double viscosity, double velocity, double z_low,
                                                    double z_high) {
   const auto* box = dynamic_cast<const Box*>(bed.container.get());
-  if (!box || bed.centres.empty() || box->periodicity().any()) return std::nullopt;
+  if (!box || bed.centres.empty() || box->periodicity().lateral()) return std::nullopt;
   const double L = box->size_x(), tolerance = 1e-6 * L, d = bed.diameters.front();
   if (std::abs(box->size_y() - L) > tolerance) return std::nullopt;
   std::vector<Eigen::Vector3d> centres = bed.centres;  // in any order

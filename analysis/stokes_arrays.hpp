@@ -17,7 +17,8 @@ std::optional<double> zick_homsy_simple_cubic(double solid_fraction);
 // sides the flow slips along (mirror planes of the array), one sphere at the centre of each
 // L-long cell along the axis, z from L / 2 up, spaced L. The gradient over whole cells is the
 // array's, n F = 6 pi mu a K U / L^3, with K from zick_homsy_simple_cubic. None when the bed is
-// not such a column (within 1e-6 L), its solid fraction is not tabulated, or the section
+// not such a column (within 1e-6 L; it may be periodic along z, the sides may not), its solid
+// fraction is not tabulated, or the section
 // [z_low, z_high] (m) does not span whole cells at the same phase. Stokes flow only: the caller
 // checks the Reynolds number. `viscosity` dynamic, Pa s.
 std::optional<double> simple_cubic_column_gradient(const Bed& bed, double viscosity, double velocity, double z_low,

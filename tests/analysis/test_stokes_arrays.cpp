@@ -77,7 +77,14 @@ TEST(SimpleCubicColumn, AnythingElseHasNoKnownAnswer) {
   EXPECT_FALSE(gradient(mixed));
   Bed periodic = good;
   periodic.container = std::make_shared<Box>(L, L, true, true);
-  EXPECT_FALSE(gradient(periodic));
+  EXPECT_FALSE(gradient(periodic));  // periodic sides are not the array's mirror planes
+  Bed section = good;                // periodic along the column: the array itself, three cells of it
+  auto tube = std::make_shared<Box>(L, L, false, false);
+  tube->set_axial_period(3.0 * L);
+  section.container = tube;
+  section.centres.resize(3);
+  section.diameters.resize(3);
+  EXPECT_TRUE(gradient(section, 1.0 * L, 4.0 * L));
   Bed shuffled = good;  // the order of the rows does not matter
   std::swap(shuffled.centres[0], shuffled.centres[4]);
   EXPECT_TRUE(gradient(shuffled));
