@@ -424,8 +424,13 @@ void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool period
              dict("dictionary", "system", "decomposeParDict", note,
                   fmt::format("numberOfSubdomains {};\n\nmethod          {};\n\n"
                               "hierarchicalCoeffs\n{{\n    n               (1 1 {});\n    delta           0.001;\n"
-                              "    order           xyz;\n}}\n",
-                              p.processors, p.decomposition, p.processors)));
+                              "    order           xyz;\n}}\n{}",
+                              p.processors, p.decomposition, p.processors,
+                              // A cyclic pair's faces on one process: else each keeps none of the patch itself
+                              // (they become processorCyclic faces) and the flow rate over it has no faces.
+                              periodic ? "\nconstraints\n{\n    cyclics\n    {\n        type            preservePatches;\n"
+                                         "        patches         (inlet outlet);\n    }\n}\n"
+                                       : "")));
 }
 
 // snappyHexMesh's set-up for the fluid surface `fluid_stl` (ASCII STL, a solid per patch named in

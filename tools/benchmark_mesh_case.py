@@ -62,6 +62,13 @@ verification_spheres: a column of a simple cubic array of spheres in Stokes flow
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
         (1982) tabulate: one `bedforge run` each with [case.convergence] (--sphere-levels meshes from
         --sphere-edge d, ratio 1.3); each level's error, the order of the errors, the study's own verdict.
+verification_periodic: periodic sections, cyclic cases driven by meanVelocityForce: the empty tube of the
+        verification (D = 2 d) one period of 3 d long, whose fully developed flow is Hagen-Poiseuille's in every
+        cell; and three cells of a simple cubic array as scenes/examples/periodic_cubic_verification.toml at each
+        solid fraction of --periodic-fractions (Zick & Homsy's, none of their spheres cut by the periodic planes);
+        one `bedforge run` each with [case.convergence] (--periodic-levels meshes from --periodic-edge d, ratio
+        1.3): each level's error, the order of the errors, and issue 56's target (within 1 % of Zick & Homsy on
+        the finest level, order at least 1.5).
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -85,7 +92,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
-            "default", "solver", "verification", "verification_spheres"]
+            "default", "solver", "verification", "verification_spheres", "verification_periodic"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -436,22 +443,20 @@ files = ["case"]
     return out
 
 
-def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
-    """Simple cubic columns at each solid fraction: count spheres, the pressure drop over the middle
-    cells_measured, whose planes lie a whole number of cells apart at the same phase."""
-    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
-    for phi in fractions:
-        side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
-        # From the box's bottom and the top sphere's top, both planes at the same phase:
-        exclude = ((count - 0.5 - cells_measured) * side + 0.5) / 2.0
-        path = os.path.join(tmp, f"simple_cubic_{phi}")
-        with open(path + ".txt", "w") as f:
-            f.write("x y z d\n" + "".join(f"0 0 {(k + 0.5) * side * 3.0:.12f} 3.0\n" for k in range(count)))
-        open(path + ".toml", "w").write(f"""[container]
+def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case=""):
+    """One column of a simple cubic array at solid fraction phi, `count` spheres of 3 mm at the
+    centres of L-long cells in a square box of side L with slip sides, Stokes flow: one
+    `bedforge run` with a convergence study (`levels` meshes from `edge` d, ratio 1.3).
+    `container` and `case` add keys to those sections."""
+    side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
+    path = os.path.join(tmp, name)
+    with open(path + ".txt", "w") as f:
+        f.write("x y z d\n" + "".join(f"0 0 {(k + 0.5) * side * 3.0:.12f} 3.0\n" for k in range(count)))
+    open(path + ".toml", "w").write(f"""[container]
 type = "box"
 size_x_d = {side:.12f}
 size_y_d = {side:.12f}
-[packing]
+{container}[packing]
 algorithm = "import"
 file = "{path}.txt"
 units = "mm"
@@ -464,17 +469,79 @@ cells_per_gap = 4
 [case]
 walls = "slip"
 reynolds = 0.01
-section_exclude_d = {exclude:.12f}
+{case}processors = 2
+run = true
+convergence = {{levels = {levels}, ratio = 1.3}}
+[outputs]
+files = ["case"]
+""")
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    report = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
+    return {"wall_s": wall, "study": report["convergence"], "d_m": report["d_ref_m"]}
+
+
+def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
+    """Simple cubic columns at each solid fraction: count spheres, the pressure drop over the middle
+    cells_measured, whose planes lie a whole number of cells apart at the same phase."""
+    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
+    for phi in fractions:
+        side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
+        # From the box's bottom and the top sphere's top, both planes at the same phase:
+        exclude = ((count - 0.5 - cells_measured) * side + 0.5) / 2.0
+        out["runs"][str(phi)] = cubic_column_run(tmp, f"simple_cubic_{phi}", phi, count, edge, levels,
+                                                 case=f"section_exclude_d = {exclude:.12f}\n")
+    return out
+
+
+def verification_periodic(tmp, edge, levels, fractions, cells=3):
+    """The periodic empty tube and periodic simple cubic columns (`cells` cells per period), each a run
+    with a convergence study."""
+    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
+    path = os.path.join(tmp, "periodic_tube")
+    open(path + ".toml", "w").write(f"""[container]
+type = "cylinder"
+diameter_d = 2.0
+period_z_d = 3.0
+[particles]
+count = 0
+diameter_m = 0.003
+[surface]
+edge_length_d = {edge * 2}
+[case]
+reynolds = 1.0
 processors = 2
 run = true
 convergence = {{levels = {levels}, ratio = 1.3}}
 [outputs]
 files = ["case"]
 """)
-        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
-        case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
-        out["runs"][str(phi)] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
+    out["runs"]["empty tube"] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+    for phi in fractions:
+        side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
+        out["runs"][str(phi)] = cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
+                                                 container=f"period_z_d = {cells * side:.12f}\n")
     return out
+
+
+def periodic_target_lines(v):
+    """Issue 56's target for the cubic arrays, read off each run's finest solved level and order."""
+    lines = []
+    for key, run in v["runs"].items():
+        if key == "empty tube":
+            continue
+        solved = [lv for lv in run["study"]["levels"] if "failure" not in lv]
+        order = run["study"].get("order_from_exact")
+        if not solved:
+            lines.append(f"- solid fraction {key}: no level solved: target not met")
+            continue
+        error = solved[0]["relative_error_to_exact"]
+        met = abs(error) <= 0.01 and order is not None and order >= 1.5
+        lines.append(f"- solid fraction {key}: finest error {100 * error:+.2f} %, order "
+                     f"{'none' if order is None else f'{order:.2f}'}: {'met' if met else 'NOT met'}")
+    return ["Issue 56's target for the cubic arrays: within 1 % of Zick & Homsy on the finest level, order at "
+            "least 1.5.", "", *lines, ""]
 
 
 def stamp(rows):
@@ -911,6 +978,21 @@ def write(results):
         lines += verification_lines(v, "solid fraction", "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")
+    if "verification_periodic" in results:
+        v = results["verification_periodic"]
+        lines += ["## Verification of periodic sections: cyclic cases against Hagen-Poiseuille and Zick & Homsy", "",
+                  f"Made at commit {v['commit']} on {v['date']}: periodic sections whose inlet and outlet are one "
+                  "cyclic pair, the flow driven by meanVelocityForce at the superficial velocity set (dp/L the driving "
+                  "gradient scaled to the flow rate set). The empty tube, D = 2 d, one period of 3 d, Re_p = 1: its "
+                  "fully developed flow is Hagen-Poiseuille's in every cell. Three cells of a simple cubic array "
+                  "(one column in a square box with slip sides, the array's mirror planes), Stokes flow (Re_p = 0.01), "
+                  f"at each solid fraction; exact: Zick & Homsy (1982, Table 2), to about 0.1 %. {v['levels']} meshes "
+                  f"from a surface edge of {v['edge_d']} d (the tube's twice that), ratio {v['ratio']}. Error = dp/L / "
+                  "exact - 1; the order is a least-squares fit of ln |error| against ln h over all levels. "
+                  "Body-centred and face-centred arrays are not run: their tables are not in the repository.", ""]
+        lines += verification_lines(v, "case", "verification_periodic.png")
+        lines += periodic_target_lines(v)
+        plot_verification(v, "verification_periodic.png", "periodic sections (cyclic)", "exact", "")
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -1003,6 +1085,10 @@ def main():
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
     ap.add_argument("--sphere-edge", type=float, default=0.05, help="verification_spheres: finest surface edge (d)")
+    ap.add_argument("--periodic-edge", type=float, default=0.025, help="verification_periodic: finest surface edge (d)")
+    ap.add_argument("--periodic-levels", type=int, default=4, help="verification_periodic: meshes in all")
+    ap.add_argument("--periodic-fractions", type=float, nargs="+", default=[0.125, 0.216, 0.343, 0.45],
+                    help="verification_periodic: solid fractions Zick & Homsy tabulate")
     ap.add_argument("--sphere-levels", type=int, default=4, help="verification_spheres: meshes in all")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
@@ -1064,6 +1150,10 @@ def main():
             write(results)
         if "verification_spheres" in args.only:
             results["verification_spheres"] = verification_spheres(tmp, args.sphere_edge, args.sphere_levels)
+            write(results)
+        if "verification_periodic" in args.only:
+            results["verification_periodic"] = verification_periodic(tmp, args.periodic_edge, args.periodic_levels,
+                                                                     args.periodic_fractions)
             write(results)
 
 

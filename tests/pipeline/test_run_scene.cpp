@@ -375,13 +375,12 @@ TEST(RunScene, TheEmptyTubeExampleMatchesHagenPoiseuille) {
 // Homsy's drag. On such meshes the levels lie 8-19 % under it, their errors falling at order 1.7
 // (measured 2026-11-27; from 0.05 d: 4-11 %, order 2.0, the extrapolation +0.8 %). The order's
 // bounds are the 1-3 the study's order must lie in (issue 24).
-TEST(RunScene, TheSimpleCubicExampleConvergesToZickAndHomsy) {
-  const Scene scene = example_scene("simple_cubic_verification.toml", {{"surface.edge_length_d", 0.1},
-                                                                       {"surface.contact_edge_length_d", 0.05}});
-  const fs::path dir = test_support::fresh_dir("simple_cubic");
-  const RunOutcome r = run(scene, dir);
-  const nlohmann::json& c = r.stages["case"];
-  // 6 pi mu a K U / L^3 with K = 7.442 at phi = 0.216, L = d (pi / (6 phi))^(1/3).
+namespace {
+
+// A simple cubic array's case (phi = 0.216, d = 3 mm, water, Re_p = 0.01) against Zick & Homsy:
+// the exact gradient 6 pi mu a K U / L^3 with K = 7.442, L = d (pi / (6 phi))^(1/3); its three
+// levels each below it and nearer than the coarser one, at an order between 1 and 3.
+void expect_converging_to_zick_homsy(const nlohmann::json& c) {
   const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
   const double side = d * std::cbrt(pi / (6.0 * 0.216)), exact = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
   ASSERT_TRUE(c["exact_pressure_gradient_pa_m"].is_number()) << c.dump();
@@ -399,6 +398,17 @@ TEST(RunScene, TheSimpleCubicExampleConvergesToZickAndHomsy) {
   ASSERT_TRUE(study["order_from_exact"].is_number()) << study.dump();
   EXPECT_GT(study["order_from_exact"].get<double>(), 1.0);
   EXPECT_LT(study["order_from_exact"].get<double>(), 3.0);
+}
+
+}  // namespace
+
+TEST(RunScene, TheSimpleCubicExampleConvergesToZickAndHomsy) {
+  const Scene scene = example_scene("simple_cubic_verification.toml", {{"surface.edge_length_d", 0.1},
+                                                                       {"surface.contact_edge_length_d", 0.05}});
+  const fs::path dir = test_support::fresh_dir("simple_cubic");
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& c = r.stages["case"];
+  expect_converging_to_zick_homsy(c);
   std::ifstream velocity(dir / "case/0/U");
   std::stringstream text;
   text << velocity.rdbuf();
@@ -419,8 +429,7 @@ TEST(RunScene, ASimpleCubicColumnWhoseSpheresAreShrunkHasNoExactAnswer) {
 }
 
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three
-// cells, cyclic inlet and outlet, meanVelocityForce): every level below the exact drag and
-// nearer it than the coarser one, at an order the schemes allow (measured 2.05 at the example's
+// cells, cyclic inlet and outlet, meanVelocityForce; order 2.05 measured at the example's
 // settings, 2026-11-28).
 TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const Scene scene = example_scene("periodic_cubic_verification.toml", {{"surface.edge_length_d", 0.1},
@@ -428,24 +437,8 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const fs::path dir = test_support::fresh_dir("periodic_cubic");
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& c = r.stages["case"];
-  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
-  const double side = d * std::cbrt(pi / (6.0 * 0.216)), exact = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
-  ASSERT_TRUE(c["exact_pressure_gradient_pa_m"].is_number()) << c.dump();
-  EXPECT_NEAR(c["exact_pressure_gradient_pa_m"].get<double>(), exact, 1e-9 * exact);
   EXPECT_TRUE(c["periodic_mean_velocity_m_s"].is_number());
-  const nlohmann::json& study = c["convergence"];
-  ASSERT_EQ(study["levels"].size(), 3u) << study.dump();
-  double coarser_error = -1.0;
-  for (auto level = study["levels"].rbegin(); level != study["levels"].rend(); ++level) {
-    ASSERT_FALSE(level->contains("failure")) << level->dump();
-    const double error = (*level)["relative_error_to_exact"].get<double>();
-    EXPECT_LT(error, 0.0) << level->dump();
-    EXPECT_GT(error, coarser_error) << level->dump();
-    coarser_error = error;
-  }
-  ASSERT_TRUE(study["order_from_exact"].is_number()) << study.dump();
-  EXPECT_GT(study["order_from_exact"].get<double>(), 1.0);
-  EXPECT_LT(study["order_from_exact"].get<double>(), 3.0);
+  expect_converging_to_zick_homsy(c);
 }
 
 // Why case.cells defaults to polyhedra: on gmsh's tetrahedra themselves the same tube's pressure
@@ -583,11 +576,13 @@ TEST(RunScene, ATargetVoidFractionIsTheSectionsVoidFraction) {
 // case driven by meanVelocityForce must give Hagen-Poiseuille: measured -0.016 % and -0.011 % on
 // meshes of 900-1400 cells (2026-11-28); 1 % leaves room for gmsh's meshes differing between
 // builds. A wrong drive (the superficial velocity held as the mean, a flow rate not scaled) or a
-// cyclic pair mismatched is off by more.
+// cyclic pair mismatched is off by more. On two processes, whose decomposition must keep the
+// cyclic pair's faces together (else the flow rate over the outlet has no faces and the run stops).
 TEST(RunScene, APeriodicEmptyTubeGivesHagenPoiseuille) {
   const std::string text =
       "[container]\ndiameter_d = 3\nperiod_z_d = 3\n[particles]\ncount = 0\ndiameter_m = 0.002\n"
-      "[surface]\nedge_length_d = 0.25\n[mesh]\nthreads = 1\n[case]\nrun = true\n[case.convergence]\nlevels = 0\n"
+      "[surface]\nedge_length_d = 0.25\n[mesh]\nthreads = 1\n[case]\nrun = true\nprocessors = 2\n"
+      "[case.convergence]\nlevels = 0\n"
       "[outputs]\nfiles = [\"case\"]\n";
   const fs::path dir = test_support::fresh_dir("periodic_empty_tube");
   const RunOutcome r = run(read_scene(parse_scene_text(text, "t.toml"), "t.toml"), dir);

@@ -13,6 +13,16 @@ Scene read(const std::string& text, const std::filesystem::path& base = {}) {
   return read_scene(parse_scene_text(text, "t.toml"), "t.toml", base);
 }
 
+// What reading `text` says: the InputError's message, or "accepted".
+std::string message(const std::string& text) {
+  try {
+    read(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 }  // namespace
 
 TEST(Scene, DefaultsAndRequiredKeys) {
@@ -133,14 +143,6 @@ TEST(Scene, SlabsAreRefusedWhereTheirPlanesWouldChangeTheBed) {
 #endif
 
 TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
-  auto message = [](const std::string& text) {
-    try {
-      read(text);
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   const std::string section = "[container]\ndiameter_d = 5\nperiod_z_d = 5\n[particles]\ncount = 105\n";
   EXPECT_EQ(read(section).container->axial_period(), 0.005);
   // A packer that settles on a floor and more spheres than a random packing holds (0.70 solid);
@@ -172,14 +174,6 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
 }
 
 TEST(Scene, ATargetVoidFractionMakesAPeriodicSection) {
-  auto message = [](const std::string& text) {
-    try {
-      read(text);
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   // 212 unit spheres in a = 5 at 0.4347: the period of scenes/examples/periodic_section.toml, 10 d.
   const std::string target = "[container]\ndiameter_m = 0.01\n[particles]\ncount = 212\ndiameter_m = 0.002\n"
                              "[packing.soft_sphere]\ntarget_void_fraction = 0.4347\n";
