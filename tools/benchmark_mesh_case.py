@@ -437,10 +437,15 @@ convergence = {{levels = {levels}, ratio = {ratio}}}
 [outputs]
 files = ["case"]
 """)
-        wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
-        case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
-        out["runs"][cells] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+        out["runs"][cells] = study_run(path)
     return out
+
+
+def study_run(path):
+    """`bedforge run` of path.toml into path, timed: its wall time, convergence study and d (m)."""
+    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
+    case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
+    return {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
 
 
 def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case=""):
@@ -475,9 +480,7 @@ convergence = {{levels = {levels}, ratio = 1.3}}
 [outputs]
 files = ["case"]
 """)
-    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
-    report = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
-    return {"wall_s": wall, "study": report["convergence"], "d_m": report["d_ref_m"]}
+    return study_run(path)
 
 
 def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
@@ -515,9 +518,7 @@ convergence = {{levels = {levels}, ratio = 1.3}}
 [outputs]
 files = ["case"]
 """)
-    wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
-    case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
-    out["runs"]["empty tube"] = {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
+    out["runs"]["empty tube"] = study_run(path)
     for phi in fractions:
         side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
         out["runs"][str(phi)] = cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
