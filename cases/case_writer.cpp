@@ -149,13 +149,6 @@ std::string boundary_field(const std::string& inlet, const std::string& outlet, 
                      inlet, outlet, solids);
 }
 
-// The spheres' volume (m^3).
-double solid_volume(const Bed& bed) {
-  double v = 0.0;
-  for (double d : bed.diameters) v += std::numbers::pi / 6.0 * d * d * d;
-  return v;
-}
-
 // A periodic section's inlet and outlet: one cyclic pair.
 const char* kCyclic = "        type            cyclic;\n";
 

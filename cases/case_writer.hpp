@@ -81,7 +81,7 @@ struct CaseInfo {
   bool particles = false;                // the bed has spheres (a particles patch)
   // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
   // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
-  std::optional<double> mean_velocity_m_s;
+  std::optional<double> mean_velocity_m_s = std::nullopt;
   nlohmann::json to_json() const;        // its report.json entry
 };
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <numbers>
 #include <vector>
 
 #include "core/container.hpp"
@@ -38,6 +39,13 @@ inline double reference_diameter(const Bed& bed) {
 // The largest sphere's diameter (m); an empty bed's reference diameter.
 inline double largest_diameter(const Bed& bed) {
   return bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) : bed.empty_reference_diameter;
+}
+
+// The spheres' total volume (m^3).
+inline double solid_volume(const Bed& bed) {
+  double v = 0.0;
+  for (double d : bed.diameters) v += std::numbers::pi / 6.0 * d * d * d;
+  return v;
 }
 
 // Height of the bed: the top of its highest sphere (m), 0 for an empty bed; along a periodic

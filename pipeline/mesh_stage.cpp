@@ -99,12 +99,11 @@ void refuse_edge(const Scene& scene, const MeshEstimate& e, double available_byt
 }  // namespace
 
 MeshEstimate estimate_mesh(const Scene& scene) {
-  const double pi = std::acos(-1.0);
   double d = 0.0, solid = 0.0;
   if (scene.import.bed) {
     const Bed& b = scene.import.bed->bed;
     d = reference_diameter(b);  // an imported empty container keeps its own
-    for (double di : b.diameters) solid += pi / 6.0 * di * di * di;
+    solid = solid_volume(b);
   } else {
     d = scene.sizes.sauter_mean();
     solid = static_cast<double>(scene.count) * scene.sizes.mean_volume();

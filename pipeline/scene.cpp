@@ -9,6 +9,9 @@
 #include "core/atomic_file.hpp"
 #include "core/bed_io.hpp"
 #include "core/error.hpp"
+#ifdef BEDFORGE_HAVE_CGAL
+#include "meshing/surface/clip_planes.hpp"
+#endif
 
 namespace bedforge::pipeline {
 
@@ -82,14 +85,7 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
 // periodic planes, no treated contact crossing them, one piece.
 void check_periodic_surface(const Scene& sc) {
-  using Treatment = meshing::SurfaceParams::Treatment;
-  for (auto [t, key] : {std::pair{sc.surface.treatment, "contacts.treatment"},
-                        std::pair{sc.surface.wall_treatment, "contacts.wall_treatment"}})
-    if (sc.count > 0 && t != Treatment::none && t != Treatment::shrink)
-      throw InputError(fmt::format("{} = \"{}\" on a periodic section: its surface's periodic planes cut spheres, "
-                                   "not yet bridges, caps or unions; allowed: \"shrink\" or \"none\" (or outputs "
-                                   "without \"stl\", \"mesh\" and \"case\")",
-                                   key, meshing::treatment_name(t)));
+  if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
   if (sc.surface.clip)
     throw InputError("surface.clip_window_d on a periodic section: its planes are the period's; allowed: no clip window");
   if (sc.mesh.slabs > 1)

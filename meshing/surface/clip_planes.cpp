@@ -105,14 +105,20 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
   return out;
 }
 
-UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p) {
+void refuse_treatments_across_periodic_planes(const SurfaceParams& p) {
   using Treatment = SurfaceParams::Treatment;
   for (auto [t, key] : {std::pair{p.treatment, "contacts.treatment"}, std::pair{p.wall_treatment, "contacts.wall_treatment"}})
-    if (bed.size() > 0 && t != Treatment::none && t != Treatment::shrink)
+    if (t != Treatment::none && t != Treatment::shrink)
       throw InputError(fmt::format("{} = \"{}\" on a periodic section (container.period_z): its bridges, caps and "
                                    "unions would cross the periodic planes, which cut spheres only so far; allowed: "
-                                   "\"shrink\" or \"none\"",
+                                   "\"shrink\" or \"none\" (or no surface: outputs without \"stl\", \"mesh\" "
+                                   "and \"case\")",
                                    key, treatment_name(t)));
+}
+
+UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p) {
+  using Treatment = SurfaceParams::Treatment;
+  if (bed.size() > 0) refuse_treatments_across_periodic_planes(p);
   const double H = bed.container->axial_period(), d = reference_diameter(bed);
   const double scale = p.treatment == Treatment::shrink ? p.shrink_factor : 1.0;
   auto radius = [&](std::size_t i) { return 0.5 * scale * bed.diameters[i]; };

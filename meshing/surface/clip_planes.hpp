@@ -58,6 +58,10 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
 // whose cut loop it takes (-1 for the others). Treatments none and shrink only (a bridge, cap or
 // union would cross the planes); InputError naming the key when they are asked for, or when no
 // height lies surface.clip_clearance_d clear of every sphere's end.
+// InputError naming the key when `p` treats contacts in a way a periodic plane cannot cut yet
+// (bridge, cap, enlarge); the scene reader calls it too, before any work.
+void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
+
 struct UnwrappedSection {
   Bed bed;
   DomainPlanes planes;

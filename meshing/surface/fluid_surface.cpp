@@ -161,26 +161,28 @@ WallMesh moved_up(const WallMesh& lower, double z, const std::string& patch) {
 }
 
 // The bed as its surface is meshed, treated: a periodic section unwrapped between its planes
-// a period apart (clip_planes.hpp), any other bed as it is.
+// a period apart (clip_planes.hpp), any other bed as it is (not copied).
 struct LaidOut {
-  Bed bed;
+  std::optional<UnwrappedSection> section;
   TreatedBed treated;
-  bool periodic = false;
+  const Bed& given;
+  const Bed& bed() const { return section ? section->bed : given; }
+  bool periodic() const { return section.has_value(); }
 };
 LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
   if (bed.container->axial_period() > 0.0) {
-    UnwrappedSection u = unwrap_periodic_section(bed, p);
-    TreatedBed tb = treat_periodic_section(u, p);
-    return {std::move(u.bed), std::move(tb), true};
+    std::optional<UnwrappedSection> u = unwrap_periodic_section(bed, p);
+    TreatedBed tb = treat_periodic_section(*u, p);
+    return {std::move(u), std::move(tb), bed};
   }
-  return {bed, treat_contacts(bed, p, asked_planes(bed, p)), false};
+  return {std::nullopt, treat_contacts(bed, p, asked_planes(bed, p)), bed};
 }
 
 }  // namespace
 
 FluidDomainSize fluid_domain_size(const Bed& given, const SurfaceParams& p, double volume_per_cell) {
   const LaidOut laid = lay_out(given, p);
-  const Bed& bed = laid.bed;
+  const Bed& bed = laid.bed();
   const TreatedBed& tb = laid.treated;
   FluidDomainSize s;
   s.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
@@ -193,7 +195,7 @@ FluidDomainSize fluid_domain_size(const Bed& given, const SurfaceParams& p, doub
 FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   const double top = bed_height(given);
   LaidOut laid = lay_out(given, p);
-  const Bed& bed = laid.bed;
+  const Bed& bed = laid.bed();
   TreatedBed& tb = laid.treated;
   const double d = reference_diameter(bed), edge = p.edge_length_d * d;
   const double z0 = tb.planes.z0, z1 = tb.planes.z1;
@@ -311,18 +313,18 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   WallMesh inlet;  // a periodic section's outlet is its copy a period up, so the two are cyclic patches
   for (auto [z, holes, patch, up] : {std::tuple{z0, &tb.inlet_holes, "inlet", false}, std::tuple{z1, &tb.outlet_holes, "outlet", true}}) {
     const Frame frame = Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ());
-    if (!box && !p.clip && !laid.periodic) {  // nothing cuts it: the structured ring
+    if (!box && !p.clip && !laid.periodic()) {  // nothing cuts it: the structured ring
       f.append(ring_mesh(frame, r_in, R, wall_edge, kBreakCocircular, up, patch));
       piece(Shape::plane);
       continue;
     }
-    if (laid.periodic && up) {
+    if (laid.periodic() && up) {
       add(patch, Shape::plane, 0.0, [&] { return moved_up(inlet, z1, patch); });
       continue;
     }
     add(patch, Shape::plane, 0.0, [&] {
       WallMesh m = plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch);
-      if (laid.periodic) inlet = m;
+      if (laid.periodic()) inlet = m;
       return m;
     });
   }
@@ -363,7 +365,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
 
   const double domain = c.cross_section_area() * (z1 - z0);
   // The bed's own height, or the window's or period's (or the empty tube's).
-  const double section = p.clip || laid.periodic || n == 0 ? z1 - z0 : top;
+  const double section = p.clip || laid.periodic() || n == 0 ? z1 - z0 : top;
   const MeshQuality q = mesh_quality(f);
   out.report = tb.report;
   out.report["parameters"] = to_json(p);

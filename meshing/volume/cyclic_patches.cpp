@@ -65,7 +65,6 @@ double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::s
   std::vector<int> owner(upper.size, -1);
   long unmatched = 0;
   std::string first;
-  double z_lower = m.points[m.faces[lower.start][0]].z(), z_upper = m.points[points_of(m, upper.start)[0]].z();
   for (int f = upper.start; f < upper.start + upper.size; ++f) {
     const std::vector<int> pts = points_of(m, f);
     std::vector<int> twins;
@@ -97,7 +96,6 @@ double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::s
       }
     }
     owner[k] = m.owner[f];
-    z_upper = std::max(z_upper, m.points[pts[0]].z());
   }
   if (unmatched > 0)
     throw std::runtime_error(fmt::format("cyclic patches: {} faces of {} have no twin on {} with the same points in x "
@@ -105,7 +103,8 @@ double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::s
                                          unmatched, upper_name, lower_name, first));
   set_faces(m, upper.start, faces);
   std::copy(owner.begin(), owner.end(), m.owner.begin() + upper.start);
-  const double period = z_upper - z_lower;
+  // Each patch is flat: any point of either gives the period.
+  const double period = m.points[points_of(m, upper.start)[0]].z() - m.points[points_of(m, lower.start)[0]].z();
   for (auto [p, other, sign] : {std::tuple{&lower, &upper, 1.0}, std::tuple{&upper, &lower, -1.0}}) {
     p->type = "cyclic";
     p->neighbour = other->name;

@@ -220,7 +220,7 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
     m.neighbour.push_back(f.neighbour);
   }
   internal = {};
-  for (std::size_t p = 0; p < names.size(); ++p) m.patches.push_back({names[p], types[p], 0, 0});
+  for (std::size_t p = 0; p < names.size(); ++p) m.patches.push_back({names[p], types[p], 0, 0, {}, Eigen::Vector3d::Zero()});
   std::size_t k = 0;
   for (int p = 0; p < static_cast<int>(names.size()); ++p) {
     m.patches[p].start = static_cast<int>(m.faces.size());
