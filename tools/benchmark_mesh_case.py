@@ -69,6 +69,10 @@ verification_periodic: periodic sections, cyclic cases driven by meanVelocityFor
         one `bedforge run` each with [case.convergence] (--periodic-levels meshes from --periodic-edge d, ratio
         1.3): each level's error, the order of the errors, and issue 56's target (within 1 % of Zick & Homsy on
         the finest level, order at least 1.5).
+periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N = 500) and settings with shrunk
+        contacts, at each seed of --slice-full-seeds; then slices of --slice-count spheres packed to the full beds'
+        mean central void fraction (a period of about --slice-period d), seed after seed until --slices reach it;
+        each bed's finest dp/L, extrapolation, GCI and cells; the slices' mean against the full beds' spread.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -92,7 +96,8 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
-            "default", "solver", "verification", "verification_spheres", "verification_periodic"]
+            "default", "solver", "verification", "verification_spheres", "verification_periodic",
+            "periodic_slice"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -524,6 +529,114 @@ files = ["case"]
         out["runs"][str(phi)] = cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
                                                  container=f"period_z_d = {cells * side:.12f}\n")
     return out
+
+
+def default_scene_with(seed, treatment):
+    """scenes/default.toml with another seed and contact treatment."""
+    text = open(DEFAULT_SCENE).read()
+    for pattern, replacement in [(r"^seed = \d+", f"seed = {seed}"),
+                                 (r'^treatment = "[a-z]+"', f'treatment = "{treatment}"')]:
+        text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
+        if n != 1:
+            raise SystemExit(f"scenes/default.toml: no line matches {pattern}; update default_scene_with")
+    return text
+
+
+def slice_run(path, text):
+    """A default-settings run of one bed: its convergence study, void fractions and E&S, or the
+    packer's refusal (a periodic section that jams before its period) as `jammed`."""
+    open(path + ".toml", "w").write(text)
+    t0 = time.time()
+    out = subprocess.run([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"], capture_output=True,
+                         text=True, env=ENV)
+    if out.returncode == 3 and "jammed" in out.stderr:
+        return {"jammed": out.stderr.strip()}
+    if out.returncode != 0:
+        raise RuntimeError(f"bedforge run {path}.toml failed:\n{out.stdout}\n{out.stderr}")
+    rep = json.load(open(os.path.join(path, "report.json")))
+    case = rep["stages"]["case"]
+    finest = case["convergence"]["levels"][0]
+    return {"study": case["convergence"], "cells": finest["cells"], "dp_pa_m": finest["pressure_gradient_bed_pa_m"],
+            "eps_central": rep["stages"]["analysis"]["void_fraction"]["central_slab"],
+            "eps_section_meshed": case["flow"]["void_fraction_section"],
+            "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"], "d_m": case["d_ref_m"], "wall_s": time.time() - t0}
+
+
+def periodic_slice(tmp, seeds, period_d, count, slices, treatment="shrink"):
+    """Issue 56's z-periodic slice: full beds of the default scene (a = 5, N = 500) with `treatment`
+    at each seed, then periodic slices of `count` spheres packed to the full beds' mean central void
+    fraction (container.period_z_d follows from it, about period_d), seed after seed until `slices`
+    of them reach it; both at the default scene's mesh settings and study."""
+    out = {**commit_and_date(), "treatment": treatment, "full": {}, "slice": {}}
+    for s in seeds:
+        out["full"][str(s)] = slice_run(os.path.join(tmp, f"full_{s}"), default_scene_with(s, treatment))
+    eps = sum(r["eps_central"] for r in out["full"].values()) / len(out["full"])
+    out["target_void_fraction"] = eps
+    out["period_d"] = count * math.pi / 6.0 / ((1.0 - eps) * math.pi * 2.5 ** 2)
+    if abs(out["period_d"] - period_d) > 0.5:
+        raise SystemExit(f"{count} spheres at void fraction {eps:.4f} make a period of {out['period_d']:.2f} d, "
+                         f"not about {period_d} d: change --slice-count")
+    s = 0
+    while sum("jammed" not in r for r in out["slice"].values()) < slices and s < 4 * slices:
+        s += 1
+        extra = f"[packing.soft_sphere]\ntarget_void_fraction = {eps:.6f}\n"
+        text = default_scene_with(s, treatment).replace("count = 500", f"count = {count}", 1)
+        text = text.replace("[packing.soft_sphere]\n", extra, 1)
+        out["slice"][str(s)] = slice_run(os.path.join(tmp, f"slice_{s}"), text)
+    return out
+
+
+def slice_lines(v):
+    """The periodic slice against the full beds: a row per bed, then issue 56's target."""
+    lines = ["## A z-periodic slice against the full bed (issue 56)", "",
+             f"Made at commit {v['commit']} on {v['date']}: scenes/default.toml (a = 5, N = 500, its mesh settings and "
+             f"three-level study) with contacts.treatment = \"{v['treatment']}\" (a periodic plane cannot cut bridges "
+             f"yet), at each seed; then periodic slices of the same tube, packed to the full beds' mean central void "
+             f"fraction {v['target_void_fraction']:.4f} (packing.soft_sphere.target_void_fraction; period "
+             f"{v['period_d']:.3f} d), at the same settings, seed after seed (a slice that jams before its period is "
+             "listed and the next seed taken). dp/L: the full bed's over its section (0.5 d clear of floor and top), "
+             "the slice's over one period; E&S at that section's meshed void fraction.", "",
+             "| bed | seed | central eps (packed) | section eps (meshed) | cells (finest) | dp/L finest (Pa/m) | "
+             "/ E&S | extrapolated (Pa/m) | GCI fine | order | wall (s) |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for kind in ("full", "slice"):
+        for seed, r in v[kind].items():
+            if "jammed" in r:
+                lines.append(f"| {kind} | {seed} | jammed: {r['jammed']} | | | | | | | | |")
+                continue
+            g = r["study"].get("grid_convergence", {})
+            ext = g.get("extrapolated")
+            lines.append(f"| {kind} | {seed} | {r['eps_central']:.4f} | {r['eps_section_meshed']:.4f} | {r['cells']} | "
+                         f"{r['dp_pa_m']:.4g} | {r['dp_pa_m'] / r['es_pa_m']:.3f} | "
+                         + (f"{ext:.4g} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f}" if ext is not None
+                            else f"none ({r['study']['conclusion']}) | | ") + f" | {r['wall_s']:.0f} |")
+    solved = {k: [r for r in v[k].values() if "jammed" not in r] for k in ("full", "slice")}
+    if not solved["full"] or not solved["slice"]:
+        return lines + ["", "Too few beds solved for a comparison.", ""]
+
+    def spread(rows, key):
+        values = [key(r) for r in rows]
+        mean = sum(values) / len(values)
+        sd = math.sqrt(sum((x - mean) ** 2 for x in values) / (len(values) - 1)) if len(values) > 1 else 0.0
+        return mean, min(values), max(values), sd
+
+    lines.append("")
+    verdicts = []
+    for name, key in (("dp/L on the finest mesh (Pa/m)", lambda r: r["dp_pa_m"]),
+                      ("dp/L over E&S at the meshed void fraction", lambda r: r["dp_pa_m"] / r["es_pa_m"])):
+        f, sl = spread(solved["full"], key), spread(solved["slice"], key)
+        inside = f[1] <= sl[0] <= f[2]
+        verdicts.append(inside)
+        lines.append(f"- {name}: full beds {f[0]:.4g} (range {f[1]:.4g} to {f[2]:.4g}, standard deviation {f[3]:.3g}, "
+                     f"{len(solved['full'])} seeds); slices {sl[0]:.4g} (range {sl[1]:.4g} to {sl[2]:.4g}, "
+                     f"{len(solved['slice'])} seeds): the slices' mean {'inside' if inside else 'OUTSIDE'} the full "
+                     f"beds' range ({100 * (sl[0] / f[0] - 1):+.1f} % from their mean).")
+    cells = spread(solved["slice"], lambda r: r["cells"])[0] / spread(solved["full"], lambda r: r["cells"])[0]
+    lines.append(f"- cells: the slices' mean finest mesh is {cells:.3f} of the full beds'.")
+    met = verdicts[0] and cells <= 0.25
+    lines += ["", "Issue 56's target (dp/L within the seed-to-seed spread of the full bed's, read here as the slices' "
+              "mean inside the full beds' range over seeds, at no more than a quarter of the full bed's cells for the "
+              f"same mesh settings): {'met' if met else 'NOT met'}.", ""]
+    return lines
 
 
 def periodic_target_lines(v):
@@ -994,6 +1107,8 @@ def write(results):
         lines += verification_lines(v, "case", "verification_periodic.png")
         lines += periodic_target_lines(v)
         plot_verification(v, "verification_periodic.png", "periodic sections (cyclic)", "exact", "")
+    if "periodic_slice" in results:
+        lines += slice_lines(results["periodic_slice"])
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -1091,6 +1206,10 @@ def main():
     ap.add_argument("--periodic-fractions", type=float, nargs="+", default=[0.125, 0.216, 0.343, 0.45],
                     help="verification_periodic: solid fractions Zick & Homsy tabulate")
     ap.add_argument("--sphere-levels", type=int, default=4, help="verification_spheres: meshes in all")
+    ap.add_argument("--slice-full-seeds", type=int, nargs="+", default=[1, 2, 3], help="periodic_slice: full beds' seeds")
+    ap.add_argument("--slice-period", type=float, default=5.0, help="periodic_slice: the slice's period, about (d)")
+    ap.add_argument("--slice-count", type=int, default=105, help="periodic_slice: spheres per slice")
+    ap.add_argument("--slices", type=int, default=3, help="periodic_slice: slices that reach their period")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -1155,6 +1274,10 @@ def main():
         if "verification_periodic" in args.only:
             results["verification_periodic"] = verification_periodic(tmp, args.periodic_edge, args.periodic_levels,
                                                                      args.periodic_fractions)
+            write(results)
+        if "periodic_slice" in args.only:
+            results["periodic_slice"] = periodic_slice(tmp, args.slice_full_seeds, args.slice_period, args.slice_count,
+                                                       args.slices)
             write(results)
 
 
