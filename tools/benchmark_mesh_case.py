@@ -65,10 +65,11 @@ verification_spheres: a column of a simple cubic array of spheres in Stokes flow
 verification_periodic: periodic sections, cyclic cases driven by meanVelocityForce: the empty tube of the
         verification (D = 2 d) one period of 3 d long, whose fully developed flow is Hagen-Poiseuille's in every
         cell; and three cells of a simple cubic array as scenes/examples/periodic_cubic_verification.toml at each
-        solid fraction of --periodic-fractions (Zick & Homsy's, none of their spheres cut by the periodic planes);
-        one `bedforge run` each with [case.convergence] (--periodic-levels meshes from --periodic-edge d, ratio
-        1.3): each level's error, the order of the errors, and issue 56's target (within 1 % of Zick & Homsy on
-        the finest level, order at least 1.5).
+        solid fraction (Zick & Homsy's, none of their spheres cut by the periodic planes); one `bedforge run` each
+        with [case.convergence] (--periodic-levels meshes from --periodic-edge d, ratio 1.3): each level's error,
+        the order of the errors, and issue 56's target (within 1 % of Zick & Homsy on the finest level, order at
+        least 1.5). --periodic-runs redoes some runs (each keeps its own commit, date and edge), e.g.
+        --periodic-runs 0.45 --periodic-edge 0.016.
 periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N = 500) and settings with shrunk
         contacts, at each seed of --slice-full-seeds; then slices of --slice-count spheres packed to the full beds'
         mean central void fraction (a period of about --slice-period d), seed after seed until --slices reach it;
@@ -501,12 +502,19 @@ def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, ce
     return out
 
 
-def verification_periodic(tmp, edge, levels, fractions, cells=3):
-    """The periodic empty tube and periodic simple cubic columns (`cells` cells per period), each a run
-    with a convergence study."""
-    out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
-    path = os.path.join(tmp, "periodic_tube")
-    open(path + ".toml", "w").write(f"""[container]
+def verification_periodic(tmp, edge, levels, runs, kept, cells=3):
+    """The periodic empty tube ("empty tube" in `runs`) and periodic simple cubic columns (`cells` cells
+    per period) at each solid fraction in `runs`, each a run with a convergence study from a finest
+    edge of `edge` d and its own commit, date and edge; the runs of `kept` (an earlier result) not
+    redone stay as they were."""
+    out = {"levels": levels, "ratio": 1.3, "runs": {}}
+    for key, run in (kept or {}).get("runs", {}).items():  # results before each run carried its own stamp
+        out["runs"][key] = {"commit": kept.get("commit"), "date": kept.get("date"), "edge_d": kept.get("edge_d"), **run}
+    for key in runs:
+        stamp = {**commit_and_date(), "edge_d": edge}
+        if key == "empty tube":
+            path = os.path.join(tmp, "periodic_tube")
+            open(path + ".toml", "w").write(f"""[container]
 type = "cylinder"
 diameter_d = 2.0
 period_z_d = 3.0
@@ -523,11 +531,12 @@ convergence = {{levels = {levels}, ratio = 1.3}}
 [outputs]
 files = ["case"]
 """)
-    out["runs"]["empty tube"] = study_run(path)
-    for phi in fractions:
+            out["runs"][key] = {**stamp, **study_run(path)}
+            continue
+        phi = float(key)
         side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
-        out["runs"][str(phi)] = cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
-                                                 container=f"period_z_d = {cells * side:.12f}\n")
+        out["runs"][key] = {**stamp, **cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
+                                                        container=f"period_z_d = {cells * side:.12f}\n")}
     return out
 
 
@@ -1095,13 +1104,14 @@ def write(results):
     if "verification_periodic" in results:
         v = results["verification_periodic"]
         lines += ["## Verification of periodic sections: cyclic cases against Hagen-Poiseuille and Zick & Homsy", "",
-                  f"Made at commit {v['commit']} on {v['date']}: periodic sections whose inlet and outlet are one "
+                  "Periodic sections whose inlet and outlet are one "
                   "cyclic pair, the flow driven by meanVelocityForce at the superficial velocity set (dp/L the driving "
                   "gradient scaled to the flow rate set). The empty tube, D = 2 d, one period of 3 d, Re_p = 1: its "
                   "fully developed flow is Hagen-Poiseuille's in every cell. Three cells of a simple cubic array "
                   "(one column in a square box with slip sides, the array's mirror planes), Stokes flow (Re_p = 0.01), "
                   f"at each solid fraction; exact: Zick & Homsy (1982, Table 2), to about 0.1 %. {v['levels']} meshes "
-                  f"from a surface edge of {v['edge_d']} d (the tube's twice that), ratio {v['ratio']}. Error = dp/L / "
+                  f"from each run's finest surface edge (listed below its table; the tube's twice that), ratio "
+                  f"{v['ratio']}; each run's commit and date listed with it. Error = dp/L / "
                   "exact - 1; the order is a least-squares fit of ln |error| against ln h over all levels. "
                   "Body-centred and face-centred arrays are not run: their tables are not in the repository.", ""]
         lines += verification_lines(v, "case", "verification_periodic.png")
@@ -1129,7 +1139,9 @@ def verification_lines(v, column, png):
     for key, run in v["runs"].items():
         st = run["study"]
         order = st.get("order_from_exact")
-        lines.append(f"- {key}: exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
+        made_by = (f"made at commit {run['commit']} on {run['date']} from a finest edge of {run['edge_d']} d; "
+                   if "commit" in run else "")
+        lines.append(f"- {key}: {made_by}exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
                      f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
                      f"the study's own verdict: {st['conclusion']}.")
     return lines + ["", f"![error against cell size]({png})", ""]
@@ -1203,8 +1215,9 @@ def main():
     ap.add_argument("--sphere-edge", type=float, default=0.05, help="verification_spheres: finest surface edge (d)")
     ap.add_argument("--periodic-edge", type=float, default=0.025, help="verification_periodic: finest surface edge (d)")
     ap.add_argument("--periodic-levels", type=int, default=4, help="verification_periodic: meshes in all")
-    ap.add_argument("--periodic-fractions", type=float, nargs="+", default=[0.125, 0.216, 0.343, 0.45],
-                    help="verification_periodic: solid fractions Zick & Homsy tabulate")
+    ap.add_argument("--periodic-runs", nargs="+", default=["empty tube", "0.125", "0.216", "0.343", "0.45"],
+                    help="verification_periodic: the runs to redo (\"empty tube\", solid fractions Zick & Homsy tabulate); "
+                         "the others' results are kept")
     ap.add_argument("--sphere-levels", type=int, default=4, help="verification_spheres: meshes in all")
     ap.add_argument("--slice-full-seeds", type=int, nargs="+", default=[1, 2, 3], help="periodic_slice: full beds' seeds")
     ap.add_argument("--slice-period", type=float, default=5.0, help="periodic_slice: the slice's period, about (d)")
@@ -1273,7 +1286,8 @@ def main():
             write(results)
         if "verification_periodic" in args.only:
             results["verification_periodic"] = verification_periodic(tmp, args.periodic_edge, args.periodic_levels,
-                                                                     args.periodic_fractions)
+                                                                     args.periodic_runs,
+                                                                     results.get("verification_periodic"))
             write(results)
         if "periodic_slice" in args.only:
             results["periodic_slice"] = periodic_slice(tmp, args.slice_full_seeds, args.slice_period, args.slice_count,
