@@ -312,7 +312,7 @@ def write(result):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dir", help="a `bedforge run` output with a convergence study, already solved")
-    ap.add_argument("--edge", type=float, default=0.08, help="finest surface edge (d)")
+    ap.add_argument("--edge", type=float, default=0.1, help="finest surface edge (d)")
     ap.add_argument("--levels", type=int, default=4, help="meshes in all")
     ap.add_argument("--gap-cells", type=float, default=4, help="surface.cells_per_gap on the finest level")
     args = ap.parse_args()
