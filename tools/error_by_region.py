@@ -27,48 +27,15 @@ import argparse
 import json
 import os
 import re
-import subprocess
 import tempfile
 import time
 
 import numpy as np
 
+from benchmark_mesh_case import scene, timed
 from bedforge_files import BEDFORGE, DOCS, commit_and_date, read_bed, read_poly_mesh
 
-ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 GAP_BINS_D = [0.0, 0.02, 0.05, 0.1, 0.15, 0.25, 0.5, np.inf]  # edges of the gap classes (d)
-
-
-def scene(edge, levels, gap_cells):
-    return f"""[container]
-type = "cylinder"
-diameter_d = 4.0
-[particles]
-count = 40
-diameter_m = 0.003
-[packing]
-seed = 1
-[contacts]
-treatment = "bridge"
-[surface]
-edge_length_d = {edge}
-contact_edge_length_d = {edge / 3:.6g}
-cells_per_gap = {gap_cells}
-[case]
-reynolds = 1.0
-processors = 2
-run = true
-convergence = {{levels = {levels}, ratio = 1.3}}
-[outputs]
-files = ["positions", "case"]
-"""
-
-
-def run(cmd, cwd=None):
-    out = subprocess.run(cmd, capture_output=True, text=True, env=ENV, cwd=cwd)
-    if out.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{out.stdout[-2000:]}\n{out.stderr[-2000:]}")
-    return out.stdout
 
 
 def latest_time(case):
@@ -79,11 +46,11 @@ def latest_time(case):
 def prepare(case):
     """The level's last time reconstructed, with OpenFOAM's wallShearStress; its name."""
     if latest_time(case) is None:
-        run(["reconstructPar", "-latestTime", "-case", case])
+        timed(["reconstructPar", "-latestTime", "-case", case])
     t = latest_time(case)
     name = f"{t:g}"
     if not os.path.exists(os.path.join(case, name, "wallShearStress")):
-        run(["simpleFoam", "-postProcess", "-func", "wallShearStress", "-latestTime", "-case", case])
+        timed(["simpleFoam", "-postProcess", "-func", "wallShearStress", "-latestTime", "-case", case])
     return name
 
 
@@ -263,7 +230,7 @@ def rows(level):
 def write(result):
     json.dump(result, open(os.path.join(DOCS, "error_by_region.json"), "w"), indent=1)
     levels = result["levels"]
-    finest, coarsest = levels[0], levels[-1]
+    finest = levels[0]
     total = {lv["level"]: sum(v for _, v in rows(lv)) for lv in levels}
     # The interphase drag: without the linear field's push, which is the result itself.
     interphase = {lv["level"]: sum(v for name, v in rows(lv) if "linear" not in name) for lv in levels}
@@ -324,8 +291,8 @@ def main():
             arguments = f" --dir {args.dir}"
         else:
             run_dir = os.path.join(tmp, "bed")
-            open(run_dir + ".toml", "w").write(scene(args.edge, args.levels, args.gap_cells))
-            run([BEDFORGE, "--quiet", "run", run_dir + ".toml", "-o", run_dir, "--overwrite"])
+            open(run_dir + ".toml", "w").write(scene(4, 40, "bridge", args.edge, True, args.gap_cells, levels=args.levels))
+            timed([BEDFORGE, "--quiet", "run", run_dir + ".toml", "-o", run_dir, "--overwrite"])
             what = (f"a = 4, N = 40 (seed 1), bridges, Re_p = 1, {args.levels} levels from a surface edge of "
                     f"{args.edge} d with {args.gap_cells:g} cells per gap, ratio 1.3")
             arguments = f" --edge {args.edge} --levels {args.levels} --gap-cells {args.gap_cells:g}"
