@@ -71,7 +71,8 @@ verification_periodic: periodic sections, cyclic cases driven by meanVelocityFor
         least 1.5). --periodic-runs redoes some runs (each keeps its own commit, date and edge), e.g.
         --periodic-runs 0.45 --periodic-edge 0.016.
 periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N = 500) and settings with shrunk
-        contacts, at each seed of --slice-full-seeds; then slices of --slice-count spheres packed to the full beds'
+        contacts, at each seed of --slice-full-seeds, dp/L over the section --slice-full-exclude d clear of floor and
+        top (default 2, the central slab of the analysis); then slices of --slice-count spheres packed to the full beds'
         mean central void fraction (a period of about --slice-period d), seed after seed until --slices reach it;
         each bed's finest dp/L, extrapolation, GCI and cells; the slices' mean against the full beds' spread.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
@@ -571,14 +572,18 @@ def slice_run(path, text):
             "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"], "d_m": case["d_ref_m"], "wall_s": time.time() - t0}
 
 
-def periodic_slice(tmp, seeds, period_d, count, slices, treatment="shrink"):
+def periodic_slice(tmp, seeds, period_d, count, slices, full_exclude_d, treatment="shrink"):
     """Issue 56's z-periodic slice: full beds of the default scene (a = 5, N = 500) with `treatment`
-    at each seed, then periodic slices of `count` spheres packed to the full beds' mean central void
-    fraction (container.period_z_d follows from it, about period_d), seed after seed until `slices`
-    of them reach it; both at the default scene's mesh settings and study."""
-    out = {**commit_and_date(), "treatment": treatment, "full": {}, "slice": {}}
+    at each seed, their dp/L over the section full_exclude_d clear of floor and top (the bulk a
+    slice stands for: the default scene's central slab is 2 d clear); then periodic slices of
+    `count` spheres packed to the full beds' mean central void fraction (container.period_z_d
+    follows from it, about period_d), seed after seed until `slices` of them reach it; both at the
+    default scene's mesh settings and study."""
+    out = {**commit_and_date(), "treatment": treatment, "full_section_exclude_d": full_exclude_d, "full": {},
+           "slice": {}}
     for s in seeds:
-        out["full"][str(s)] = slice_run(os.path.join(tmp, f"full_{s}"), default_scene_with(s, treatment))
+        text = default_scene_with(s, treatment).replace("[case]\n", f"[case]\nsection_exclude_d = {full_exclude_d}\n", 1)
+        out["full"][str(s)] = slice_run(os.path.join(tmp, f"full_{s}"), text)
     eps = sum(r["eps_central"] for r in out["full"].values()) / len(out["full"])
     out["target_void_fraction"] = eps
     out["period_d"] = count * math.pi / 6.0 / ((1.0 - eps) * math.pi * 2.5 ** 2)
@@ -603,7 +608,8 @@ def slice_lines(v):
              f"yet), at each seed; then periodic slices of the same tube, packed to the full beds' mean central void "
              f"fraction {v['target_void_fraction']:.4f} (packing.soft_sphere.target_void_fraction; period "
              f"{v['period_d']:.3f} d), at the same settings, seed after seed (a slice that jams before its period is "
-             "listed and the next seed taken). dp/L: the full bed's over its section (0.5 d clear of floor and top), "
+             f"listed and the next seed taken). dp/L: the full bed's over its section "
+             f"({v.get('full_section_exclude_d', 0.5):g} d clear of floor and top), "
              "the slice's over one period; E&S at that section's meshed void fraction.", "",
              "| bed | seed | central eps (packed) | section eps (meshed) | cells (finest) | dp/L finest (Pa/m) | "
              "/ E&S | extrapolated (Pa/m) | GCI fine | order | wall (s) |", "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -1223,6 +1229,8 @@ def main():
     ap.add_argument("--slice-period", type=float, default=5.0, help="periodic_slice: the slice's period, about (d)")
     ap.add_argument("--slice-count", type=int, default=105, help="periodic_slice: spheres per slice")
     ap.add_argument("--slices", type=int, default=3, help="periodic_slice: slices that reach their period")
+    ap.add_argument("--slice-full-exclude", type=float, default=2.0,
+                    help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -1291,7 +1299,7 @@ def main():
             write(results)
         if "periodic_slice" in args.only:
             results["periodic_slice"] = periodic_slice(tmp, args.slice_full_seeds, args.slice_period, args.slice_count,
-                                                       args.slices)
+                                                       args.slices, args.slice_full_exclude)
             write(results)
 
 
