@@ -47,6 +47,10 @@ struct ClipPlacement {
 ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes asked,
                                 const std::vector<double>& radius, const ContactExtents& extents);
 
+// InputError naming the key when `p` treats contacts in a way a periodic plane cannot cut yet
+// (bridge, cap, enlarge); the scene reader calls it too, before any work.
+void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
+
 // A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
 // planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between
 // the spheres' ends (at their radius under `p`'s treatment) over one period that lie
@@ -56,12 +60,8 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
 // bed's container has no period (the copies are its images); copies count in its Sauter mean.
 // twin[i]: for a sphere crossing the upper plane, the index of its copy crossing the lower one,
 // whose cut loop it takes (-1 for the others). Treatments none and shrink only (a bridge, cap or
-// union would cross the planes); InputError naming the key when they are asked for, or when no
-// height lies surface.clip_clearance_d clear of every sphere's end.
-// InputError naming the key when `p` treats contacts in a way a periodic plane cannot cut yet
-// (bridge, cap, enlarge); the scene reader calls it too, before any work.
-void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
-
+// union would cross the planes; refuse_treatments_across_periodic_planes names the key), and
+// InputError when no height lies surface.clip_clearance_d clear of every sphere's end.
 struct UnwrappedSection {
   Bed bed;
   DomainPlanes planes;
