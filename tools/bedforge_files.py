@@ -71,7 +71,14 @@ def read_bed(path):
     return np.column_stack([bed["x_m"], bed["y_m"], bed["z_m"]]), bed["d_m"], container
 
 
-def _foam_list(data, start, dtype, width, binary):
+def foam_file(path):
+    """An OpenFOAM file's bytes, where its FoamFile header ends, and whether it is binary."""
+    data = open(path, "rb").read()
+    header_end = data.index(b"}", data.index(b"FoamFile")) + 1
+    return data, header_end, re.search(rb"format\s+binary", data[:header_end]) is not None
+
+
+def foam_list(data, start, dtype, width, binary):
     """The OpenFOAM list at data[start:], `N (items)` raw or as text: (array (N, width), its end)."""
     m = re.compile(rb"(\d+)\s*\(").search(data, start)
     n, body = int(m.group(1)), m.end()
@@ -88,15 +95,13 @@ def read_poly_mesh(directory):
     offsets (faces + 1) into labels (their vertices in order), owner (cell per face) and
     neighbour (cell per internal face)."""
     def load(name):
-        data = open(os.path.join(directory, name), "rb").read()
-        header_end = data.index(b"}", data.index(b"FoamFile")) + 1
-        return data, header_end, re.search(rb"format\s+binary", data[:header_end]) is not None
+        return foam_file(os.path.join(directory, name))
     data, h, binary = load("points")
-    points, _ = _foam_list(data, h, "<f8", 3, binary)
+    points, _ = foam_list(data, h, "<f8", 3, binary)
     data, h, binary = load("faces")
     if b"faceCompactList" in data[:h]:
-        offsets, end = _foam_list(data, h, "<i4", 1, binary)
-        labels, _ = _foam_list(data, end, "<i4", 1, binary)
+        offsets, end = foam_list(data, h, "<i4", 1, binary)
+        labels, _ = foam_list(data, end, "<i4", 1, binary)
         offsets, labels = offsets.ravel().astype(np.int64), labels.ravel().astype(np.int64)
     else:
         body = data[re.compile(rb"(\d+)\s*\(").search(data, h).end():]
@@ -106,6 +111,6 @@ def read_poly_mesh(directory):
     cells = []
     for name in ("owner", "neighbour"):
         data, h, binary = load(name)
-        cells.append(_foam_list(data, h, "<i4", 1, binary)[0].ravel())
+        cells.append(foam_list(data, h, "<i4", 1, binary)[0].ravel())
     owner, neighbour = cells
     return points, offsets, labels, owner, neighbour

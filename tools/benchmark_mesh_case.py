@@ -508,9 +508,7 @@ def verification_periodic(tmp, edge, levels, runs, kept, cells=3):
     per period) at each solid fraction in `runs`, each a run with a convergence study from a finest
     edge of `edge` d and its own commit, date and edge; the runs of `kept` (an earlier result) not
     redone stay as they were."""
-    out = {"levels": levels, "ratio": 1.3, "runs": {}}
-    for key, run in (kept or {}).get("runs", {}).items():  # results before each run carried its own stamp
-        out["runs"][key] = {"commit": kept.get("commit"), "date": kept.get("date"), "edge_d": kept.get("edge_d"), **run}
+    out = {"levels": levels, "ratio": 1.3, "runs": dict((kept or {}).get("runs", {}))}
     for key in runs:
         stamp = {**commit_and_date(), "edge_d": edge}
         if key == "empty tube":
@@ -541,11 +539,12 @@ files = ["case"]
     return out
 
 
-def default_scene_with(seed, treatment):
-    """scenes/default.toml with another seed and contact treatment."""
+def default_scene_with(seed, treatment, count=None):
+    """scenes/default.toml with another seed and contact treatment (and sphere count)."""
     text = open(DEFAULT_SCENE).read()
     for pattern, replacement in [(r"^seed = \d+", f"seed = {seed}"),
-                                 (r'^treatment = "[a-z]+"', f'treatment = "{treatment}"')]:
+                                 (r'^treatment = "[a-z]+"', f'treatment = "{treatment}"')] + (
+                                     [(r"^count = \d+", f"count = {count}")] if count else []):
         text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
         if n != 1:
             raise SystemExit(f"scenes/default.toml: no line matches {pattern}; update default_scene_with")
@@ -586,16 +585,16 @@ def periodic_slice(tmp, seeds, period_d, count, slices, full_exclude_d, treatmen
         out["full"][str(s)] = slice_run(os.path.join(tmp, f"full_{s}"), text)
     eps = sum(r["eps_central"] for r in out["full"].values()) / len(out["full"])
     out["target_void_fraction"] = eps
-    out["period_d"] = count * math.pi / 6.0 / ((1.0 - eps) * math.pi * 2.5 ** 2)
+    a = float(re.search(r"^diameter_d = ([0-9.]+)", open(DEFAULT_SCENE).read(), re.M).group(1))
+    out["period_d"] = count / 6.0 / ((1.0 - eps) * (a / 2.0) ** 2)  # spheres' volume over (1 - eps) x cross-section
     if abs(out["period_d"] - period_d) > 0.5:
         raise SystemExit(f"{count} spheres at void fraction {eps:.4f} make a period of {out['period_d']:.2f} d, "
                          f"not about {period_d} d: change --slice-count")
     s = 0
+    target = f"[packing.soft_sphere]\ntarget_void_fraction = {eps:.6f}\n"
     while sum("jammed" not in r for r in out["slice"].values()) < slices and s < 4 * slices:
         s += 1
-        extra = f"[packing.soft_sphere]\ntarget_void_fraction = {eps:.6f}\n"
-        text = default_scene_with(s, treatment).replace("count = 500", f"count = {count}", 1)
-        text = text.replace("[packing.soft_sphere]\n", extra, 1)
+        text = default_scene_with(s, treatment, count).replace("[packing.soft_sphere]\n", target, 1)
         out["slice"][str(s)] = slice_run(os.path.join(tmp, f"slice_{s}"), text)
     return out
 

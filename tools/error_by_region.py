@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from benchmark_mesh_case import scene, timed
-from bedforge_files import BEDFORGE, DOCS, commit_and_date, read_bed, read_poly_mesh
+from bedforge_files import BEDFORGE, DOCS, commit_and_date, foam_file, foam_list, read_bed, read_poly_mesh
 
 GAP_BINS_D = [0.0, 0.02, 0.05, 0.1, 0.15, 0.25, 0.5, np.inf]  # edges of the gap classes (d)
 
@@ -54,37 +54,17 @@ def prepare(case):
     return name
 
 
-def foam_header(data):
-    end = data.index(b"}", data.index(b"FoamFile")) + 1
-    return end, re.search(rb"format\s+binary", data[:end]) is not None
-
-
-def foam_values(data, start, width, binary):
-    """The list after `start` in a field file: uniform (one value) or nonuniform List."""
+def field_values(path, start_at, width):
+    """The nonuniform list (n, width) of an OpenFOAM field file that follows the patterns of
+    `start_at` found one after the other (the internal field's, or a patch's block and its value)."""
+    data, h, binary = foam_file(path)
+    start = h
+    for pattern in start_at:
+        start = re.compile(pattern).search(data, start).end()
     m = re.compile(rb"(uniform|nonuniform)").search(data, start)
     if m.group(1) == b"uniform":
-        return None
-    m2 = re.compile(rb"(\d+)\s*\(").search(data, m.end())
-    n, body = int(m2.group(1)), m2.end()
-    if binary:
-        return np.frombuffer(data, "<f8", n * width, body).reshape(n, width)
-    end = data.index(b")\n;" if width == 1 else b"\n)", body)
-    return np.array(re.findall(rb"[-+0-9.eE]+", data[body:end].replace(b"(", b" ").replace(b")", b" ")),
-                    dtype=np.float64).reshape(n, width)
-
-
-def internal_field(path, width):
-    data = open(path, "rb").read()
-    h, binary = foam_header(data)
-    return foam_values(data, data.index(b"internalField", h), width, binary)
-
-
-def patch_field(path, patch, width):
-    data = open(path, "rb").read()
-    h, binary = foam_header(data)
-    b = data.index(b"boundaryField", h)
-    start = re.compile(rb"\n\s*" + re.escape(patch.encode()) + rb"\s*\n\s*\{").search(data, b).end()
-    return foam_values(data, data.index(b"value", start), width, binary)
+        raise SystemExit(f"{path}: a uniform value where error_by_region.py expects one per cell or face")
+    return foam_list(data, m.end(), "<f8", width, binary)[0]
 
 
 def patches(case):
@@ -147,7 +127,7 @@ def split_level(case, bed, rho, gradient):
     OpenFOAM's forces objects. `gradient`: the level's dp/L (Pa/m)."""
     t = prepare(case)
     points, offsets, labels, owner, _ = read_poly_mesh(os.path.join(case, "constant/polyMesh"))
-    p = internal_field(os.path.join(case, t, "p"), 1).ravel() * rho
+    p = field_values(os.path.join(case, t, "p"), [rb"internalField"], 1).ravel() * rho
     centres, diameters, container = bed
     if container.get("type") != "cylinder":
         raise SystemExit(f"error_by_region.py splits beds in a cylinder, not a {container.get('type')}")
@@ -155,19 +135,20 @@ def split_level(case, bed, rho, gradient):
     d = float(np.mean(diameters))
     out = {"parts": {}, "area": {}, "check": {}}
     ranges = patches(case)
-    sums = {}
-    # The linear field of the level's gradient, its level set by the particle faces' mean pressure.
+    faces_of = {}
     for patch in ("particles", "wall"):
         start, n = ranges[patch]
         faces = np.arange(start, start + n)
         sf, xf = face_geometry(points, offsets, labels, faces)
-        tau = patch_field(os.path.join(case, t, "wallShearStress"), patch, 3) * rho  # Pa, on the fluid
+        tau = field_values(os.path.join(case, t, "wallShearStress"),  # Pa, on the fluid
+                           [rb"boundaryField", rb"\n\s*" + re.escape(patch.encode()) + rb"\s*\n\s*\{", rb"value"], 3) * rho
         magsf = np.linalg.norm(sf, axis=1)
         pf = p[owner[faces]]
-        sums[patch] = (sf, xf, pf, tau, magsf)
-    sf, xf, pf, _, magsf = sums["particles"]
+        faces_of[patch] = (sf, xf, pf, tau, magsf)
+    # The linear field of the level's gradient, its level set by the particle faces' mean pressure.
+    sf, xf, pf, _, magsf = faces_of["particles"]
     level = np.sum((pf + gradient * xf[:, 2]) * magsf) / np.sum(magsf)
-    for patch, (sf, xf, pf, tau, magsf) in sums.items():
+    for patch, (sf, xf, pf, tau, magsf) in faces_of.items():
         g, facing_wall = gaps(xf, centres, diameters / 2.0, wall_radius, patch == "particles")
         bins = np.digitize(g / d, GAP_BINS_D) - 1
         linear = -gradient * xf[:, 2] + level
