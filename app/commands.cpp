@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <map>
@@ -14,6 +15,7 @@
 
 #include "app/flags.hpp"
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "core/version.hpp"
 #include "pipeline/directory_stages.hpp"
 #include "pipeline/run_scene.hpp"
@@ -97,6 +99,18 @@ int run_command_line(int argc, char** argv) {
                                 "mesh the fluid domain of DIR/fluid.stl with gmsh, held to the quality gate: writes "
                                 "DIR/fluid.msh (bad_cells.vtk when the gate fails)",
                                 "directory holding fluid.stl and bed.csv (as written by surface)", Command::mesh);
+  // One rank's piece of a decomposed case: started by `mpirun -np P bedforge piece DIR`, each
+  // process takes its piece from Open MPI's rank unless told.
+  int piece = -1, pieces = 0;
+  CLI::App* piece_cmd =
+      on_directory("piece",
+                   "mesh one axial piece of DIR/bed.csv and write it as DIR/case/processorK with processor patches "
+                   "to its neighbours (DIR/case written first); under mpirun each rank takes its own piece",
+                   "directory holding bed.csv, scene.toml and case/", Command::mesh);
+  piece_cmd->add_option("--piece", piece, "int: this piece, 0 at the bottom (default: OMPI_COMM_WORLD_RANK)")
+      ->check(CLI::NonNegativeNumber);
+  piece_cmd->add_option("--pieces", pieces, "int: the number of pieces (default: OMPI_COMM_WORLD_SIZE)")
+      ->check(CLI::PositiveNumber);
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   CLI::App* case_cmd = on_directory("case",
@@ -142,6 +156,22 @@ int run_command_line(int argc, char** argv) {
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (*mesh) pipeline::mesh_directory(dir, flags.overrides(), console);
+  if (*piece_cmd) {
+    // Open MPI's rank and size when the option is not given.
+    auto from_mpi = [&](int& value, const char* option, const char* variable) {
+      if (piece_cmd->count(option) > 0) return;
+      const char* set = std::getenv(variable);
+      if (!set)
+        throw InputError(fmt::format("bedforge piece: {} not given and {} not set (not started by Open MPI's mpirun)",
+                                     option, variable));
+      value = std::stoi(set);
+    };
+    from_mpi(piece, "--piece", "OMPI_COMM_WORLD_RANK");
+    from_mpi(pieces, "--pieces", "OMPI_COMM_WORLD_SIZE");
+    if (piece >= pieces)
+      throw InputError(fmt::format("--piece {}: allowed: 0 to {} (--pieces {})", piece, pieces - 1, pieces));
+    pipeline::piece_directory(dir, flags.overrides(), piece, pieces, console);
+  }
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   if (*case_cmd) pipeline::case_directory(dir, flags.overrides(), overwrite, console);

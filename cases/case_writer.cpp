@@ -497,6 +497,41 @@ void refuse_existing_case(const fs::path& case_dir, bool overwrite) {
     throw InputError(fmt::format("{} exists; remove it or pass --overwrite", case_dir.string()));
 }
 
+namespace {
+
+template <class Mesh>
+void write_piece(const fs::path& case_dir, int piece, const Mesh& mesh, bool binary, const std::string& note,
+                 const nlohmann::json& report) {
+  if (!fs::is_directory(case_dir / "0"))
+    throw InputError(fmt::format("{}: no 0/ fields; a case's pieces are written into a case written first",
+                                 case_dir.string()));
+  std::random_device rd;
+  const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
+  const fs::path tmp = case_dir / fmt::format(".processor{}.partial-{:x}", piece, rd());
+  try {
+    write_poly_mesh(tmp / "constant/polyMesh", mesh, binary, note);
+    fs::copy(case_dir / "0", tmp / "0", fs::copy_options::recursive);
+    write_text(tmp / "bedforge_piece.json", report.dump(2) + "\n");
+    fs::remove_all(piece_dir);
+    fs::rename(tmp, piece_dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace
+
+void write_case_piece(const fs::path& case_dir, int piece, const meshing::PolyMesh& mesh, bool binary,
+                      const std::string& note, const nlohmann::json& report) {
+  write_piece(case_dir, piece, mesh, binary, note, report);
+}
+void write_case_piece(const fs::path& case_dir, int piece, const meshing::PolyhedralMesh& mesh, bool binary,
+                      const std::string& note, const nlohmann::json& report) {
+  write_piece(case_dir, piece, mesh, binary, note, report);
+}
+
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,

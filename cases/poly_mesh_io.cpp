@@ -110,6 +110,10 @@ void write_mesh(const std::filesystem::path& dir, const Mesh& m, bool binary, co
                          "        transform       translational;\n        neighbourPatch  {};\n"
                          "        separationVector ({:.17g} {:.17g} {:.17g});\n",
                          p.neighbour, p.separation.x(), p.separation.y(), p.separation.z());
+    if (p.type == "processor")
+      out << fmt::format("        inGroups        List<word> 1(processor);\n        matchTolerance  0.0001;\n"
+                         "        transform       unknown;\n        myProcNo        {};\n        neighbProcNo    {};\n",
+                         p.processor, p.neighbour_processor);
     out << fmt::format("        nFaces          {};\n        startFace       {};\n    }}\n", p.size, p.start);
   }
   out << ")\n";

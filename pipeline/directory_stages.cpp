@@ -21,6 +21,7 @@
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 #include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
+#include "pipeline/piece_stage.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
 #include "meshing/volume/gmsh_model.hpp"
@@ -130,6 +131,22 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
   d.report.set_stage("mesh", std::move(m.report));
   files.write(dir);
   d.report.save(dir);
+}
+#endif
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+void piece_directory(const fs::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
+                     const Console& console) {
+  Directory d = open_directory(dir, overrides);
+  const meshing::SurfaceParams surface = read_surface_sections(d.scene);
+  const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
+  const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
+  const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
+  const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", prov.version,
+                                       prov.seed ? std::to_string(*prov.seed) : "none", piece, pieces);
+  const nlohmann::json r = piece_stage(d.bed, surface, mesh, params, piece, pieces, dir / "case", note, console);
+  console.line(fmt::format("piece {} of {}: {} cells in {}", piece, pieces, r["cells"].get<long>(),
+                           (dir / "case" / fmt::format("processor{}", piece)).string()));
 }
 #endif
 

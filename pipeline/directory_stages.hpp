@@ -24,6 +24,12 @@ void surface_directory(const std::filesystem::path& dir, const std::vector<Overr
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 // The volume mesh of DIR/fluid.stl (refused, located, when it is not closed): fluid.msh.
 void mesh_directory(const std::filesystem::path& dir, const std::vector<Override>& overrides, const Console& console);
+
+// Piece `piece` of `pieces` of DIR/bed.csv's fluid domain as DIR/case/processor<piece>
+// (piece_stage.hpp), the case written into DIR/case first. Every piece's report goes beside its
+// cells, not into DIR/report.json, which the ranks would race for.
+void piece_directory(const std::filesystem::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
+                     const Console& console);
 #endif
 
 #ifdef BEDFORGE_HAVE_GMSH

@@ -13,13 +13,6 @@ namespace bedforge::meshing {
 
 namespace {
 
-// A face's point labels, whichever way the mesh stores its faces.
-std::vector<int> points_of(const PolyMesh& m, int f) { return {m.faces[f].begin(), m.faces[f].end()}; }
-std::vector<int> points_of(const PolyhedralMesh& m, int f) {
-  const auto face = m.faces[f];
-  return {face.begin(), face.end()};
-}
-
 // Replaces the faces first .. first + faces.size() - 1 (a patch's, in place; same total size).
 void set_faces(PolyMesh& m, int first, const std::vector<std::vector<int>>& faces) {
   for (std::size_t k = 0; k < faces.size(); ++k)

@@ -40,11 +40,13 @@ struct VolumeCell {
 struct PolyMesh {
   struct Patch {
     std::string name;
-    std::string type;  // OpenFOAM patch type: "patch" (inlet, outlet), "wall" or "cyclic"
+    std::string type;  // OpenFOAM patch type: "patch" (inlet, outlet), "wall", "cyclic" or "processor"
     int start = 0, size = 0;
     // cyclic only (cyclic_patches.hpp): the other patch, and the translation from this one to it (m)
     std::string neighbour;
     Eigen::Vector3d separation = Eigen::Vector3d::Zero();
+    // processor only (processor_patches.hpp): this piece's processor and the one across the patch
+    int processor = -1, neighbour_processor = -1;
   };
   std::vector<Eigen::Vector3d> points;  // m
   std::vector<Face> faces;
@@ -80,6 +82,13 @@ struct PolyhedralMesh {
   int cells = 0;
   int internal_faces() const { return static_cast<int>(neighbour.size()); }
 };
+
+// Face f's point labels, whichever way the mesh stores its faces.
+inline std::vector<int> points_of(const PolyMesh& m, int f) { return {m.faces[f].begin(), m.faces[f].end()}; }
+inline std::vector<int> points_of(const PolyhedralMesh& m, int f) {
+  const auto face = m.faces[f];
+  return {face.begin(), face.end()};
+}
 
 // Cells with labelled boundary faces into a PolyMesh.
 //   points      P x 3, m

@@ -200,52 +200,59 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int sl
   return planes;
 }
 
+SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, int slabs) {
+  const double d = reference_diameter(bed);
+  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
+  SurfaceParams q = surface;
+  q.clip = true;
+  q.clip_bottom_d = k > 0 ? planes[k - 1] : surface.clip ? surface.clip_bottom_d : -surface.inlet_length_d;
+  q.clip_top_d = k + 1 < slabs ? planes[k] : surface.clip ? surface.clip_top_d : bed_height(bed) / d + surface.outlet_length_d;
+  return q;
+}
+
+VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
+                     const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path) {
+  const SurfaceParams q = slab_surface(bed, surface, k, slabs);
+  // The slab's clip planes may find no height clear of the spheres, or cut one too close to
+  // another cut: say which slab, since the scene set no clip window.
+  const FluidSurface fs = [&] {
+    try {
+      return build_fluid_surface(bed, q);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut "
+                                   "from the bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
+                                   k + 1, slabs, q.clip_bottom_d, q.clip_top_d, e.what()));
+    }
+  }();
+  Progress quiet("mesh", false);
+  VolumeMesh slab;
+  try {
+    // Memory a slab frees stays with the allocator for the next slab and the join: handing it
+    // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
+    slab = build_volume_mesh(fs.fluid, bed, d_ref, p, {}, bad_cells_path, quiet, false);
+  } catch (const ConvergenceError& e) {
+    throw ConvergenceError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor): {}", k + 1, slabs,
+                                       q.clip_bottom_d, q.clip_top_d, e.what()));
+  }
+  slab.report["heights_d"] = {q.clip_bottom_d, q.clip_top_d};  // asked
+  slab.report["planes_d"] = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
+  slab.report["surface_triangles"] = fs.fluid.triangles.size();
+  slab.report["cells"] = slab.mesh.cells;
+  return slab;
+}
+
 VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
                                      const VolumeMeshParams& p, const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  const double d = reference_diameter(bed);
-  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
   for (int k = 0; k < slabs; ++k) {
-    // The slab's own domain: the whole domain's ends outside, the planes between slabs inside.
-    SurfaceParams q = surface;
-    q.clip = true;
-    q.clip_bottom_d = k > 0 ? planes[k - 1] : surface.clip ? surface.clip_bottom_d : -surface.inlet_length_d;
-    q.clip_top_d = k + 1 < slabs ? planes[k] : surface.clip ? surface.clip_top_d : bed_height(bed) / d + surface.outlet_length_d;
-    progress.update(fmt::format("slab {} of {} ({:.2f}-{:.2f} d): surface", k + 1, slabs, q.clip_bottom_d, q.clip_top_d));
-    VolumeMesh slab;
-    {
-      // The slab's clip planes may find no height clear of the spheres, or cut one too close to
-      // another cut: say which slab, since the scene set no clip window.
-      const FluidSurface fs = [&] {
-        try {
-          return build_fluid_surface(bed, q);
-        } catch (const InputError& e) {
-          throw InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut "
-                                       "from the bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
-                                       k + 1, slabs, q.clip_bottom_d, q.clip_top_d, e.what()));
-        }
-      }();
-      Progress quiet("mesh", false);
-      try {
-        // Memory a slab frees stays with the allocator for the next slab and the join: handing it
-        // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
-        slab = build_volume_mesh(fs.fluid, bed, d_ref, p, {}, bad_cells_path, quiet, false);
-      } catch (const ConvergenceError& e) {
-        throw ConvergenceError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor): {}", k + 1, slabs,
-                                           q.clip_bottom_d, q.clip_top_d, e.what()));
-      }
-      slab.report["heights_d"] = {q.clip_bottom_d, q.clip_top_d};  // asked
-      slab.report["planes_d"] = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
-      slab.report["surface_triangles"] = fs.fluid.triangles.size();
-    }
+    progress.update(fmt::format("slab {} of {}: surface and cells", k + 1, slabs));
+    VolumeMesh slab = mesh_slab(bed, surface, k, slabs, d_ref, p, bad_cells_path);
     progress.update(fmt::format("slab {} of {}: {} cells joined", k + 1, slabs, slab.mesh.cells), (k + 1.0) / slabs);
     joined.add(slab.mesh, k == 0, k + 1 == slabs, k);
-    slab.report["cells"] = slab.mesh.cells;
     reports.push_back(std::move(slab.report));
-    slab = VolumeMesh();
   }
   joined.top_points = {};
   release_free_memory();  // the slabs' gmsh models: the join's arrays are of other sizes

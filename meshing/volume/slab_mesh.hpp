@@ -32,6 +32,20 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 // last slab). Empty when slabs < 2.
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 
+// The surface parameters of slab `k` (from 0, bottom up) of `slabs`: a clip window from the
+// plane below it to the plane above it (slab_planes_d), the whole domain's ends (or the scene's
+// clip window's) outside. The surface stage may move a plane a little to keep it clear of the
+// spheres, alike for the slabs on either side.
+SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, int slabs);
+
+// Slab `k` of `slabs` meshed on its own: its surface (slab_surface) and build_volume_mesh with
+// `params` (`params.layers` off), quietly. Its report adds "heights_d" (asked), "planes_d"
+// (where the surface stage put them), "surface_triangles" and "cells". InputError naming
+// mesh.slabs when the slab cannot be cut from the bed; ConvergenceError naming the slab when
+// its cells fail the gate (written to `bad_cells_path`).
+VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
+                     const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path);
+
 // The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;
 // `params.layers` must be off) and joined. `d_ref` (m) scales the parameters; the report holds

@@ -1,0 +1,28 @@
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cases/case_params.hpp"
+#include "core/bed.hpp"
+#include "meshing/surface/fluid_surface.hpp"
+#include "meshing/volume/volume_mesh.hpp"
+#include "pipeline/console.hpp"
+
+namespace bedforge::pipeline {
+
+// One piece of a decomposed case, the work of one rank: slab `piece` (from 0, bottom up) of
+// `pieces` of the fluid domain of `bed` under `surface` (meshing::mesh_slab with `mesh`), its
+// polyhedral dual when `case_params.polyhedra`, its planes to the neighbouring slabs made
+// processor patches (meshing::make_processor_patches), written as case_dir/processor<piece>
+// (cases::write_case_piece; the case's 0/ must be written). No process holds more than its
+// own slab. Returns the piece's report (also written beside its cells): its cells, its cells'
+// fluid volume (m^3) and the part of it with centres in the bed section (m^3, for the section's
+// void fraction as meshed), the slab's report, time and peak memory.
+// InputError when the treatments cannot be cut by a plane (meshing::slabs_possible); the
+// errors of mesh_slab otherwise, naming the piece.
+nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, int piece, int pieces,
+                           const std::filesystem::path& case_dir, const std::string& note, const Console& console);
+
+}  // namespace bedforge::pipeline
