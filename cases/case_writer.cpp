@@ -200,7 +200,7 @@ std::string allrun(const CaseParams& p, const BedSection& section, bool periodic
   if (flag) s += "# ./Allrun -snappy first replaces the gmsh mesh by one from snappyHexMesh (decomposed with -np N).\n";
   s += "cd \"${0%/*}\" || exit 1\n"
        "export WM_PROJECT_DIR=\"${WM_PROJECT_DIR:-/usr/share/openfoam}\"\n"
-       "np=1\n" + std::string(p.snappy_cells ? "snappy=1\n" : "snappy=0\n") +
+       "np=1\npieces=0\n" + std::string(p.snappy_cells ? "snappy=1\n" : "snappy=0\n") +
        "while [ $# -gt 0 ]; do\n"
        "    case \"$1\" in\n"
        "        -np) np=\"$2\"; shift 2 ;;\n";
@@ -225,9 +225,12 @@ std::string allrun(const CaseParams& p, const BedSection& section, bool periodic
        "    echo \"running $* on $np processes\"\n"
        "    step \"$1\" mpirun -np \"$np\" \"$@\" -parallel\n"
        "}\n"
-       "decompose() {\n"
+       "subdomains() {\n"
        "    sed -i -e \"s/^numberOfSubdomains .*/numberOfSubdomains $np;/\" \\\n"
        "        -e \"s/^    n .*/    n               (1 1 $np);/\" system/decomposeParDict\n"
+       "}\n"
+       "decompose() {\n"
+       "    subdomains\n"
        "    run decomposePar -force \"$@\"\n"
        "}\n";
   if (p.snappy)
@@ -243,18 +246,28 @@ std::string allrun(const CaseParams& p, const BedSection& section, bool periodic
          "        run checkMesh\n"
          "    fi\n"
          "fi\n";
+  if (!p.snappy_cells)
+    s += "# A case whose pieces `bedforge piece` wrote (processor*/bedforge_piece.json, one rank each) is\n"
+         "# decomposed already: its processes are its pieces, with no decomposePar; its results stay in\n"
+         "# processor*/ (reconstructParMesh -constant, then reconstructPar, gather them).\n"
+         "[ \"$snappy\" = 0 ] && pieces=$(ls processor*/bedforge_piece.json 2>/dev/null | wc -l)\n"
+         "[ \"$pieces\" -gt 1 ] && np=$pieces && subdomains\n";
   if (p.polyhedra && !p.snappy_cells)
     s += "# constant/polyMesh holds the dual polyhedra of gmsh's tetrahedra, as `polyDualMesh 80` makes them:\n"
          "# an empty tube's pressure drop converges to the exact one on the dual, not on the tetrahedra.\n"
          "if [ \"$snappy\" = 0 ]; then\n"
-         "    run checkMesh\n"
+         "    if [ \"$pieces\" -gt 1 ]; then parallel checkMesh; else run checkMesh; fi\n"
          "fi\n";
+  else if (!p.snappy_cells)
+    s += "[ \"$pieces\" -gt 1 ] && parallel checkMesh\n";
   s += "# Past about a million cells per process the solver's temporary fields outgrow glibc's 32 MB\n"
        "# limit for heap blocks: each was mapped afresh and cleared page by page on every use, which\n"
        "# made an iteration ten times slower. Kept in the heap, they are reused (a larger peak); the\n"
        "# setting holds for every step from here on.\n"
        "export MALLOC_MMAP_MAX_=0 MALLOC_TRIM_THRESHOLD_=1000000000000\n"
-       "if [ \"$np\" -gt 1 ]; then\n"
+       "if [ \"$pieces\" -gt 1 ]; then\n"
+       "    parallel simpleFoam\n"
+       "elif [ \"$np\" -gt 1 ]; then\n"
        "    [ \"$snappy\" = 1 ] || decompose\n"
        "    parallel simpleFoam\n"
        "    [ \"$snappy\" = 1 ] || run reconstructPar -latestTime\n"

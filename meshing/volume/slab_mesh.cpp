@@ -196,7 +196,21 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int sl
   std::vector<double> planes;
   const double d = reference_diameter(bed);
   const double lo = s.clip ? s.clip_bottom_d : 0.0, hi = s.clip ? s.clip_top_d : bed_height(bed) / d;
-  for (int k = 1; k < slabs; ++k) planes.push_back(lo + (hi - lo) * k / slabs);
+  std::vector<double> ends;  // d
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
+      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
+  std::sort(ends.begin(), ends.end());
+  for (int k = 1; k < slabs; ++k) {
+    const double asked = lo + (hi - lo) * k / slabs;
+    double best = asked, widest = -1.0;
+    for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
+      const double mid = 0.5 * (ends[j] + ends[j + 1]);
+      if (std::abs(mid - asked) <= s.clip_shift_d && ends[j + 1] - ends[j] > widest)
+        best = mid, widest = ends[j + 1] - ends[j];
+    }
+    planes.push_back(best);
+  }
   return planes;
 }
 

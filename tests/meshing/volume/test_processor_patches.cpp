@@ -1,0 +1,107 @@
+// Processor patches: two slabs of a bed, meshed each on its own and turned into their polyhedral
+// duals, order their shared plane's faces alike without seeing each other: face k on one side
+// is face k on the other, the same points (bit for bit) from the same 0th point, in reverse
+// order, as decomposePar writes a neighbour's copy. Every piece lists the same patches first.
+#include "meshing/volume/processor_patches.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "meshing/volume/dual_mesh.hpp"
+#include "meshing/volume/slab_mesh.hpp"
+#include "support/packed_bed.hpp"
+#include "support/temp_dir.hpp"
+
+using namespace bedforge;
+using namespace bedforge::meshing;
+
+namespace {
+
+const PolyMesh::Patch& patch(const PolyhedralMesh& m, const std::string& name) {
+  for (const auto& p : m.patches)
+    if (p.name == name) return p;
+  throw std::runtime_error("no patch " + name);
+}
+
+}  // namespace
+
+TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
+  const Bed b = test_support::packed_bed(60, 4.0, 2);
+  SurfaceParams sp;  // shrink
+  sp.edge_length_d = 0.25;
+  VolumeMeshParams p;
+  const auto dir = test_support::fresh_dir("processor_patches", true);
+  const int pieces = 3;
+  std::vector<PolyhedralMesh> piece;
+  std::vector<long> boundary_faces;
+  for (int k = 0; k < pieces; ++k) {
+    const VolumeMesh slab = mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk");
+    piece.push_back(dual_mesh(slab.mesh, cell_geometry(slab.mesh).centres, 80.0));
+    long faces = 0;
+    for (const auto& q : piece.back().patches) faces += q.size;
+    boundary_faces.push_back(faces);
+    const int internal = piece.back().internal_faces();
+    make_processor_patches(piece.back(), k, pieces);
+    // The internal faces stay; the boundary keeps every face, owned by the same cells' count.
+    EXPECT_EQ(piece.back().internal_faces(), internal);
+    EXPECT_EQ(static_cast<long>(piece.back().faces.size()) - internal, faces);
+    EXPECT_EQ(piece.back().owner.size(), piece.back().faces.size());
+  }
+  // The same patches in the same order on every piece, the processor patches after them, the
+  // boundary laid out patch after patch from the last internal face.
+  for (int k = 0; k < pieces; ++k) {
+    const auto& patches = piece[k].patches;
+    const std::vector<std::string> expected_tail =
+        k == 0 ? std::vector<std::string>{"procBoundary0to1"}
+        : k == 1 ? std::vector<std::string>{"procBoundary1to0", "procBoundary1to2"}
+                 : std::vector<std::string>{"procBoundary2to1"};
+    ASSERT_EQ(patches.size(), piece[0].patches.size() - 1 + expected_tail.size());
+    int start = piece[k].internal_faces();
+    for (std::size_t j = 0; j < patches.size(); ++j) {
+      EXPECT_EQ(patches[j].start, start);
+      start += patches[j].size;
+      if (j < patches.size() - expected_tail.size()) {
+        EXPECT_EQ(patches[j].name, piece[0].patches[j].name);
+        EXPECT_NE(patches[j].type, "processor");
+      } else {
+        EXPECT_EQ(patches[j].name, expected_tail[j - (patches.size() - expected_tail.size())]);
+        EXPECT_EQ(patches[j].type, "processor");
+        EXPECT_EQ(patches[j].processor, k);
+      }
+    }
+    EXPECT_EQ(start, static_cast<int>(piece[k].faces.size()));
+    // The domain's own inlet and outlet are only on the end pieces.
+    EXPECT_EQ(patch(piece[k], "inlet").size > 0, k == 0);
+    EXPECT_EQ(patch(piece[k], "outlet").size > 0, k == pieces - 1);
+  }
+  // Each shared plane: face for face, point for point.
+  for (int k = 0; k + 1 < pieces; ++k) {
+    const PolyhedralMesh &lower = piece[k], &upper = piece[k + 1];
+    const auto& a = patch(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
+    const auto& c = patch(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
+    EXPECT_EQ(a.neighbour_processor, k + 1);
+    EXPECT_EQ(c.neighbour_processor, k);
+    ASSERT_EQ(a.size, c.size);
+    ASSERT_GT(a.size, 50);
+    long mismatched = 0;
+    for (int f = 0; f < a.size; ++f) {
+      const std::vector<int> x = points_of(lower, a.start + f), y = points_of(upper, c.start + f);
+      bool same = x.size() == y.size();
+      for (std::size_t j = 0; same && j < x.size(); ++j)
+        same = lower.points[x[j]] == upper.points[y[(x.size() - j) % x.size()]];
+      mismatched += !same;
+      // Flat on the plane, each normal out of its own piece.
+      EXPECT_GT(face_geometry(lower.points, lower.faces[a.start + f]).area.z(), 0.0);
+      EXPECT_LT(face_geometry(upper.points, upper.faces[c.start + f]).area.z(), 0.0);
+    }
+    EXPECT_EQ(mismatched, 0) << "of " << a.size << " faces on the plane above piece " << k;
+  }
+}
+
+TEST(ProcessorPatches, RefusesAPieceOutsideTheCount) {
+  PolyhedralMesh m;
+  EXPECT_THROW(make_processor_patches(m, 2, 2), std::runtime_error);
+  EXPECT_THROW(make_processor_patches(m, 0, 2), std::runtime_error);  // no inlet patch
+}

@@ -1,0 +1,107 @@
+// A case written in pieces, one per Open MPI rank (`mpirun -np 2 bedforge piece DIR`), runs in
+// parallel straight away: no decomposePar, checkMesh passes across the pieces and on the mesh
+// reconstructed from them, and the bed's pressure drop is the one of the same slabs joined
+// into one mesh. (Skipped when OpenFOAM's programs are not on PATH.)
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/cli.hpp"
+
+namespace fs = std::filesystem;
+using namespace cli_test;
+
+namespace {
+
+bool have_openfoam() { return shell("command -v simpleFoam && command -v mpirun").status == 0; }
+
+// gmsh on one thread: its parallel HXT makes other cells on every run, and on some of them one
+// face of a piece's dual failed checkMesh's face-pyramid check (a defect not yet found, issue 58).
+const char* kScene =
+    "[container]\ntype = \"cylinder\"\ndiameter_d = 4.0\n[particles]\ncount = 60\ndiameter_m = 0.003\n"
+    "[packing]\nseed = 2\n[contacts]\ntreatment = \"shrink\"\n[surface]\nedge_length_d = 0.2\n"
+    "[mesh]\nslabs = 2\nthreads = 1\n[case.convergence]\nlevels = 0\n[outputs]\nfiles = [\"positions\", \"case\"]\n"
+    "[case]\nprocessors = 2\n";
+
+// `bedforge run` of kScene, the case solved or only written, into a fresh directory `name`.
+fs::path run(const std::string& name, bool solve) {
+  const fs::path dir = fresh_dir(name), scene = fresh_dir(name + "_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml") << kScene << (solve ? "run = true\n" : "run = false\n");
+  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  return dir;
+}
+
+double said_gradient(const std::string& log) {
+  const auto at = log.find("dp/L over the bed section");
+  if (at == std::string::npos) return NAN;
+  return std::stod(log.substr(log.find("m): ", at) + 4));
+}
+
+const std::string kOpenFoam =
+    "export WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam}; "
+    "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; ";
+
+}  // namespace
+
+TEST(PieceStage, TwoRanksWriteACaseThatRunsInParallelAsTheJoinedSlabsDo) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam, mpirun) not on PATH";
+  // The same slabs joined into one mesh, solved on two processes through decomposePar.
+  const fs::path joined = run("piece_joined", true);
+  const auto report = nlohmann::json::parse(read(joined / "report.json"));
+  const double joined_gradient = report["stages"]["case"]["flow"]["pressure_gradient_bed_pa_m"].get<double>();
+  const long joined_cells = report["stages"]["case"]["cells"].get<long>();
+
+  // The case written, then its pieces, one per rank.
+  const fs::path dir = run("piece_pieces", false);
+  const Result pieces = shell(kOpenFoam + "mpirun -np 2 " + BEDFORGE_BINARY + " --quiet piece " + dir.string());
+  ASSERT_EQ(pieces.status, 0) << pieces.output;
+  long cells = 0, plane_faces = 0;
+  for (int k = 0; k < 2; ++k) {
+    const auto r = nlohmann::json::parse(read(dir / fmt::format("case/processor{}/bedforge_piece.json", k)));
+    EXPECT_EQ(r["piece"].get<int>(), k);
+    cells += r["cells"].get<long>();
+    EXPECT_TRUE(fs::exists(dir / fmt::format("case/processor{}/0/U", k)));
+  }
+  // Each piece names its neighbour across the plane, with as many faces on either side.
+  for (int k = 0; k < 2; ++k) {
+    const std::string boundary = read(dir / fmt::format("case/processor{}/constant/polyMesh/boundary", k));
+    const auto at = boundary.find(fmt::format("procBoundary{}to{}", k, 1 - k));
+    ASSERT_NE(at, std::string::npos) << boundary;
+    const auto n = boundary.find("nFaces", at);
+    const long faces = std::stol(boundary.substr(boundary.find_first_of("0123456789", n)));
+    if (k == 0) plane_faces = faces;
+    EXPECT_EQ(faces, plane_faces);
+  }
+  // The dual cells of the points on the plane are cut in two: a few more cells, no fewer.
+  EXPECT_GT(cells, joined_cells);
+  EXPECT_LE(cells, joined_cells + plane_faces);
+
+  // Allrun sees the pieces: parallel checkMesh and simpleFoam on 2 processes, no decomposePar.
+  const Result allrun = shell(kOpenFoam + (dir / "case/Allrun").string());
+  ASSERT_EQ(allrun.status, 0) << allrun.output << read(dir / "case/log.checkMesh");
+  EXPECT_FALSE(fs::exists(dir / "case/log.decomposePar"));
+  const std::string check = read(dir / "case/log.checkMesh");
+  EXPECT_NE(check.find("Mesh OK."), std::string::npos) << check;
+  EXPECT_NE(check.find(fmt::format("cells:            {}", cells)), std::string::npos) << check;
+  EXPECT_NE(read(dir / "case/log.simpleFoam").find("SIMPLE solution converged"), std::string::npos);
+  // Issue 58's rule for the pieces against the one-piece route at the same settings: dp/L within
+  // 0.5 % (the cells differ only at the planes between pieces).
+  const double gradient = said_gradient(allrun.output);
+  EXPECT_NEAR(gradient, joined_gradient, 0.005 * joined_gradient) << allrun.output;
+
+  // The whole mesh can still be gathered: reconstructParMesh, then checkMesh on it.
+  const Result gathered =
+      shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh -constant "
+            "> log.reconstructParMesh 2>&1 && checkMesh > log.checkMesh.whole 2>&1");
+  ASSERT_EQ(gathered.status, 0) << read(dir / "case/log.reconstructParMesh");
+  const std::string whole = read(dir / "case/log.checkMesh.whole");
+  EXPECT_NE(whole.find("Mesh OK."), std::string::npos) << whole;
+  EXPECT_NE(whole.find(fmt::format("cells:            {}", cells)), std::string::npos) << whole;
+}
