@@ -18,6 +18,11 @@ namespace bedforge::meshing {
 // face k of one side is face k of the other, its points in reverse order from the same 0th: the
 // form decomposePar gives the neighbour's copy. std::runtime_error when the mesh has no inlet or
 // outlet patch, or when piece is not in [0, pieces).
+// On gmsh's cells the pieces' cells are their slabs', each held to the gate. On their dual the cell of a
+// point on a plane is cut in two halves, one per piece, whose centres lie close to the plane:
+// a face between two halves can fail checkMesh (skewness 4.2-4.3, or an inverted face pyramid
+// near a sphere at the wall, on a = 4, N = 60 beds, 2026-11-29). Whole cells across the plane
+// need each piece to see its neighbour's cells next to it: not done yet (issue 58).
 template <class Mesh>
 void make_processor_patches(Mesh& mesh, int piece, int pieces);
 

@@ -31,9 +31,9 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 // heights (the empty inlet and outlet sections, or a clip window's ends, go to the first and the
 // last slab), each moved within surface.clip_shift_d to the middle of the widest interval
 // between the spheres' tops and bottoms (at their own and their shrunk radius): a plane just
-// clear of a sphere's top cuts it in a thin cap whose wedge of fluid gives skewed cells where a
-// piece's cells meet the plane (checkMesh failed one face at skewness 4.2 with the nearest
-// height 0.005 d clear). Empty when slabs < 2.
+// clear of a sphere's top cuts it in a thin cap and leaves an acute wedge of fluid beside it.
+// (For pieces on the polyhedral dual this did not suffice: processor_patches.hpp.) Empty when
+// slabs < 2.
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 
 // The surface parameters of slab `k` (from 0, bottom up) of `slabs`: a clip window from the
