@@ -106,7 +106,9 @@ int run_command_line(int argc, char** argv) {
       on_directory("piece",
                    "mesh one axial piece of DIR/bed.csv and write it as DIR/case/processorK with processor patches "
                    "to its neighbours (DIR/case written first); under mpirun each rank takes its own piece",
-                   "directory holding bed.csv, scene.toml and case/", Command::mesh);
+                   "directory holding bed.csv, scene.toml and case/",
+                   static_cast<Command>(static_cast<unsigned>(Command::surface) | static_cast<unsigned>(Command::mesh) |
+                                        static_cast<unsigned>(Command::case_)));
   piece_cmd->add_option("--piece", piece, "int: this piece, 0 at the bottom (default: OMPI_COMM_WORLD_RANK)")
       ->check(CLI::NonNegativeNumber);
   piece_cmd->add_option("--pieces", pieces, "int: the number of pieces (default: OMPI_COMM_WORLD_SIZE)")

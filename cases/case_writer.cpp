@@ -515,9 +515,6 @@ namespace {
 template <class Mesh>
 void write_piece(const fs::path& case_dir, int piece, const Mesh& mesh, bool binary, const std::string& note,
                  const nlohmann::json& report) {
-  if (!fs::is_directory(case_dir / "0"))
-    throw InputError(fmt::format("{}: no 0/ fields; a case's pieces are written into a case written first",
-                                 case_dir.string()));
   std::random_device rd;
   const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
   const fs::path tmp = case_dir / fmt::format(".processor{}.partial-{:x}", piece, rd());

@@ -104,8 +104,7 @@ CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const
 // have written it: `mesh` into case_dir/processor<piece>/constant/polyMesh, the case's 0/ fields
 // copied beside it (their boundaries take the processor patches from setConstraintTypes), and
 // `report` as processor<piece>/bedforge_piece.json. Built under a temporary name and renamed,
-// replacing an earlier piece only once complete. InputError when case_dir/0 is not there (the
-// case is written first).
+// replacing an earlier piece only once complete. The case (case_dir/0) is written first.
 void write_case_piece(const std::filesystem::path& case_dir, int piece, const meshing::PolyMesh& mesh, bool binary,
                       const std::string& note, const nlohmann::json& report);
 void write_case_piece(const std::filesystem::path& case_dir, int piece, const meshing::PolyhedralMesh& mesh,

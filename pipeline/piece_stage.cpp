@@ -18,14 +18,22 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
                            const cases::CaseParams& case_params, int piece, int pieces,
                            const std::filesystem::path& case_dir, const std::string& note, const Console& console) {
   const StageMeter meter;
+  if (!std::filesystem::is_directory(case_dir / "0"))
+    throw InputError(fmt::format("{}: no case to write a piece into (no 0/ fields); write the case first, e.g. "
+                                 "`bedforge run` with case.run = false",
+                                 case_dir.string()));
   if (!meshing::slabs_possible(surface, mesh))
-    throw InputError("mesh.pieces: a piece's planes would cut treated contacts or prism layers; allowed: "
-                     "contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\", no [mesh.layers]");
+    throw InputError(fmt::format("contacts.treatment = \"{}\", contacts.wall_treatment = \"{}\", mesh.layers.count = "
+                                 "{}: a piece's planes would cut treated contacts or prism layers open; allowed for "
+                                 "pieces: contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\", "
+                                 "mesh.layers.count = 0",
+                                 meshing::treatment_name(surface.treatment),
+                                 meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
   const double d = reference_diameter(bed);
   Progress progress("piece", console.progress);
   progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
   meshing::VolumeMesh slab =
-      meshing::mesh_slab(bed, surface, piece, pieces, d, mesh, case_dir / fmt::format("bad_cells_piece{}.vtk", piece));
+      meshing::mesh_slab(bed, surface, piece, pieces, d, mesh, case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
   // The bed section of the whole domain (its ends as asked), and the piece's fluid in it.
   const meshing::SurfaceParams whole = meshing::slab_surface(bed, surface, 0, 1);
   const cases::CaseGeometry g =
@@ -47,6 +55,7 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
   if (case_params.polyhedra) {
     meshing::PolyhedralMesh dual = meshing::dual_mesh(slab.mesh, cells.centres, cases::kDualFeatureAngleDeg);
     slab = meshing::VolumeMesh();
+    release_free_memory();  // the tetrahedra
     meshing::make_processor_patches(dual, piece, pieces);
     report["cells"] = dual.cells;
     meter.record(report);

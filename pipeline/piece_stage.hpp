@@ -19,8 +19,8 @@ namespace bedforge::pipeline {
 // own slab. Returns the piece's report (also written beside its cells): its cells, its cells'
 // fluid volume (m^3) and the part of it with centres in the bed section (m^3, for the section's
 // void fraction as meshed), the slab's report, time and peak memory.
-// InputError when the treatments cannot be cut by a plane (meshing::slabs_possible); the
-// errors of mesh_slab otherwise, naming the piece.
+// InputError, before any work, when case_dir/0 is not there or the treatments cannot be cut by
+// a plane (meshing::slabs_possible); the errors of mesh_slab otherwise, naming the piece.
 nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, int piece, int pieces,
                            const std::filesystem::path& case_dir, const std::string& note, const Console& console);

@@ -225,7 +225,7 @@ SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, 
 }
 
 VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
-                     const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path) {
+                     const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path, bool release_memory) {
   const SurfaceParams q = slab_surface(bed, surface, k, slabs);
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
@@ -241,9 +241,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int sl
   Progress quiet("mesh", false);
   VolumeMesh slab;
   try {
-    // Memory a slab frees stays with the allocator for the next slab and the join: handing it
-    // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
-    slab = build_volume_mesh(fs.fluid, bed, d_ref, p, {}, bad_cells_path, quiet, false);
+    slab = build_volume_mesh(fs.fluid, bed, d_ref, p, {}, bad_cells_path, quiet, release_memory);
   } catch (const ConvergenceError& e) {
     throw ConvergenceError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor): {}", k + 1, slabs,
                                        q.clip_bottom_d, q.clip_top_d, e.what()));
@@ -263,7 +261,9 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
   nlohmann::json reports = nlohmann::json::array();
   for (int k = 0; k < slabs; ++k) {
     progress.update(fmt::format("slab {} of {}: surface and cells", k + 1, slabs));
-    VolumeMesh slab = mesh_slab(bed, surface, k, slabs, d_ref, p, bad_cells_path);
+    // Memory a slab frees stays with the allocator for the next slab and the join: handing it
+    // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
+    VolumeMesh slab = mesh_slab(bed, surface, k, slabs, d_ref, p, bad_cells_path, false);
     progress.update(fmt::format("slab {} of {}: {} cells joined", k + 1, slabs, slab.mesh.cells), (k + 1.0) / slabs);
     joined.add(slab.mesh, k == 0, k + 1 == slabs, k);
     reports.push_back(std::move(slab.report));

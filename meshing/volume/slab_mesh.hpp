@@ -43,12 +43,13 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, 
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, int slabs);
 
 // Slab `k` of `slabs` meshed on its own: its surface (slab_surface) and build_volume_mesh with
-// `params` (`params.layers` off), quietly. Its report adds "heights_d" (asked), "planes_d"
+// `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
+// in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
 // (where the surface stage put them), "surface_triangles" and "cells". InputError naming
 // mesh.slabs when the slab cannot be cut from the bed; ConvergenceError naming the slab when
 // its cells fail the gate (written to `bad_cells_path`).
 VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
-                     const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path);
+                     const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path, bool release_memory);
 
 // The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;

@@ -121,3 +121,27 @@ TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
   EXPECT_NE(gathered.output.find("Mesh OK."), std::string::npos) << gathered.output;
   EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
 }
+
+// Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
+// no case to write into, and contacts a plane would cut open; no processor directory is left.
+TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
+  const fs::path dir = fresh_dir("piece_refused");
+  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
+  Result r = bedforge("piece " + dir.string() + " --piece 2 --pieces 2");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--piece 2: allowed: 0 to 1"), std::string::npos) << r.output;
+  r = shell("env -u OMPI_COMM_WORLD_RANK " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() + " --pieces 2");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--piece not given and OMPI_COMM_WORLD_RANK not set"), std::string::npos) << r.output;
+  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("no case to write a piece into"), std::string::npos) << r.output;
+  fs::create_directories(dir / "case/0");
+  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --contacts bridge");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("contacts.treatment = \"bridge\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("allowed for pieces: contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\""),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "case/processor0"));
+}

@@ -37,7 +37,7 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   std::vector<PolyhedralMesh> piece;
   std::vector<long> boundary_faces;
   for (int k = 0; k < pieces; ++k) {
-    const VolumeMesh slab = mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk");
+    const VolumeMesh slab = mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk", true);
     piece.push_back(dual_mesh(slab.mesh, cell_geometry(slab.mesh).centres, 80.0));
     long faces = 0;
     for (const auto& q : piece.back().patches) faces += q.size;
