@@ -10,24 +10,31 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const Bed& bed,
                      const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     bool spheres_as_packed, const Console& console) {
+                     bool spheres_as_packed, const Console& console, const CasePieces* pieces) {
   const StageMeter meter;
   const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
-  // The domain's extent and patches: from gmsh's cells, or from the surface snappyHexMesh meshes.
+  // The domain's extent and patches: from gmsh's cells, from the surface snappyHexMesh meshes, or
+  // for a case in pieces its inlet and outlet heights.
   std::vector<std::string> patches;
   if (mesh)
     for (const auto& patch : mesh->patches) patches.push_back(patch.name);
-  else
+  else if (surface)
     patches = surface->patches;
-  const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface->points, bed);
+  const std::vector<Eigen::Vector3d> ends =
+      pieces ? std::vector<Eigen::Vector3d>{{0.0, 0.0, pieces->inlet_z}, {0.0, 0.0, pieces->outlet_z}}
+             : std::vector<Eigen::Vector3d>{};
+  const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface ? surface->points : ends, bed);
   CaseStage out;
   out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
                                fluid_stl, spheres_as_packed);
-  if (!mesh) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
+  if (pieces) pieces->write(out.info);
+  if (surface) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
-  std::string line = !mesh ? fmt::format("case: snappyHexMesh's set-up in {} (not a validated route: check its "
-                                         "cells, docs/mesh_case_benchmark.md)",
-                                         case_dir.string())
+  std::string line = pieces ? fmt::format("case: {} {} in {} pieces (one rank each) in {}", out.info.cells,
+                                          p.polyhedra ? "polyhedra" : "cells", pieces->count, case_dir.string())
+                     : !mesh ? fmt::format("case: snappyHexMesh's set-up in {} (not a validated route: check its "
+                                           "cells, docs/mesh_case_benchmark.md)",
+                                           case_dir.string())
                      : p.polyhedra
                          ? fmt::format("case: {} polyhedra (the dual of {} cells) in {}", out.info.cells, mesh->cells,
                                        case_dir.string())

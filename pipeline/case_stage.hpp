@@ -1,5 +1,6 @@
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -29,10 +30,20 @@ struct CaseStage {
 // needed, with params.snappy, beside gmsh's).
 // Both are let go of once the case is written and the allocator's free pages handed back, so
 // that OpenFOAM's processes get the memory they held (callers pass their only reference).
+// A case in pieces (mesh.pieces > 1), made by ranks of their own (piece_stage.hpp): the domain's
+// inlet and outlet heights (m), and `write`, which puts the pieces into the case just written and
+// completes its info (cells, fluid volume, the section's void fraction as meshed).
+struct CasePieces {
+  int count = 0;
+  double inlet_z = 0.0, outlet_z = 0.0;
+  std::function<void(cases::CaseInfo&)> write;
+};
+
+// With `pieces` (mesh and surface null) the case is written without cells, then its pieces.
 CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_ptr<const meshing::TriangleMesh> surface,
                      const Bed& bed,
                      const cases::CaseParams& params, const Provenance& provenance, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     bool spheres_as_packed, const Console& console);
+                     bool spheres_as_packed, const Console& console, const CasePieces* pieces = nullptr);
 
 }  // namespace bedforge::pipeline

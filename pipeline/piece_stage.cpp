@@ -2,10 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <numeric>
+#include <tuple>
 #include <vector>
 
 #include "cases/case_writer.hpp"
+#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/stage_meter.hpp"
 #include "meshing/volume/dual_mesh.hpp"
@@ -34,10 +38,9 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
   progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
   meshing::VolumeMesh slab =
       meshing::mesh_slab(bed, surface, piece, pieces, d, mesh, case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
-  // The bed section of the whole domain (its ends as asked), and the piece's fluid in it.
-  const meshing::SurfaceParams whole = meshing::slab_surface(bed, surface, 0, 1);
-  const cases::CaseGeometry g =
-      cases::case_geometry({Eigen::Vector3d(0, 0, whole.clip_bottom_d * d), Eigen::Vector3d(0, 0, whole.clip_top_d * d)}, bed);
+  // The bed section of the whole domain, and the piece's fluid in it.
+  const auto [inlet_z, outlet_z] = domain_heights(bed, surface);
+  const cases::CaseGeometry g = cases::case_geometry({Eigen::Vector3d(0, 0, inlet_z), Eigen::Vector3d(0, 0, outlet_z)}, bed);
   const cases::BedSection section = cases::bed_section(nullptr, g, g.periodic ? 0.0 : case_params.section_exclude_d);
   const meshing::CellGeometry cells = meshing::cell_geometry(slab.mesh);
   double fluid = 0.0, in_section = 0.0;
@@ -68,6 +71,54 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
   }
   progress.finish();
   return report;
+}
+
+std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceParams& surface) {
+  const meshing::SurfaceParams whole = meshing::slab_surface(bed, surface, 0, 1);
+  const double d = reference_diameter(bed);
+  return {whole.clip_bottom_d * d, whole.clip_top_d * d};
+}
+
+CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
+                       const std::filesystem::path& run_dir, const Console& console) {
+  CasePieces out;
+  out.count = pieces;
+  std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
+  out.write = [pieces, run_dir, &console](cases::CaseInfo& info) {
+    namespace fs = std::filesystem;
+    const fs::path self = fs::read_symlink("/proc/self/exe"), log = info.directory / "log.pieces";
+    Progress progress("pieces", console.progress);
+    progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
+    // Open MPI refuses root unless told (containers, CI), as in Allrun.
+    const std::string cmd = fmt::format(
+        "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; "
+        "mpirun -np {} '{}' --quiet --no-progress piece '{}' > '{}' 2>&1",
+        pieces, self.string(), run_dir.string(), log.string());
+    const int status = std::system(cmd.c_str());
+    progress.finish();
+    if (status != 0) {
+      // A rank's own message says which piece and why.
+      std::ifstream in(log);
+      std::string line, said;
+      while (std::getline(in, line))
+        if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
+      throw std::runtime_error(fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
+                                           self.filename().string(), said.empty() ? "no rank said why" : said,
+                                           log.string()));
+    }
+    long cells = 0;
+    double fluid = 0.0, in_section = 0.0;
+    for (int k = 0; k < pieces; ++k) {
+      const nlohmann::json r = nlohmann::json::parse(read_file(info.directory / fmt::format("processor{}/bedforge_piece.json", k)));
+      cells += r["cells"].get<long>();
+      fluid += r["fluid_volume_m3"].get<double>();
+      in_section += r["section_fluid_volume_m3"].get<double>();
+    }
+    info.cells = cells;
+    info.fluid_volume_m3 = fluid;
+    info.section.void_fraction = in_section / (info.inlet_area_m2 * (info.section.z_high - info.section.z_low));
+  };
+  return out;
 }
 
 }  // namespace bedforge::pipeline

@@ -7,6 +7,7 @@
 #include "core/bed.hpp"
 #include "meshing/surface/fluid_surface.hpp"
 #include "meshing/volume/volume_mesh.hpp"
+#include "pipeline/case_stage.hpp"
 #include "pipeline/console.hpp"
 
 namespace bedforge::pipeline {
@@ -24,5 +25,17 @@ namespace bedforge::pipeline {
 nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, int piece, int pieces,
                            const std::filesystem::path& case_dir, const std::string& note, const Console& console);
+
+// The inlet's and outlet's heights (m) of the fluid domain of `bed` under `surface` (its clip
+// window's ends when it has one), as its pieces and the case that holds them take them.
+std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceParams& surface);
+
+// The pieces of the case a run writes (case_stage with CasePieces): `pieces` ranks started as
+// `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
+// the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
+// case/log.pieces; when a rank fails, std::runtime_error with its message. Set
+// OMPI_MCA_rmaps_base_oversubscribe=1 for more ranks than cores.
+CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
+                       const std::filesystem::path& run_dir, const Console& console);
 
 }  // namespace bedforge::pipeline

@@ -25,6 +25,7 @@
 #include "pipeline/case_stage.hpp"
 #include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
+#include "pipeline/piece_stage.hpp"
 #include "pipeline/pressure_drop_answer.hpp"
 #endif
 
@@ -58,7 +59,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
   const RunPlan plan = plan_run(opt.wants, keys, previous, [&dir](const std::string& f) { return fs::exists(dir / f); });
   if (plan.case_.build) cases::refuse_existing_case(dir / "case", opt.overwrite);  // before the long stages
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
-  if (plan.mesh.build) refuse_mesh_beyond_memory(scene, available_memory_bytes());
+  // A case in pieces: no whole surface or mesh in this process, the ranks make the pieces.
+  const bool in_pieces = scene.mesh.pieces > 1;
+  if (plan.mesh.build && !in_pieces) refuse_mesh_beyond_memory(scene, available_memory_bytes());
   // Without OpenFOAM the case is written and not solved, said now and by the exit status.
   const std::string missing = plan.case_.build && scene.case_params.run
                                   ? cases::missing_openfoam_program(scene.case_params.processors)
@@ -106,7 +109,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // Now with the bed's narrow gaps, whose cells the scene alone cannot foresee: before the surface.
   MeshEstimate estimate;
-  if (plan.mesh.build) {
+  if (plan.mesh.build && !in_pieces) {
     const double available = available_memory_bytes();
     estimate = refuse_mesh_beyond_memory(scene, bed, available);
     console.line(estimate_line(estimate, available));
@@ -129,7 +132,11 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 
 #ifdef BEDFORGE_HAVE_CGAL
   std::shared_ptr<const meshing::FluidSurface> surface;
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (plan.surface.build && !in_pieces) {
+#else
   if (plan.surface.build) {
+#endif
     SurfaceStage s = surface_stage(bed, scene.surface, dir / "bad_triangles.vtp", console);
     if (opt.wants.stl) add_surface_files(s.surface, files);
     surface = std::move(s.surface);
@@ -143,7 +150,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 #endif
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   std::shared_ptr<const meshing::PolyMesh> mesh;
-  if (plan.mesh.build) {
+  if (in_pieces) {
+    // Made by the case stage's ranks.
+  } else if (plan.mesh.build) {
     const fs::path msh = opt.wants.mesh ? dir / ".fluid.partial.msh" /* gmsh picks the format by extension */ : fs::path();
     if (opt.wants.mesh) files.add_made("fluid.msh", msh);
     MeshStage m = mesh_stage(surface->fluid, surface->exact_volume_m3, bed, scene.surface, scene.mesh, msh, dir / "bad_cells.vtk", console);
@@ -184,9 +193,12 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
     }
   };
   if (plan.case_.build) {
+    const std::optional<CasePieces> pieces =
+        in_pieces ? std::optional(case_pieces(bed, scene.surface, scene.mesh.pieces, dir, console)) : std::nullopt;
     const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, case_scene.case_params, prov,
                                    read_file(dir / "scene.toml"), scene.case_params.snappy ? dir / "fluid.stl" : fs::path(),
-                                   dir / "case", opt.overwrite, scene.surface.keeps_spheres(), console);
+                                   dir / "case", opt.overwrite, scene.surface.keeps_spheres(), console,
+                                   pieces ? &*pieces : nullptr);
     nlohmann::json entry = c.report;
     std::optional<ConvergenceStudy> s;
     if (study) {

@@ -82,6 +82,33 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
 }
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+// What a case in pieces can be given today: planes that cut only shrunk or untreated spheres,
+// and no whole surface or mesh anywhere.
+void check_pieces(const Scene& sc) {
+  const int n = sc.mesh.pieces;
+  if (!meshing::slabs_possible(sc.surface, sc.mesh))
+    throw InputError(fmt::format("mesh.pieces = {}: the planes between pieces cut through the bed, and through treated "
+                                 "contacts or prism layers they would open them; allowed: 0 or 1, or mesh.pieces > 1 "
+                                 "with contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\" (now "
+                                 "\"{}\" and \"{}\") and mesh.layers.count = 0 (now {})",
+                                 n, meshing::treatment_name(sc.surface.treatment),
+                                 meshing::treatment_name(sc.surface.wall_treatment), sc.mesh.layers.count));
+  if (sc.container->axial_period() > 0.0)
+    throw InputError(fmt::format("mesh.pieces = {} on a periodic section; allowed: 0 or 1", n));
+  if (sc.wants("stl") || sc.wants("mesh"))
+    throw InputError(fmt::format("mesh.pieces = {} with outputs.files \"stl\" or \"mesh\": in pieces there is no whole "
+                                 "surface or mesh to write; allowed: outputs.files without them, or mesh.pieces = 0",
+                                 n));
+  if (sc.case_params.snappy)
+    throw InputError(fmt::format("mesh.pieces = {} with case.mesher = \"snappy\" (or case.snappy): the pieces are "
+                                 "gmsh's cells; allowed: case.mesher = \"gmsh\"",
+                                 n));
+  if (sc.case_params.convergence.levels > 0)
+    throw InputError(fmt::format("mesh.pieces = {} with case.convergence.levels = {}: a study's levels in pieces are not "
+                                 "made yet; allowed: case.convergence.levels = 0, or mesh.pieces = 0",
+                                 n, sc.case_params.convergence.levels));
+}
+
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
 // periodic planes, no treated contact crossing them, one piece.
 void check_periodic_surface(const Scene& sc) {
@@ -219,6 +246,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
+  if (sc.mesh.pieces > 1) check_pieces(sc);
 #endif
   mesh.finish();
   case_section.finish();

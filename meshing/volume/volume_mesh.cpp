@@ -38,6 +38,7 @@ VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
   p.max_optimize_passes = static_cast<int>(s.integer("max_optimize_passes", p.max_optimize_passes, 1, 20));
   p.threads = static_cast<int>(s.integer("threads", p.threads, 0, 1024));
   p.slabs = static_cast<int>(s.integer("slabs", p.slabs, 0, 64));
+  p.pieces = static_cast<int>(s.integer("pieces", p.pieces, 0, 4096));
   SceneSection g = s.sub("gate");
   p.gate.max_non_orthogonality_deg =
       g.number("max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg, Range::open(0.0, 90.0));
@@ -58,6 +59,7 @@ nlohmann::json to_json(const VolumeMeshParams& p) {
           {"max_optimize_passes", p.max_optimize_passes},
           {"threads", p.threads},
           {"slabs", p.slabs},
+          {"pieces", p.pieces},
           {"gate",
            {{"max_non_orthogonality_deg", p.gate.max_non_orthogonality_deg},
             {"max_skewness", p.gate.max_skewness},

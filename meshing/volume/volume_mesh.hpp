@@ -35,6 +35,9 @@ struct VolumeMeshParams {
   // Axial slabs meshed one at a time and joined (meshing/volume/slab_mesh.hpp), so that gmsh's memory
   // follows a slab, not the bed: 0 chooses (slab_count), 1 meshes in one piece.
   int slabs = 0;
+  // The case written in this many axial pieces, one Open MPI rank each (bedforge piece), and run
+  // on as many processes without decomposePar; no process holds the whole mesh. 0 or 1: one piece.
+  int pieces = 0;
   QualityGate gate;
   PrismLayerParams layers;               // [mesh.layers]; none by default
 };

@@ -28,15 +28,17 @@ bool have_openfoam() { return shell("command -v simpleFoam && command -v mpirun"
 const char* kScene =
     "[container]\ntype = \"cylinder\"\ndiameter_d = 4.0\n[particles]\ncount = 60\ndiameter_m = 0.003\n"
     "[packing]\nseed = 2\n[contacts]\ntreatment = \"shrink\"\n[surface]\nedge_length_d = 0.2\n"
-    "[mesh]\nslabs = 2\n[case.convergence]\nlevels = 0\n[outputs]\nfiles = [\"positions\", \"case\"]\n"
+    "[case.convergence]\nlevels = 0\n[outputs]\nfiles = [\"positions\", \"case\"]\n"
     "[case]\nprocessors = 2\n";
 
-// `bedforge run` of kScene, the case solved or only written, on `cells`, into a fresh directory `name`.
-fs::path run(const std::string& name, bool solve, const std::string& cells = "polyhedra") {
+// `bedforge run` of kScene, the case solved or only written, on `cells`, with `mesh` the [mesh]
+// section (slabs joined by default), into a fresh directory `name`.
+fs::path run(const std::string& name, bool solve, const std::string& cells = "polyhedra",
+             const std::string& mesh = "[mesh]\nslabs = 2\n") {
   const fs::path dir = fresh_dir(name), scene = fresh_dir(name + "_scene");
   fs::create_directories(scene);
   std::ofstream(scene / "s.toml") << kScene << (solve ? "run = true\n" : "run = false\n") << "cells = \"" << cells
-                                  << "\"\n";
+                                  << "\"\n" << mesh;
   const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
   EXPECT_EQ(r.status, 0) << r.output;
   return dir;
@@ -54,7 +56,7 @@ const std::string kOpenFoam =
 
 }  // namespace
 
-TEST(PieceStage, TwoRanksWriteACaseThatRunsInParallelWithThePressureDropOfTheJoinedSlabs) {
+TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam, mpirun) not on PATH";
   // The same slabs joined into one mesh, solved on two processes through decomposePar.
   const fs::path joined = run("piece_joined", true);
@@ -62,10 +64,11 @@ TEST(PieceStage, TwoRanksWriteACaseThatRunsInParallelWithThePressureDropOfTheJoi
   const double joined_gradient = report["stages"]["case"]["flow"]["pressure_gradient_bed_pa_m"].get<double>();
   const long joined_cells = report["stages"]["case"]["cells"].get<long>();
 
-  // The case written, then its pieces, one per rank.
-  const fs::path dir = run("piece_pieces", false);
-  const Result pieces = shell(kOpenFoam + "mpirun -np 2 " + BEDFORGE_BINARY + " --quiet piece " + dir.string());
-  ASSERT_EQ(pieces.status, 0) << pieces.output;
+  // mesh.pieces = 2: the run writes the case, two ranks its pieces, and Allrun solves them.
+  const fs::path dir = run("piece_pieces", true, "polyhedra", "[mesh]\npieces = 2\n");
+  const auto pieces_report = nlohmann::json::parse(read(dir / "report.json"));
+  const auto& c = pieces_report["stages"]["case"];
+  EXPECT_FALSE(pieces_report["stages"].contains("mesh")) << "no whole mesh is made";
   long cells = 0, plane_faces = 0;
   for (int k = 0; k < 2; ++k) {
     const auto r = nlohmann::json::parse(read(dir / fmt::format("case/processor{}/bedforge_piece.json", k)));
@@ -73,6 +76,7 @@ TEST(PieceStage, TwoRanksWriteACaseThatRunsInParallelWithThePressureDropOfTheJoi
     cells += r["cells"].get<long>();
     EXPECT_TRUE(fs::exists(dir / fmt::format("case/processor{}/0/U", k)));
   }
+  EXPECT_EQ(c["cells"].get<long>(), cells);
   // Each piece names its neighbour across the plane, with as many faces on either side.
   for (int k = 0; k < 2; ++k) {
     const std::string boundary = read(dir / fmt::format("case/processor{}/constant/polyMesh/boundary", k));
@@ -83,20 +87,22 @@ TEST(PieceStage, TwoRanksWriteACaseThatRunsInParallelWithThePressureDropOfTheJoi
     if (k == 0) plane_faces = faces;
     EXPECT_EQ(faces, plane_faces);
   }
-  // The dual cells of the points on the plane are cut in two: a few more cells, no fewer.
-  EXPECT_GT(cells, joined_cells);
-  EXPECT_LE(cells, joined_cells + plane_faces);
+  // The dual cells of the points on the plane are cut in two: a few more cells than joined
+  // (gmsh's threads make a few hundred more or fewer on each run: 0.3 % of them allowed).
+  EXPECT_GT(cells, joined_cells - joined_cells * 3 / 1000);
+  EXPECT_LE(cells, joined_cells + plane_faces + joined_cells * 3 / 1000);
 
-  // Allrun sees the pieces: parallel checkMesh and simpleFoam on 2 processes, no decomposePar.
-  const Result allrun = shell(kOpenFoam + (dir / "case/Allrun").string());
-  ASSERT_EQ(allrun.status, 0) << allrun.output << read(dir / "case/log.checkMesh");
+  // Solved on the pieces as they are: parallel checkMesh and simpleFoam, no decomposePar.
   EXPECT_FALSE(fs::exists(dir / "case/log.decomposePar"));
   EXPECT_NE(read(dir / "case/log.checkMesh").find(fmt::format("cells:            {}", cells)), std::string::npos);
-  EXPECT_NE(read(dir / "case/log.simpleFoam").find("SIMPLE solution converged"), std::string::npos);
+  EXPECT_TRUE(c["flow"]["converged"].get<bool>()) << c["flow"].dump();
+  EXPECT_EQ(c["flow"]["mesh"]["cells"].get<long>(), cells);
   // Issue 58's rule for the pieces against the one-piece route at the same settings: dp/L within
   // 0.5 % (the cells differ only at the planes between pieces).
-  const double gradient = said_gradient(allrun.output);
-  EXPECT_NEAR(gradient, joined_gradient, 0.005 * joined_gradient) << allrun.output;
+  const double gradient = c["flow"]["pressure_gradient_bed_pa_m"].get<double>();
+  EXPECT_NEAR(gradient, joined_gradient, 0.005 * joined_gradient);
+  EXPECT_NE(said_gradient(read(dir / "case/log.Allrun")), 0.0);
+  EXPECT_NEAR(said_gradient(read(dir / "case/log.Allrun")), gradient, 1e-5 * gradient);
 }
 
 TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
@@ -144,4 +150,20 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
+  // A scene asking for pieces the route cannot make is refused when read, naming mesh.pieces:
+  // the default scene's bridges, then with shrink its convergence study.
+  std::string scene = read(fs::path(BEDFORGE_SOURCE_DIR) / "scenes/default.toml");
+  scene.replace(scene.find("algorithm = \"hxt\""), 17, "algorithm = \"hxt\"\npieces = 2");
+  for (const std::string said : {"contacts.treatment and contacts.wall_treatment", "case.convergence.levels = 3"}) {
+    const fs::path out = fresh_dir("piece_refused_run"), file = fresh_dir("piece_refused_scene");
+    fs::create_directories(file);
+    std::ofstream(file / "s.toml") << scene;
+    r = bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("mesh.pieces = 2"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(said), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out / "bed.csv"));
+    if (const auto at = scene.find("treatment = \"bridge\""); at != std::string::npos)
+      scene.replace(at, 20, "treatment = \"shrink\"");
+  }
 }
