@@ -38,13 +38,16 @@ namespace {
 // the report the earlier stages left.
 struct Directory {
   Bed bed;
+  nlohmann::json bed_header;  // bed.csv's {"version", "seed", "scene"}
   toml::table scene;
   Report report;
 };
 
 Directory open_directory(const fs::path& dir, const std::vector<Override>& overrides) {
   Directory d;
-  d.bed = read_bed_text(dir / "bed.csv", 1.0).bed;
+  ImportedBed read = read_bed_text(dir / "bed.csv", 1.0);
+  d.bed = std::move(read.bed);
+  d.bed_header = std::move(read.header);
   if (!d.bed.container)
     throw InputError(fmt::format("{}: the header names no container; write the bed with `bedforge import`",
                                  (dir / "bed.csv").string()));
@@ -141,9 +144,11 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const meshing::SurfaceParams surface = read_surface_sections(d.scene);
   const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
-  const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
-  const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", prov.version,
-                                       prov.seed ? std::to_string(*prov.seed) : "none", piece, pieces);
+  // The seed from bed.csv: a run starts its ranks before it writes report.json.
+  const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());
+  const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", kVersion,
+                                       seed.is_number() ? std::to_string(seed.get<unsigned long long>()) : "none",
+                                       piece, pieces);
   const nlohmann::json r = piece_stage(d.bed, surface, mesh, params, piece, pieces, dir / "case", note, console);
   console.line(fmt::format("piece {} of {}: {} cells in {}", piece, pieces, r["cells"].get<long>(),
                            (dir / "case" / fmt::format("processor{}", piece)).string()));

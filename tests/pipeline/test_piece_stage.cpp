@@ -86,6 +86,8 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
     const long faces = std::stol(boundary.substr(boundary.find_first_of("0123456789", n)));
     if (k == 0) plane_faces = faces;
     EXPECT_EQ(faces, plane_faces);
+    // Its files record the bed's seed (the scene's 2) and which piece it is.
+    EXPECT_NE(boundary.find(fmt::format("seed 2, piece {} of 2", k)), std::string::npos) << boundary;
   }
   // The dual cells of the points on the plane are cut in two: a few more cells than joined
   // (gmsh's threads make a few hundred more or fewer on each run: 0.3 % of them allowed).
