@@ -102,9 +102,13 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
       std::string line, said;
       while (std::getline(in, line))
         if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
-      throw std::runtime_error(fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
+      // Stopped as the rank stopped: bad input, a gate not passed, or a defect.
+      const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
                                            self.filename().string(), said.empty() ? "no rank said why" : said,
-                                           log.string()));
+                                           log.string());
+      if (said.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
+      if (said.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
+      throw std::runtime_error(what);
     }
     long cells = 0;
     double fluid = 0.0, in_section = 0.0;

@@ -33,7 +33,8 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
 // The pieces of the case a run writes (case_stage with CasePieces): `pieces` ranks started as
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
-// case/log.pieces; when a rank fails, std::runtime_error with its message. Set
+// case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
+// one (std::runtime_error otherwise). Set
 // OMPI_MCA_rmaps_base_oversubscribe=1 for more ranks than cores.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console);

@@ -80,6 +80,7 @@ stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stag
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
 """
 import argparse
+import glob
 import json
 import math
 import os
@@ -99,7 +100,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice"]
+            "periodic_slice", "pieces"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -672,6 +673,105 @@ def periodic_target_lines(v):
             "least 1.5.", "", *lines, ""]
 
 
+def pieces_scene(count, solve):
+    """scenes/default.toml (a = 5, N = 500, seed 1) with shrink, one mesh, and the case in `count`
+    pieces (0: one piece), solved when `solve`."""
+    text = default_scene_with(1, "shrink")
+    for pattern, replacement in [(r"^levels = \d+", "levels = 0"), (r'^algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'),
+                                 (r"^run = true", f"run = {'true' if solve else 'false'}")]:
+        text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
+        if n != 1:
+            raise SystemExit(f"scenes/default.toml: no line matches {pattern}; update pieces_scene")
+    return text
+
+
+def pieces(tmp, ranks):
+    """Issue 58 on one machine: the default bed with shrink in one piece (mesh stage, then the case
+    stage's dual and the solve), then in P pieces on P ranks (`[mesh] pieces = P`, mpirun oversubscribed
+    where P exceeds the cores): each rank's peak and time, the run's wall time, dp/L on 2 ranks
+    against one piece's. P = 1 is one rank's piece of the one-piece run's case (`bedforge piece`)."""
+    env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
+    rows = []
+    for p in [0] + ranks:
+        path = os.path.join(tmp, f"pieces_{p}")
+        open(path + ".toml", "w").write(pieces_scene(p if p > 1 else 0, p in (0, 2)))
+        t0 = time.time()
+        out = subprocess.run([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"], capture_output=True,
+                             text=True, env=env)
+        if out.returncode != 0:
+            raise RuntimeError(f"bedforge run {path}.toml failed:\n{out.stdout}\n{out.stderr}")
+        wall = time.time() - t0
+        rep = json.load(open(os.path.join(path, "report.json")))
+        case = rep["stages"]["case"]
+        row = {"pieces": p, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
+               "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
+        if "flow" in case:
+            row["dp_pa_m"] = case["flow"]["pressure_gradient_bed_pa_m"]
+            row["solve_s"] = case["flow"]["time_s"]
+            row["solver_peak_mb"] = case["flow"]["solver_peak_memory_mb"]
+        if p == 1:  # one rank's piece of the one-piece run's case
+            for old in glob.glob(os.path.join(path, "case", "processor*")):
+                shutil.rmtree(old)
+            t0 = time.time()
+            subprocess.run(["mpirun", "-np", "1", BEDFORGE, "--quiet", "--no-progress", "piece", path], check=True,
+                           capture_output=True, env=dict(env, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1"))
+            row["wall_s"] = time.time() - t0
+        if p >= 1:
+            row["ranks"] = []
+            for k in range(p):
+                r = json.load(open(os.path.join(path, "case", f"processor{k}", "bedforge_piece.json")))
+                row["ranks"].append({"cells": r["cells"], "peak_mb": r["peak_memory_mb"], "time_s": r["time_s"],
+                                     "scope": r["peak_memory_scope"]})
+            row["cells"] = sum(r["cells"] for r in row["ranks"])
+            if p > 1:  # Allrun's checkMesh when solved, else one run here
+                case_dir = os.path.join(path, "case")
+                log = open(os.path.join(case_dir, "log.checkMesh")).read() if "flow" in case else subprocess.run(
+                    ["mpirun", "-np", str(p), "checkMesh", "-parallel", "-case", case_dir], capture_output=True, text=True,
+                    env=dict(env, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")).stdout
+                row["check_mesh_ok"] = "Mesh OK." in log
+                row["check_mesh_failed"] = re.findall(r"^\s*\*\*\*(.*)$", log, re.M)
+        rows.append({**commit_and_date(), **row})
+    return rows
+
+
+def pieces_lines(rows):
+    """Issue 58's section: one piece against P pieces on P ranks, and its targets as far as measured."""
+    one = next(r for r in rows if r["pieces"] == 0)
+    mesh_peak = one["stage_peak_mb"].get("mesh", 0.0)
+    lines = ["## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = 500, seed 1, 0.15 d, "
+             "4 cells per gap) with contacts shrunk (the pieces' planes cannot cut bridges yet), one mesh. *One "
+             "piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. *P pieces*: "
+             "`[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each rank meshing "
+             "its slab, making its dual and writing `processorK`; P = 1 is one rank's piece of the one-piece run's "
+             "case. Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up. dp/L on 2 ranks "
+             "(solved in pieces, no decomposePar) against one piece's.", "",
+             "| route | polyhedra | largest rank's peak (MB) | x 1/P of P = 1 | ranks' time (s) | run's wall time (s) | "
+             "checkMesh | dp/L (Pa/m) |",
+             "|---|---|---|---|---|---|---|---|"]
+    single = next((r for r in rows if r["pieces"] == 1), None)
+    lines.append(f"| one piece | {one['cells']} | {mesh_peak:.0f} (mesh stage), {one['stage_peak_mb'].get('case', 0):.0f} "
+                 f"(case stage) | | | {one['wall_s']:.0f} | | {one.get('dp_pa_m', float('nan')):.4g} |")
+    for r in rows:
+        if r["pieces"] < 1:
+            continue
+        peak = max(k["peak_mb"] for k in r["ranks"])
+        scaled = f"{peak / (single_peak(single) / r['pieces']):.2f}" if single else ""
+        times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
+        check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
+        dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if "dp_pa_m" in r else ""
+        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak:.0f} | {scaled} | "
+                     f"{times} | {r['wall_s']:.0f} | {check} | {dp} |")
+    lines += ["", "Issue 58's targets as far as this bed goes: dp/L within 0.5 % of one piece's at the same settings; the "
+              "largest rank's peak within 20 % of 1/P (the column x 1/P between 0.8 and 1.2). Its bed (a = 14, N = 1e4, "
+              "bridges) waits for planes that cut bridges (issue 56).", ""]
+    return lines
+
+
+def single_peak(row):
+    return max(k["peak_mb"] for k in row["ranks"])
+
+
 def stamp(rows):
     """The line that says which code made a section: its commit and date, or that it predates them."""
     return [made_line(rows, "Made before this script recorded commits and dates, on gmsh's tetrahedra (before 3d88d5a "
@@ -1124,6 +1224,8 @@ def write(results):
         plot_verification(v, "verification_periodic.png", "periodic sections (cyclic)", "exact", "")
     if "periodic_slice" in results:
         lines += slice_lines(results["periodic_slice"])
+    if "pieces" in results:
+        lines += pieces_lines(results["pieces"])
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -1230,6 +1332,7 @@ def main():
     ap.add_argument("--slices", type=int, default=3, help="periodic_slice: slices that reach their period")
     ap.add_argument("--slice-full-exclude", type=float, default=2.0,
                     help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
+    ap.add_argument("--pieces-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces: ranks (pieces) to run")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -1299,6 +1402,9 @@ def main():
         if "periodic_slice" in args.only:
             results["periodic_slice"] = periodic_slice(tmp, args.slice_full_seeds, args.slice_period, args.slice_count,
                                                        args.slices, args.slice_full_exclude)
+            write(results)
+        if "pieces" in args.only:
+            results["pieces"] = pieces(tmp, args.pieces_ranks)
             write(results)
 
 
