@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <numeric>
+#include <optional>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -13,10 +16,49 @@
 #include "core/error.hpp"
 #include "core/stage_meter.hpp"
 #include "meshing/volume/dual_mesh.hpp"
+#include "meshing/volume/dual_pieces.hpp"
 #include "meshing/volume/processor_patches.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 
 namespace bedforge::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Where piece `piece` leaves its tetrahedra next to its plane `plane` ("inlet" or "outlet") for
+// the piece across it (meshing/volume/dual_pieces.hpp).
+fs::path layer_path(const fs::path& case_dir, int piece, const std::string& plane) {
+  return case_dir / "piece_layers" / fmt::format("piece{}_{}.bin", piece, plane);
+}
+
+// Open MPI's job when this process is one of `pieces` ranks started together, "" otherwise: the
+// ranks of one job wait for each other's layers, and never take an earlier job's.
+std::string mpi_job(int pieces) {
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  const char* job = std::getenv("OMPI_MCA_ess_base_jobid");
+  return size && job && std::to_string(pieces) == size ? job : "";
+}
+
+// The layer piece `neighbour` wrote at `path`: in a job, waited for until the job's own is
+// there (a rank that fails ends the job, so the wait ends too); outside one, as it is.
+meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const std::string& job, Progress& progress) {
+  if (job.empty()) return meshing::read_plane_layer(path);
+  progress.update(fmt::format("waiting for piece {}'s cells next to this one", neighbour));
+  std::optional<fs::file_time_type> seen;
+  for (;;) {
+    std::error_code ec;
+    const fs::file_time_type at = fs::last_write_time(path, ec);
+    if (!ec && at != seen) {
+      seen = at;
+      meshing::PlaneLayer layer = meshing::read_plane_layer(path);
+      if (layer.tag == job) return layer;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
+}  // namespace
 
 nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, int piece, int pieces,
@@ -33,6 +75,15 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
                                  "mesh.layers.count = 0",
                                  meshing::treatment_name(surface.treatment),
                                  meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
+  // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them.
+  const std::string job = mpi_job(pieces);
+  if (case_params.polyhedra && job.empty())
+    for (const auto& [neighbour, plane] : {std::pair{piece - 1, "outlet"}, std::pair{piece + 1, "inlet"}})
+      if (neighbour >= 0 && neighbour < pieces && !fs::exists(layer_path(case_dir, neighbour, plane)))
+        throw InputError(fmt::format("{}: piece {}'s cells next to piece {} are not there; allowed: the pieces of a "
+                                     "case on polyhedra made together (`mpirun -np {} bedforge piece DIR`, or "
+                                     "`bedforge run` with mesh.pieces = {}), or case.cells = \"tetrahedra\"",
+                                     layer_path(case_dir, neighbour, plane).string(), neighbour, piece, pieces, pieces));
   const double d = reference_diameter(bed);
   Progress progress("piece", console.progress);
   progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
@@ -54,12 +105,31 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
                            {"fluid_volume_m3", fluid},
                            {"section_fluid_volume_m3", in_section},
                            {"section_z_m", {section.z_low, section.z_high}}};
-  progress.update(fmt::format("piece {} of {}: {} cells written", piece + 1, pieces, slab.mesh.cells));
   if (case_params.polyhedra) {
-    meshing::PolyhedralMesh dual = meshing::dual_mesh(slab.mesh, cells.centres, cases::kDualFeatureAngleDeg);
+    // Whole dual cells across the planes: each neighbour's tetrahedra next to the plane shared
+    // with it, written by its rank as this rank writes its own (dual_pieces.hpp).
+    for (const auto& [plane, shared] : {std::pair{"inlet", piece > 0}, std::pair{"outlet", piece + 1 < pieces}})
+      if (shared) {
+        meshing::PlaneLayer layer = meshing::plane_layer(slab.mesh, plane);
+        layer.tag = job;
+        meshing::write_plane_layer(layer_path(case_dir, piece, plane), layer);
+      }
+    std::optional<meshing::PlaneLayer> below, above;
+    if (piece > 0) below = neighbour_layer(layer_path(case_dir, piece - 1, "outlet"), piece - 1, job, progress);
+    if (piece + 1 < pieces) above = neighbour_layer(layer_path(case_dir, piece + 1, "inlet"), piece + 1, job, progress);
+    progress.update(fmt::format("piece {} of {}: polyhedra", piece + 1, pieces));
+    meshing::SlabWithLayers whole =
+        meshing::slab_with_layers(slab.mesh, below ? &*below : nullptr, above ? &*above : nullptr);
     slab = meshing::VolumeMesh();
+    below.reset(), above.reset();
     release_free_memory();  // the tetrahedra
-    meshing::make_processor_patches(dual, piece, pieces);
+    std::vector<int> cell_points;
+    meshing::PolyhedralMesh dual = meshing::dual_piece(
+        meshing::dual_mesh(whole.mesh, meshing::tetrahedron_centroids(whole.mesh), cases::kDualFeatureAngleDeg,
+                           &cell_points),
+        cell_points, whole.side, piece, pieces);
+    whole = meshing::SlabWithLayers();
+    release_free_memory();
     report["cells"] = dual.cells;
     meter.record(report);
     cases::write_case_piece(case_dir, piece, dual, case_params.binary, note, report);
@@ -69,6 +139,7 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
     meter.record(report);
     cases::write_case_piece(case_dir, piece, slab.mesh, case_params.binary, note, report);
   }
+  progress.update(fmt::format("piece {} of {}: {} cells written", piece + 1, pieces, report["cells"].get<long>()));
   progress.finish();
   return report;
 }
@@ -85,8 +156,8 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
   out.write = [pieces, run_dir, &console](cases::CaseInfo& info) {
-    namespace fs = std::filesystem;
     const fs::path self = fs::read_symlink("/proc/self/exe"), log = info.directory / "log.pieces";
+    fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // an earlier run's
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
     // Open MPI refuses root unless told (containers, CI), as in Allrun.
@@ -110,6 +181,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
       if (said.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
       throw std::runtime_error(what);
     }
+    fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
     long cells = 0;
     double fluid = 0.0, in_section = 0.0;
     for (int k = 0; k < pieces; ++k) {

@@ -13,15 +13,21 @@
 namespace bedforge::pipeline {
 
 // One piece of a decomposed case, the work of one rank: slab `piece` (from 0, bottom up) of
-// `pieces` of the fluid domain of `bed` under `surface` (meshing::mesh_slab with `mesh`), its
-// polyhedral dual when `case_params.polyhedra`, its planes to the neighbouring slabs made
-// processor patches (meshing::make_processor_patches), written as case_dir/processor<piece>
-// (cases::write_case_piece; the case's 0/ must be written). No process holds more than its
-// own slab. Returns the piece's report (also written beside its cells): its cells, its cells'
-// fluid volume (m^3) and the part of it with centres in the bed section (m^3, for the section's
-// void fraction as meshed), the slab's report, time and peak memory.
-// InputError, before any work, when case_dir/0 is not there or the treatments cannot be cut by
-// a plane (meshing::slabs_possible); the errors of mesh_slab otherwise, naming the piece.
+// `pieces` of the fluid domain of `bed` under `surface` (meshing::mesh_slab with `mesh`), written
+// as case_dir/processor<piece> (cases::write_case_piece; the case's 0/ must be written) with
+// processor patches to the neighbouring pieces. On gmsh's cells: the slab's, its planes made
+// processor patches (meshing::make_processor_patches). On their polyhedral dual
+// (`case_params.polyhedra`): whole dual cells across the planes (meshing/volume/dual_pieces.hpp),
+// for which the rank writes its tetrahedra next to each shared plane to
+// case_dir/piece_layers/piece<piece>_<inlet|outlet>.bin and reads its neighbours'; ranks of one
+// Open MPI job (OMPI_COMM_WORLD_SIZE = pieces) wait for each other's, a piece made alone takes
+// them as an earlier job left them. No process holds more than its own slab and its neighbours'
+// layers. Returns the piece's report (also written beside its cells): its cells, the fluid
+// volume of its slab's tetrahedra (m^3) and the part of it with centres in the bed section (m^3,
+// for the section's void fraction as meshed), the slab's report, time and peak memory.
+// InputError, before any work, when case_dir/0 is not there, the treatments cannot be cut by a
+// plane (meshing::slabs_possible), or a piece on polyhedra made alone finds no neighbour's layer;
+// the errors of mesh_slab otherwise, naming the piece.
 nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, int piece, int pieces,
                            const std::filesystem::path& case_dir, const std::string& note, const Console& console);
@@ -34,7 +40,8 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
-// one (std::runtime_error otherwise). Set
+// one (std::runtime_error otherwise). The ranks' layers (case/piece_layers) are removed before
+// they start, and once all have succeeded. Set
 // OMPI_MCA_rmaps_base_oversubscribe=1 for more ranks than cores.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console);

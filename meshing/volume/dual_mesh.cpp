@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "core/edge_key.hpp"
+#include "core/point_key.hpp"
 
 namespace bedforge::meshing {
 
@@ -58,7 +59,8 @@ std::string where(const Eigen::Vector3d& x) { return fmt::format("({:.6g}, {:.6g
 
 }  // namespace
 
-PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& cell_centres, double feature_angle_deg) {
+PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& cell_centres, double feature_angle_deg,
+                         std::vector<int>* cell_points) {
   const int n_points = static_cast<int>(m.points.size());
   const int n_cells = m.cells;
   const int n_faces = static_cast<int>(m.faces.size());
@@ -152,9 +154,7 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
       continue;
     }
     std::array<Eigen::Vector3d, 3> t{m.points[m.faces[f][0]], m.points[m.faces[f][1]], m.points[m.faces[f][2]]};
-    std::sort(t.begin(), t.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-    });
+    std::sort(t.begin(), t.end(), coordinates_less);
     d.points.push_back(t[0] + ((t[1] - t[0]) + (t[2] - t[0])) / 3.0);
   }
   const int first_boundary_centre = n_cells - n_internal;  // + boundary face index
@@ -278,6 +278,7 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
     d.patches.push_back(patch);
   }
   d.cells = n_points;
+  if (cell_points) *cell_points = std::move(order);
   return d;
 }
 

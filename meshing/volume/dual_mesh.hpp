@@ -20,9 +20,10 @@ namespace bedforge::meshing {
 // becomes, per patch, a face through the centres of its boundary faces, or, at a feature point,
 // one quadrilateral per boundary face (the point, two edge midpoints, the face's centre).
 // Internal faces come in upper-triangular order, boundary faces patch by patch as in `mesh`.
+//   cell_points           when given, set to the point of `mesh` of each dual cell (C' = P)
 // std::runtime_error, with the location, when an edge's cells do not form a ring (a mesh
 // that is not a manifold there).
 PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d>& cell_centres,
-                         double feature_angle_deg);
+                         double feature_angle_deg, std::vector<int>* cell_points = nullptr);
 
 }  // namespace bedforge::meshing

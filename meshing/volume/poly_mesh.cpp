@@ -128,9 +128,24 @@ CellGeometry cell_geometry(const PolyhedralMesh& m) { return cell_geometry_of(m)
 std::vector<Eigen::Vector3d> cell_centres(const PolyMesh& m) { return cell_geometry(m).centres; }
 std::vector<double> cell_volumes(const PolyMesh& m) { return cell_geometry(m).volumes; }
 
+std::vector<VolumeCell> tetrahedra(const PolyMesh& m) {
+  std::vector<VolumeCell> cells(m.cells);
+  auto add_point = [&](int c, int v) {
+    VolumeCell& cell = cells[c];
+    if (cell.n < 4 && std::find(cell.v.begin(), cell.v.begin() + cell.n, v) == cell.v.begin() + cell.n) cell.v[cell.n++] = v;
+  };
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int v : m.faces[f]) {
+      add_point(m.owner[f], v);
+      if (f < m.neighbour.size()) add_point(m.neighbour[f], v);
+    }
+  return cells;
+}
+
 PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& input,
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
-                              const std::vector<std::string>& names, const std::vector<std::string>& types) {
+                              const std::vector<std::string>& names, const std::vector<std::string>& types,
+                              std::vector<int>* point_map) {
   // Cells bottom to top.
   std::vector<int> order(input.size());
   {
@@ -242,6 +257,7 @@ PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::ve
   m.points.resize(n);
   for (std::size_t v = 0; v < points.size(); ++v)
     if (used[v] >= 0) m.points[used[v]] = points[v];
+  if (point_map) *point_map = std::move(used);
   return m;
 }
 

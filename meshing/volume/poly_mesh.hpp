@@ -97,15 +97,23 @@ inline std::vector<int> points_of(const PolyhedralMesh& m, int f) {
 //   boundary    B faces, the domain's boundary
 //   patch       B, index into `names` for each boundary face
 //   names/types patch names and OpenFOAM types, in the order the patches are written
+//   point_map   when given, set to each input point's index in the mesh (P; -1 if no cell uses it)
 // Cells are numbered bottom to top (by centroid z), which keeps the matrix bandwidth small in a
-// column. std::runtime_error when a cell face is on the boundary but in no patch, or a face is
+// column; points in the order the faces first use them. std::runtime_error when a cell face is on the boundary but in no patch, or a face is
 // shared by more than two cells, with its location.
 // OpenFOAM's type of a patch bedforge names: "patch" for inlet and outlet, else "wall".
 std::string patch_type(const std::string& name);
 
 PolyMesh poly_mesh_from_cells(std::vector<Eigen::Vector3d> points, const std::vector<VolumeCell>& cells,
                               const std::vector<Face>& boundary, const std::vector<int>& patch,
-                              const std::vector<std::string>& names, const std::vector<std::string>& types);
+                              const std::vector<std::string>& names, const std::vector<std::string>& types,
+                              std::vector<int>* point_map = nullptr);
+
+// The cells of a mesh of tetrahedra as their points (the inverse of poly_mesh_from_cells), in
+// cell order; each tetrahedron's points in the order its faces first name them.
+//   mesh   tetrahedra only (gmsh's cells without prism layers)
+// Returns C cells of 4 points.
+std::vector<VolumeCell> tetrahedra(const PolyMesh& mesh);
 
 // Face centre and area vector (|S| = area, along the normal) as OpenFOAM computes them
 // (primitiveMeshFaceCentresAndAreas): exact for a triangle; a polygon is split into triangles

@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include "core/point_key.hpp"
+
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <stdexcept>
 #include <utility>
@@ -10,33 +13,36 @@
 
 namespace bedforge::meshing {
 
-namespace {
-
-// Keeps the first `n` faces and appends `face`.
-void truncate_faces(PolyMesh& m, int n) { m.faces.resize(n); }
-void truncate_faces(PolyhedralMesh& m, int n) {
-  m.faces.points.resize(m.faces.offsets[n]);
-  m.faces.offsets.resize(n + 1);
+ProcessorPatch processor_patch(int piece, int neighbour) {
+  ProcessorPatch p;
+  p.patch.name = fmt::format("procBoundary{}to{}", piece, neighbour);
+  p.patch.type = "processor";
+  p.patch.processor = piece;
+  p.patch.neighbour_processor = neighbour;
+  return p;
 }
-void append_face(PolyMesh& m, const std::vector<int>& face) {
-  Face f;
-  f.n = static_cast<int>(face.size());
-  std::copy(face.begin(), face.end(), f.v.begin());
-  m.faces.push_back(f);
+
+void order_processor_faces(const std::vector<Eigen::Vector3d>& points, ProcessorPatch& p) {
+  using Key = std::array<double, 3>;
+  std::vector<std::vector<Key>> keys(p.faces.size());
+  for (std::size_t f = 0; f < p.faces.size(); ++f) {
+    std::vector<int>& face = p.faces[f];
+    std::rotate(face.begin(),
+                std::min_element(face.begin(), face.end(),
+                                 [&](int a, int b) { return coordinates_less(points[a], points[b]); }),
+                face.end());
+    for (int v : face) keys[f].push_back({points[v].x(), points[v].y(), points[v].z()});
+    std::sort(keys[f].begin(), keys[f].end());
+  }
+  std::vector<std::size_t> order(p.faces.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+  ProcessorPatch sorted{p.patch, {}, {}};
+  for (std::size_t f : order) sorted.faces.push_back(std::move(p.faces[f])), sorted.owner.push_back(p.owner[f]);
+  p = std::move(sorted);
 }
-void append_face(PolyhedralMesh& m, const std::vector<int>& face) { m.faces.push_back(face); }
 
-// A boundary patch as it will be written: its faces (points) and their cells.
-struct NewPatch {
-  PolyMesh::Patch patch;
-  std::vector<std::vector<int>> faces;
-  std::vector<int> owner;
-};
-
-}  // namespace
-
-template <class Mesh>
-void make_processor_patches(Mesh& m, int piece, int pieces) {
+void make_processor_patches(PolyMesh& m, int piece, int pieces) {
   if (piece < 0 || piece >= pieces)
     throw std::runtime_error(fmt::format("processor patches: piece {} of {} does not exist", piece, pieces));
   auto index = [&](const std::string& name) {
@@ -45,59 +51,39 @@ void make_processor_patches(Mesh& m, int piece, int pieces) {
     throw std::runtime_error(fmt::format("processor patches: piece {} has no {} patch", piece, name));
   };
   const int inlet = index("inlet"), outlet = index("outlet");
-  using XY = std::pair<double, double>;
-  auto xy = [&](int p) { return XY{m.points[p].x(), m.points[p].y()}; };
-  std::vector<NewPatch> out;
-  NewPatch below, above;
-  for (auto [to, p] : {std::pair{&below, piece - 1}, std::pair{&above, piece + 1}}) {
-    to->patch.name = fmt::format("procBoundary{}to{}", piece, p);
-    to->patch.type = "processor";
-    to->patch.processor = piece;
-    to->patch.neighbour_processor = p;
-  }
+  std::vector<ProcessorPatch> out;
+  ProcessorPatch below = processor_patch(piece, piece - 1), above = processor_patch(piece, piece + 1);
   for (int k = 0; k < static_cast<int>(m.patches.size()); ++k) {
-    NewPatch kept{m.patches[k], {}, {}};
-    NewPatch& to = k == inlet && piece > 0 ? below : k == outlet && piece + 1 < pieces ? above : kept;
+    ProcessorPatch kept{m.patches[k], {}, {}};
+    ProcessorPatch& to = k == inlet && piece > 0 ? below : k == outlet && piece + 1 < pieces ? above : kept;
     for (int f = m.patches[k].start; f < m.patches[k].start + m.patches[k].size; ++f) {
       to.faces.push_back(points_of(m, f));
       to.owner.push_back(m.owner[f]);
     }
     out.push_back(std::move(kept));
   }
-  // A shared plane's faces in the order of their points' x and y, each from its least point.
-  for (NewPatch* p : {&below, &above}) {
-    std::vector<std::vector<XY>> keys(p->faces.size());
-    for (std::size_t f = 0; f < p->faces.size(); ++f) {
-      std::vector<int>& face = p->faces[f];
-      const auto least =
-          std::min_element(face.begin(), face.end(), [&](int a, int b) { return xy(a) < xy(b); });
-      std::rotate(face.begin(), least, face.end());
-      for (int v : face) keys[f].push_back(xy(v));
-      std::sort(keys[f].begin(), keys[f].end());
-    }
-    std::vector<std::size_t> order(p->faces.size());
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
-    NewPatch sorted{p->patch, {}, {}};
-    for (std::size_t f : order) sorted.faces.push_back(std::move(p->faces[f])), sorted.owner.push_back(p->owner[f]);
-    *p = std::move(sorted);
-  }
+  // A shared plane's faces alike on both sides (on the plane, by x and y).
+  order_processor_faces(m.points, below);
+  order_processor_faces(m.points, above);
   if (piece > 0) out.push_back(std::move(below));
   if (piece + 1 < pieces) out.push_back(std::move(above));
   // The boundary written anew, patch after patch.
   const int internal = m.internal_faces();
-  truncate_faces(m, internal);
+  m.faces.resize(internal);
   m.owner.resize(internal);
   m.patches.clear();
-  for (NewPatch& p : out) {
+  for (ProcessorPatch& p : out) {
     p.patch.start = static_cast<int>(m.owner.size());
     p.patch.size = static_cast<int>(p.faces.size());
-    for (std::size_t f = 0; f < p.faces.size(); ++f) append_face(m, p.faces[f]), m.owner.push_back(p.owner[f]);
+    for (std::size_t f = 0; f < p.faces.size(); ++f) {
+      Face face;
+      face.n = static_cast<int>(p.faces[f].size());
+      std::copy(p.faces[f].begin(), p.faces[f].end(), face.v.begin());
+      m.faces.push_back(face);
+      m.owner.push_back(p.owner[f]);
+    }
     m.patches.push_back(p.patch);
   }
 }
-
-template void make_processor_patches(PolyMesh&, int, int);
-template void make_processor_patches(PolyhedralMesh&, int, int);
 
 }  // namespace bedforge::meshing

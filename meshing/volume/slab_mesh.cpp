@@ -11,29 +11,12 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/point_key.hpp"
 #include "core/stage_meter.hpp"
 
 namespace bedforge::meshing {
 
 namespace {
-
-// A point's exact coordinates as a hash key: the points of a shared plane are the same doubles
-// on both sides (the surface stage rounds every point to 12 digits).
-struct PointKey {
-  double x, y, z;
-  bool operator==(const PointKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-struct PointKeyHash {
-  std::size_t operator()(const PointKey& k) const {
-    std::uint64_t h = 1469598103934665603ull;
-    for (double c : {k.x, k.y, k.z}) {
-      std::uint64_t b;
-      std::memcpy(&b, &c, sizeof b);
-      h = (h ^ b) * 1099511628211ull;
-    }
-    return h;
-  }
-};
 
 // A triangle by its sorted point indices.
 std::array<int, 3> sorted_triangle(const Face& f) {
@@ -78,7 +61,7 @@ struct Joined {
     Eigen::Vector3d unmatched_at = Eigen::Vector3d::Zero();
     for (std::size_t v = 0; v < m.points.size(); ++v) {
       const Eigen::Vector3d& x = m.points[v];
-      const PointKey key{x.x(), x.y(), x.z()};
+      const PointKey key(x);
       if (!first && on_inlet[v]) {
         const auto it = top_points.find(key);
         if (it == top_points.end()) {
@@ -128,16 +111,9 @@ struct Joined {
     top_points = std::move(next_top);
     top_faces = std::move(next_top_faces);
     // Cells: a tetrahedron's points are those of its faces (the slabs have no prism layers).
-    std::vector<VolumeCell> slab_cells(m.cells);
-    auto add_point = [&](int c, int v) {
-      VolumeCell& cell = slab_cells[c];
-      if (std::find(cell.v.begin(), cell.v.begin() + cell.n, v) == cell.v.begin() + cell.n) cell.v[cell.n++] = v;
-    };
-    for (std::size_t f = 0; f < m.faces.size(); ++f)
-      for (int v : m.faces[f]) {
-        if (slab_cells[m.owner[f]].n < 4) add_point(m.owner[f], global[v]);
-        if (f < m.neighbour.size() && slab_cells[m.neighbour[f]].n < 4) add_point(m.neighbour[f], global[v]);
-      }
+    std::vector<VolumeCell> slab_cells = tetrahedra(m);
+    for (VolumeCell& c : slab_cells)
+      for (int j = 0; j < c.n; ++j) c.v[j] = global[c.v[j]];
     cells.insert(cells.end(), slab_cells.begin(), slab_cells.end());
   }
 

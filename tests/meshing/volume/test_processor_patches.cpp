@@ -1,7 +1,7 @@
-// Processor patches: two slabs of a bed, meshed each on its own and turned into their polyhedral
-// duals, order their shared plane's faces alike without seeing each other: face k on one side
-// is face k on the other, the same points (bit for bit) from the same 0th point, in reverse
-// order, as decomposePar writes a neighbour's copy. Every piece lists the same patches first.
+// Processor patches: slabs of a bed, meshed each on its own (gmsh's tetrahedra), order their
+// shared plane's faces alike without seeing each other: face k on one side is face k on the
+// other, the same points (bit for bit) from the same 0th point, in reverse order, as
+// decomposePar writes a neighbour's copy. Every piece lists the same patches first.
 #include "meshing/volume/processor_patches.hpp"
 
 #include <gtest/gtest.h>
@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 #include "support/packed_bed.hpp"
 #include "support/temp_dir.hpp"
@@ -19,7 +18,7 @@ using namespace bedforge::meshing;
 
 namespace {
 
-const PolyMesh::Patch& patch(const PolyhedralMesh& m, const std::string& name) {
+const PolyMesh::Patch& patch(const PolyMesh& m, const std::string& name) {
   for (const auto& p : m.patches)
     if (p.name == name) return p;
   throw std::runtime_error("no patch " + name);
@@ -34,11 +33,10 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   VolumeMeshParams p;
   const auto dir = test_support::fresh_dir("processor_patches", true);
   const int pieces = 3;
-  std::vector<PolyhedralMesh> piece;
+  std::vector<PolyMesh> piece;
   std::vector<long> boundary_faces;
   for (int k = 0; k < pieces; ++k) {
-    const VolumeMesh slab = mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk", true);
-    piece.push_back(dual_mesh(slab.mesh, cell_geometry(slab.mesh).centres, 80.0));
+    piece.push_back(mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk", true).mesh);
     long faces = 0;
     for (const auto& q : piece.back().patches) faces += q.size;
     boundary_faces.push_back(faces);
@@ -78,7 +76,7 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   }
   // Each shared plane: face for face, point for point.
   for (int k = 0; k + 1 < pieces; ++k) {
-    const PolyhedralMesh &lower = piece[k], &upper = piece[k + 1];
+    const PolyMesh &lower = piece[k], &upper = piece[k + 1];
     const auto& a = patch(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
     const auto& c = patch(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
     EXPECT_EQ(a.neighbour_processor, k + 1);
@@ -101,7 +99,7 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
 }
 
 TEST(ProcessorPatches, RefusesAPieceOutsideTheCount) {
-  PolyhedralMesh m;
+  PolyMesh m;
   EXPECT_THROW(make_processor_patches(m, 2, 2), std::runtime_error);
   EXPECT_THROW(make_processor_patches(m, 0, 2), std::runtime_error);  // no inlet patch
 }
