@@ -515,20 +515,11 @@ namespace {
 template <class Mesh>
 void write_piece(const fs::path& case_dir, int piece, const Mesh& mesh, bool binary, const std::string& note,
                  const nlohmann::json& report) {
-  std::random_device rd;
-  const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
-  const fs::path tmp = case_dir / fmt::format(".processor{}.partial-{:x}", piece, rd());
-  try {
+  write_directory_atomically(case_dir / fmt::format("processor{}", piece), [&](const fs::path& tmp) {
     write_poly_mesh(tmp / "constant/polyMesh", mesh, binary, note);
     fs::copy(case_dir / "0", tmp / "0", fs::copy_options::recursive);
     write_text(tmp / "bedforge_piece.json", report.dump(2) + "\n");
-    fs::remove_all(piece_dir);
-    fs::rename(tmp, piece_dir);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
-  }
+  });
 }
 
 }  // namespace
@@ -542,6 +533,28 @@ void write_case_piece(const fs::path& case_dir, int piece, const meshing::Polyhe
   write_piece(case_dir, piece, mesh, binary, note, report);
 }
 
+fs::path set_pieces_aside(const fs::path& case_dir) {
+  const fs::path aside = case_dir.parent_path() / ("." + case_dir.filename().string() + ".pieces-aside");
+  fs::create_directories(aside);
+  if (fs::is_directory(case_dir))
+    for (const auto& entry : fs::directory_iterator(case_dir)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("processor", 0) == 0 || name == "piece_layers") {
+        fs::remove_all(aside / name);
+        fs::rename(entry.path(), aside / name);
+      }
+    }
+  return aside;
+}
+
+void put_pieces_back(const fs::path& aside, const fs::path& case_dir, int pieces) {
+  for (int k = 0; k < pieces; ++k)
+    if (const fs::path from = aside / fmt::format("processor{}", k); fs::exists(from))
+      fs::rename(from, case_dir / from.filename());
+  if (fs::exists(aside / "piece_layers")) fs::rename(aside / "piece_layers", case_dir / "piece_layers");
+  fs::remove_all(aside);  // pieces beyond the count
+}
+
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,
@@ -549,8 +562,6 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
   if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
-  std::random_device rd;
-  const fs::path tmp = case_dir.parent_path() / fmt::format(".{}.partial-{:x}", case_dir.filename().string(), rd());
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
   const std::optional<meshing::CellGeometry> geometry =
@@ -570,7 +581,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     ubar = u * g.cross_section_area * (g.outlet_z - g.inlet_z) / *fluid_volume;
   }
   long cells = mesh ? mesh->cells : 0;  // as written
-  try {
+  write_directory_atomically(case_dir, [&](const fs::path& tmp) {
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
     if (mesh && p.polyhedra && !p.snappy_cells) {
@@ -594,13 +605,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     write_text(tmp / "bedforge/scene.toml", scene_toml);
     write_text(tmp / "bedforge/bed.csv", bed_csv);
     if (p.snappy) write_snappy_setup(tmp, p, g, bed, patches, fluid_stl, note);
-    fs::remove_all(case_dir);  // the old case goes only once the new one is complete
-    fs::rename(tmp, case_dir);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
-  }
+  });  // the old case goes only once the new one is complete
   CaseInfo info{case_dir, p, u, nu, cells, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;

@@ -100,6 +100,12 @@ CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const
                     const CaseParams& p, const std::string& note, const std::string& scene_toml,
                     const std::string& bed_csv, const std::filesystem::path& fluid_stl, bool spheres_as_packed);
 
+// The pieces an earlier run of a case left (processor*/ and piece_layers/) moved out of
+// case_dir while the case is written anew (returns where to), and put back after it, those of
+// the first `pieces` (pipeline/piece_stage.hpp keeps what was made from the same inputs).
+std::filesystem::path set_pieces_aside(const std::filesystem::path& case_dir);
+void put_pieces_back(const std::filesystem::path& aside, const std::filesystem::path& case_dir, int pieces);
+
 // One piece of a decomposed case (meshing/volume/processor_patches.hpp), as decomposePar would
 // have written it: `mesh` into case_dir/processor<piece>/constant/polyMesh, the case's 0/ fields
 // copied beside it (their boundaries take the processor patches from setConstraintTypes), and

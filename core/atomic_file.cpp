@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -31,6 +32,20 @@ void write_file_atomically(const fs::path& path, const std::function<void(std::o
   if (ec) {
     fs::remove(tmp);
     throw InputError(fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), path.string(), ec.message()));
+  }
+}
+
+void write_directory_atomically(const fs::path& dir, const std::function<void(const fs::path&)>& write) {
+  std::random_device rd;
+  const fs::path tmp = dir.parent_path() / fmt::format(".{}.partial-{:x}", dir.filename().string(), rd());
+  try {
+    write(tmp);
+    fs::remove_all(dir);
+    fs::rename(tmp, dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
   }
 }
 

@@ -13,6 +13,12 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 // The same, with the contents streamed by `write` (large files never held in memory whole).
 void write_file_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
 
+// A directory built whole by `write` (given a temporary sibling of `dir` to fill), then put in
+// place of `dir` (any old one removed only then); on any exception the temporary directory is
+// removed and the exception goes on. So no half-written directory is ever left at `dir`.
+void write_directory_atomically(const std::filesystem::path& dir,
+                                const std::function<void(const std::filesystem::path&)>& write);
+
 // Whole file as a string; InputError naming the path when it cannot be read.
 std::string read_file(const std::filesystem::path& path);
 

@@ -25,9 +25,15 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
              : std::vector<Eigen::Vector3d>{};
   const cases::CaseGeometry g = cases::case_geometry(mesh ? mesh->points : surface ? surface->points : ends, bed);
   CaseStage out;
+  // An earlier run's pieces wait aside while the case is written anew: the ranks keep those made
+  // from the same inputs.
+  const std::filesystem::path aside = pieces ? cases::set_pieces_aside(case_dir) : std::filesystem::path();
   out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
                                fluid_stl, spheres_as_packed);
-  if (pieces) pieces->write(out.info);
+  if (pieces) {
+    cases::put_pieces_back(aside, case_dir, pieces->count);
+    pieces->write(out.info);
+  }
   if (surface) out.info.surface_volume_m3 = meshing::enclosed_volume(*surface);  // what snappyHexMesh's cells should fill
   out.report = out.info.to_json();
   std::string line = pieces ? fmt::format("case: {} {} in {} pieces (one rank each) in {}", out.info.cells,

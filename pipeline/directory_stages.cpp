@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
+
 #include <limits>
 #include <optional>
 #include <string>
@@ -22,6 +24,7 @@
 #include "pipeline/convergence_study.hpp"
 #include "pipeline/mesh_stage.hpp"
 #include "pipeline/piece_stage.hpp"
+#include "core/stage_meter.hpp"
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
 #include "meshing/volume/gmsh_model.hpp"
@@ -144,14 +147,22 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const meshing::SurfaceParams surface = read_surface_sections(d.scene);
   const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
+  // Before any meshing: this machine's ranks' pieces must fit in its memory.
+  const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+  refuse_pieces_beyond_memory(estimate_mesh(surface, mesh, params, d.bed), pieces, local ? std::atoi(local) : 1,
+                              available_memory_bytes());
   // The seed from bed.csv: a run starts its ranks before it writes report.json.
   const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());
   const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", kVersion,
                                        seed.is_number() ? std::to_string(seed.get<unsigned long long>()) : "none",
                                        piece, pieces);
-  const nlohmann::json r = piece_stage(d.bed, surface, mesh, params, piece, pieces, dir / "case", note, console);
-  console.line(fmt::format("piece {} of {}: {} cells in {}", piece, pieces, r["cells"].get<long>(),
-                           (dir / "case" / fmt::format("processor{}", piece)).string()));
+  const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface, mesh, params, piece,
+                                       pieces, dir / "case", note, console);
+  console.line(fmt::format("piece {} of {}: {} cells in {}{}", piece, pieces, r["cells"].get<long>(),
+                           (dir / "case" / fmt::format("processor{}", piece)).string(),
+                           r.value("reused", false) || r["slab"].value("reused", false)
+                               ? " (kept from an earlier run made from the same)"
+                               : ""));
 }
 #endif
 

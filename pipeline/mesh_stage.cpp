@@ -58,20 +58,18 @@ constexpr double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
 // docs/findings.md): as much as the mesh stage or more.
 constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 1200.0;
 
-// The cell edge away from the surfaces (m), d the reference diameter.
-double bulk_edge(const Scene& scene, double d) { return std::min(scene.surface.edge_length_d, scene.mesh.max_size_d) * d; }
-
-MeshEstimate with_cells(const Scene& scene, double fluid_volume_m3, double gap_cells, double d) {
-  const double mesh_bytes = meshing::slabs_possible(scene.surface, scene.mesh) && scene.mesh.slabs != 1 ? 300.0 : 460.0;
-  const cases::CaseParams& c = scene.case_params;
+MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                        const cases::CaseParams& c, double fluid_volume_m3, double gap_cells, double d) {
+  const double mesh_bytes = meshing::slabs_possible(surface, mesh) && mesh.slabs != 1 ? 300.0 : 460.0;
   const bool solver = c.run && !c.snappy_cells;
-  const double h = bulk_edge(scene, d);
+  const double h = std::min(surface.edge_length_d, mesh.max_size_d) * d;  // the edge away from the surfaces
   MeshEstimate e;
   e.fluid_volume_m3 = fluid_volume_m3;
   e.gap_cells = gap_cells;
   e.cells = fluid_volume_m3 / (kVolumePerCell * h * h * h) + gap_cells;
+  e.mesh_peak_bytes = e.cells * mesh_bytes;
   const double solver_bytes = c.polyhedra ? kSolverBytesPerCellDual : kSolverBytesPerCellTetrahedra;
-  e.peak_bytes = e.cells * (solver ? solver_bytes : mesh_bytes);
+  e.peak_bytes = solver ? e.cells * solver_bytes : e.mesh_peak_bytes;
   e.peak_in_solver = solver;
   return e;
 }
@@ -117,12 +115,17 @@ MeshEstimate estimate_mesh(const Scene& scene) {
     const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
     fluid = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
   }
-  return with_cells(scene, fluid, 0.0, d);
+  return with_cells(scene.surface, scene.mesh, scene.case_params, fluid, 0.0, d);
+}
+
+MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, const Bed& bed) {
+  const meshing::FluidDomainSize f = meshing::fluid_domain_size(bed, surface, kVolumePerCell);
+  return with_cells(surface, mesh, case_params, f.volume_m3, f.gap_cells, reference_diameter(bed));
 }
 
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {
-  const meshing::FluidDomainSize f = meshing::fluid_domain_size(bed, scene.surface, kVolumePerCell);
-  return with_cells(scene, f.volume_m3, f.gap_cells, reference_diameter(bed));
+  return estimate_mesh(scene.surface, scene.mesh, scene.case_params, bed);
 }
 
 std::string estimate_line(const MeshEstimate& e, double available_bytes) {
@@ -155,6 +158,18 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
       "surface.cells_per_gap = {} with surface.contact_edge_length_d = {}: {}; allowed: surface.cells_per_gap <= about "
       "{:.2g}, surface.contact_edge_length_d >= about {:.2g}, a clip window (surface.clip_window_d){}",
       s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_not_run(e)));
+}
+
+void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes) {
+  const double per_piece = e.mesh_peak_bytes / pieces;
+  if (ranks_here * per_piece <= available_bytes) return;
+  throw InputError(fmt::format(
+      "mesh.pieces = {}: a piece would take at least {:.1f} GB to mesh ({:.3g} million cells of the whole bed shared "
+      "among the pieces, an estimate that errs low), {:.1f} GB for the {} ranks on this machine, which has {:.1f} GB "
+      "available; allowed: mesh.pieces >= {} (with as many ranks, spread over machines), fewer ranks per machine, or "
+      "a longer surface.edge_length_d",
+      pieces, per_piece / 1e9, e.cells / 1e6, ranks_here * per_piece / 1e9, ranks_here, available_bytes / 1e9,
+      static_cast<int>(std::ceil(e.mesh_peak_bytes * ranks_here / available_bytes))));
 }
 
 }  // namespace bedforge::pipeline

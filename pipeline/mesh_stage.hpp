@@ -54,11 +54,14 @@ struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
   double gap_cells = 0.0;  // of `cells`, those the narrow gaps add
   double cells = 0.0;
-  double peak_bytes = 0.0;
-  bool peak_in_solver = false;  // the peak is simpleFoam's (the case is run), not the mesh stage's
+  double mesh_peak_bytes = 0.0;  // the mesh stage's
+  double peak_bytes = 0.0;       // the run's: the mesh stage's, or simpleFoam's when the case is run
+  bool peak_in_solver = false;   // the peak is simpleFoam's (the case is run), not the mesh stage's
 };
 MeshEstimate estimate_mesh(const Scene& scene);
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);
+MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, const Bed& bed);
 // The console's line for `e` against `available_bytes`, and its report entry (stages.mesh.estimate).
 std::string estimate_line(const MeshEstimate& e, double available_bytes);
 nlohmann::json to_json(const MeshEstimate& e);
@@ -69,5 +72,13 @@ void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
 // The same once `bed` is packed, before its surface: naming surface.cells_per_gap when the
 // narrow gaps' cells are what does not fit. Returns the estimate.
 MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes);
+
+// One rank's piece of `pieces` (piece_stage), with `ranks_here` ranks on this machine
+// (OMPI_COMM_WORLD_LOCAL_SIZE): InputError naming mesh.pieces and the count that would fit when
+// the ranks here would need more than `available_bytes` to mesh their pieces, each taking a
+// 1/pieces share of e.mesh_peak_bytes (the pieces are cut to about equal estimated cells). Errs
+// towards trying: one rank with the whole default bed peaked at 4329 MB where its mesh stage
+// took 3060 MB (docs/mesh_case_benchmark.md, pieces).
+void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes);
 
 }  // namespace bedforge::pipeline

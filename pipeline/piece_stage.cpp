@@ -14,6 +14,8 @@
 #include "cases/case_writer.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/report.hpp"
+#include "core/version.hpp"
 #include "core/stage_meter.hpp"
 #include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/dual_pieces.hpp"
@@ -60,9 +62,10 @@ meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const s
 
 }  // namespace
 
-nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                           const cases::CaseParams& case_params, int piece, int pieces,
-                           const std::filesystem::path& case_dir, const std::string& note, const Console& console) {
+nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
+                           const meshing::VolumeMeshParams& mesh, const cases::CaseParams& case_params, int piece,
+                           int pieces, const std::filesystem::path& case_dir, const std::string& note,
+                           const Console& console) {
   const StageMeter meter;
   if (!std::filesystem::is_directory(case_dir / "0"))
     throw InputError(fmt::format("{}: no case to write a piece into (no 0/ fields); write the case first, e.g. "
@@ -86,24 +89,48 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
                                      layer_path(case_dir, neighbour, plane).string(), neighbour, piece, pieces, pieces));
   const double d = reference_diameter(bed);
   Progress progress("piece", console.progress);
-  progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
-  meshing::VolumeMesh slab =
-      meshing::mesh_slab(bed, surface, piece, pieces, d, mesh, case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
-  // The bed section of the whole domain, and the piece's fluid in it.
+  // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
+  // an earlier run made from the same, so only the pieces that failed are meshed again.
+  const std::string cells_key = stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
+                                           {"mesh", meshing::to_json(mesh)}, {"piece", piece}, {"pieces", pieces}});
+  const std::string piece_key = stage_key({{"cells", cells_key}, {"case", cases::to_json(case_params)}});
+  const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
+  if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json")) {
+    nlohmann::json earlier = nlohmann::json::parse(read_file(piece_dir / "bedforge_piece.json"));
+    if (earlier.value("key", "") == piece_key) {
+      earlier["reused"] = true;
+      return earlier;
+    }
+  }
+  // On polyhedra the dual is made again (its neighbours' may be new), from the tetrahedra kept.
+  const fs::path kept = layer_path(case_dir, piece, "tetrahedra");
+  meshing::VolumeMesh slab;
+  if (case_params.polyhedra && fs::exists(kept)) {
+    progress.update(fmt::format("piece {} of {}: an earlier run's cells", piece + 1, pieces));
+    const meshing::PlaneLayer earlier = meshing::read_plane_layer(kept);
+    if (earlier.tag == cells_key) slab.mesh = meshing::slab_of(earlier), slab.report = {{"reused", true}};
+  }
+  if (slab.mesh.cells == 0) {
+    progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
+    slab = meshing::mesh_slab(bed, surface, meshing::slab_planes_d(bed, surface, pieces), piece, d, mesh,
+                              case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
+    if (case_params.polyhedra) {
+      meshing::PlaneLayer all = meshing::whole_slab(slab.mesh);
+      all.tag = cells_key;
+      meshing::write_plane_layer(kept, all);
+    }
+  }
+  // The bed section of the whole domain, and the piece's share of its void fraction as meshed.
   const auto [inlet_z, outlet_z] = domain_heights(bed, surface);
   const cases::CaseGeometry g = cases::case_geometry({Eigen::Vector3d(0, 0, inlet_z), Eigen::Vector3d(0, 0, outlet_z)}, bed);
-  const cases::BedSection section = cases::bed_section(nullptr, g, g.periodic ? 0.0 : case_params.section_exclude_d);
   const meshing::CellGeometry cells = meshing::cell_geometry(slab.mesh);
-  double fluid = 0.0, in_section = 0.0;
-  for (std::size_t c = 0; c < cells.volumes.size(); ++c) {
-    fluid += cells.volumes[c];
-    if (cells.centres[c].z() > section.z_low && cells.centres[c].z() < section.z_high) in_section += cells.volumes[c];
-  }
+  const cases::BedSection section = cases::bed_section(&cells, g, case_params.section_exclude_d);
   nlohmann::json report = {{"piece", piece},
                            {"pieces", pieces},
+                           {"key", piece_key},
                            {"slab", slab.report},
-                           {"fluid_volume_m3", fluid},
-                           {"section_fluid_volume_m3", in_section},
+                           {"fluid_volume_m3", std::accumulate(cells.volumes.begin(), cells.volumes.end(), 0.0)},
+                           {"section_void_fraction_share", section.void_fraction.value()},
                            {"section_z_m", {section.z_low, section.z_high}}};
   if (case_params.polyhedra) {
     // Whole dual cells across the planes: each neighbour's tetrahedra next to the plane shared
@@ -145,7 +172,7 @@ nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface
 }
 
 std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceParams& surface) {
-  const meshing::SurfaceParams whole = meshing::slab_surface(bed, surface, 0, 1);
+  const meshing::SurfaceParams whole = meshing::slab_surface(bed, surface, {}, 0);
   const double d = reference_diameter(bed);
   return {whole.clip_bottom_d * d, whole.clip_top_d * d};
 }
@@ -157,7 +184,6 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
   out.write = [pieces, run_dir, &console](cases::CaseInfo& info) {
     const fs::path self = fs::read_symlink("/proc/self/exe"), log = info.directory / "log.pieces";
-    fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // an earlier run's
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
     // Open MPI refuses root unless told (containers, CI), as in Allrun.
@@ -183,16 +209,16 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     }
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
     long cells = 0;
-    double fluid = 0.0, in_section = 0.0;
+    double fluid = 0.0, void_fraction = 0.0;
     for (int k = 0; k < pieces; ++k) {
       const nlohmann::json r = nlohmann::json::parse(read_file(info.directory / fmt::format("processor{}/bedforge_piece.json", k)));
       cells += r["cells"].get<long>();
       fluid += r["fluid_volume_m3"].get<double>();
-      in_section += r["section_fluid_volume_m3"].get<double>();
+      void_fraction += r["section_void_fraction_share"].get<double>();
     }
     info.cells = cells;
     info.fluid_volume_m3 = fluid;
-    info.section.void_fraction = in_section / (info.inlet_area_m2 * (info.section.z_high - info.section.z_low));
+    info.section.void_fraction = void_fraction;
   };
   return out;
 }

@@ -22,15 +22,20 @@ namespace bedforge::pipeline {
 // case_dir/piece_layers/piece<piece>_<inlet|outlet>.bin and reads its neighbours'; ranks of one
 // Open MPI job (OMPI_COMM_WORLD_SIZE = pieces) wait for each other's, a piece made alone takes
 // them as an earlier job left them. No process holds more than its own slab and its neighbours'
-// layers. Returns the piece's report (also written beside its cells): its cells, the fluid
-// volume of its slab's tetrahedra (m^3) and the part of it with centres in the bed section (m^3,
-// for the section's void fraction as meshed), the slab's report, time and peak memory.
+// layers. A rerun keeps what an earlier one made from the same inputs (`bed_key`, the bed file's
+// stage_key, the parameters, the version and the count): on gmsh's cells its processor
+// directory as it is; on polyhedra its tetrahedra (kept as case_dir/piece_layers/
+// piece<piece>_tetrahedra.bin, until the run's pieces are all done), its dual made again. Returns the piece's report (also written beside its cells): its cells, the fluid
+// volume of its slab's tetrahedra (m^3) and their share of the bed section's void fraction as
+// meshed (cases::bed_section; the pieces' shares add up to it), the slab's report, time and peak
+// memory.
 // InputError, before any work, when case_dir/0 is not there, the treatments cannot be cut by a
 // plane (meshing::slabs_possible), or a piece on polyhedra made alone finds no neighbour's layer;
 // the errors of mesh_slab otherwise, naming the piece.
-nlohmann::json piece_stage(const Bed& bed, const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                           const cases::CaseParams& case_params, int piece, int pieces,
-                           const std::filesystem::path& case_dir, const std::string& note, const Console& console);
+nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
+                           const meshing::VolumeMeshParams& mesh, const cases::CaseParams& case_params, int piece,
+                           int pieces, const std::filesystem::path& case_dir, const std::string& note,
+                           const Console& console);
 
 // The inlet's and outlet's heights (m) of the fluid domain of `bed` under `surface` (its clip
 // window's ends when it has one), as its pieces and the case that holds them take them.
@@ -40,8 +45,8 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
-// one (std::runtime_error otherwise). The ranks' layers (case/piece_layers) are removed before
-// they start, and once all have succeeded. Set
+// one (std::runtime_error otherwise). The ranks' files (case/piece_layers) are removed once all
+// have succeeded; a failed run leaves them for the next, which remakes only the failed pieces. Set
 // OMPI_MCA_rmaps_base_oversubscribe=1 for more ranks than cores.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console);

@@ -100,7 +100,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice", "pieces"]
+            "periodic_slice", "pieces", "weak_scaling"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -673,10 +673,10 @@ def periodic_target_lines(v):
             "least 1.5.", "", *lines, ""]
 
 
-def pieces_scene(count, solve):
-    """scenes/default.toml (a = 5, N = 500, seed 1) with shrink, one mesh, and the case in `count`
-    pieces (0: one piece), solved when `solve`."""
-    text = default_scene_with(1, "shrink")
+def pieces_scene(count, solve, spheres=None):
+    """scenes/default.toml (a = 5, N = 500 or `spheres`, seed 1) with shrink, one mesh, and the case in
+    `count` pieces (0: one piece), solved when `solve`."""
+    text = default_scene_with(1, "shrink", spheres)
     for pattern, replacement in [(r"^levels = \d+", "levels = 0"), (r'^algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'),
                                  (r"^run = true", f"run = {'true' if solve else 'false'}")]:
         text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
@@ -732,6 +732,53 @@ def pieces(tmp, ranks):
                 row["check_mesh_failed"] = re.findall(r"^\s*\*\*\*(.*)$", log, re.M)
         rows.append({**commit_and_date(), **row})
     return rows
+
+
+def weak_scaling(tmp, ranks, per_rank):
+    """Issue 58's weak scaling: beds of `per_rank` x P spheres (a = 5, the column P times longer) in P
+    pieces on P ranks, the case written (not solved); P = 1 is one rank's piece of the one-piece run's
+    case, as in pieces(). Each rank's peak and time."""
+    env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    rows = []
+    for p in ranks:
+        path = os.path.join(tmp, f"weak_{p}")
+        open(path + ".toml", "w").write(pieces_scene(p if p > 1 else 0, False, per_rank * p))
+        t0 = time.time()
+        out = subprocess.run([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"], capture_output=True,
+                             text=True, env=env)
+        if out.returncode != 0:
+            raise RuntimeError(f"bedforge run {path}.toml failed:\n{out.stdout}\n{out.stderr}")
+        wall = time.time() - t0
+        if p == 1:
+            t0 = time.time()
+            subprocess.run(["mpirun", "-np", "1", BEDFORGE, "--quiet", "--no-progress", "piece", path], check=True,
+                           capture_output=True, env=env)
+            wall = time.time() - t0
+        ranks_out = [json.load(open(os.path.join(path, "case", f"processor{k}", "bedforge_piece.json"))) for k in range(p)]
+        rows.append({**commit_and_date(), "ranks": p, "spheres": per_rank * p, "wall_s": wall,
+                     "cells": sum(r["cells"] for r in ranks_out),
+                     "rank_peak_mb": [r["peak_memory_mb"] for r in ranks_out], "rank_time_s": [r["time_s"] for r in ranks_out]})
+    return rows
+
+
+def weak_scaling_lines(rows):
+    """Issue 58's weak-scaling target: the largest rank's peak within 20 % of one rank's, 1 to 4 ranks."""
+    one = max(rows[0]["rank_peak_mb"])
+    lines = ["## Weak scaling of the pieces: a bed P times longer on P ranks (issue 58)", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml with contacts shrunk (a = 5, 0.15 d, "
+             f"4 cells per gap, seed 1) and {rows[0]['spheres']} spheres per rank, the column P times longer; `[mesh] "
+             "pieces = P`, the case written, not solved (P = 1: one rank's piece of the one-piece run's case). Ranks "
+             "beyond the 2 cores are oversubscribed, so their times are not a speed-up.", "",
+             "| ranks | spheres | polyhedra | largest rank's peak (MB) | x one rank's | ranks' time (s) | run's wall time (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        peak = max(r["rank_peak_mb"])
+        lines.append(f"| {r['ranks']} | {r['spheres']} | {r['cells']} | {peak:.0f} | {peak / one:.2f} | "
+                     f"{min(r['rank_time_s']):.0f}-{max(r['rank_time_s']):.0f} | {r['wall_s']:.0f} |")
+    worst = max(abs(max(r["rank_peak_mb"]) / one - 1) for r in rows)
+    lines += ["", f"Issue 58's target, the per-rank peak within 20 % of one rank's from 1 to 4 ranks: "
+              f"{'**met**' if worst <= 0.2 else '**not met**'} (at most {100 * worst:.0f} % off).", ""]
+    return lines
 
 
 def pieces_lines(rows):
@@ -1245,6 +1292,8 @@ def write(results):
         lines += slice_lines(results["periodic_slice"])
     if "pieces" in results:
         lines += pieces_lines(results["pieces"])
+    if "weak_scaling" in results:
+        lines += weak_scaling_lines(results["weak_scaling"])
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -1352,6 +1401,8 @@ def main():
     ap.add_argument("--slice-full-exclude", type=float, default=2.0,
                     help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
     ap.add_argument("--pieces-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces: ranks (pieces) to run")
+    ap.add_argument("--weak-ranks", type=int, nargs="+", default=[1, 2, 4], help="weak_scaling: ranks (pieces) to run")
+    ap.add_argument("--weak-spheres", type=int, default=200, help="weak_scaling: spheres per rank")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -1424,6 +1475,9 @@ def main():
             write(results)
         if "pieces" in args.only:
             results["pieces"] = pieces(tmp, args.pieces_ranks)
+            write(results)
+        if "weak_scaling" in args.only:
+            results["weak_scaling"] = weak_scaling(tmp, args.weak_ranks, args.weak_spheres)
             write(results)
 
 

@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/intersection_volumes.hpp"
 #include "core/version.hpp"
 #include "meshing/surface/defect_locations.hpp"
 #include "meshing/surface/clip_planes.hpp"
@@ -190,6 +191,36 @@ FluidDomainSize fluid_domain_size(const Bed& given, const SurfaceParams& p, doub
                                                      *bed.container);
   if (gaps) s.gap_cells = gaps->added_cells(volume_per_cell, tb.planes.z0, tb.planes.z1);
   return s;
+}
+
+FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p, double volume_per_cell, int bins) {
+  const LaidOut laid = lay_out(given, p);
+  const Bed& bed = laid.bed();
+  const TreatedBed& tb = laid.treated;
+  FluidDomainProfile out{tb.planes.z0, tb.planes.z1, {}};
+  const double d = reference_diameter(bed), edge = p.edge_length_d * d, height = (out.z1 - out.z0) / bins;
+  const double per_volume = 1.0 / (volume_per_cell * edge * edge * edge);
+  // The fluid: each bin's cross-section less the spheres' slices in it; and the surfaces' cells,
+  // the walls' and the spheres' zones (2 pi r times the zone's height).
+  const double per_area = kCellsPerSurfaceEdgeSquared / (edge * edge);
+  out.cells.assign(bins, (bed.container->cross_section_area() * per_volume + bed.container->wall_perimeter() * per_area) * height);
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    if (!tb.kept[i]) continue;
+    const double r = tb.radius[i], zc = bed.centres[i].z();
+    const int first = std::max(0, static_cast<int>((zc - r - out.z0) / height));
+    const int last = std::min(bins - 1, static_cast<int>((zc + r - out.z0) / height));
+    for (int b = first; b <= last; ++b) {
+      const double lo = std::max(out.z0 + b * height, zc - r), hi = std::min(out.z0 + (b + 1) * height, zc + r);
+      out.cells[b] += (2.0 * std::numbers::pi * r * std::max(0.0, hi - lo)) * per_area -
+                      sphere_slab_volume(r, zc, lo, hi) * per_volume;
+    }
+  }
+  const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);
+  if (gaps) {
+    const std::vector<double> added = gaps->added_cells_profile(volume_per_cell, out.z0, out.z1, bins);
+    for (int b = 0; b < bins; ++b) out.cells[b] += added[b];
+  }
+  return out;
 }
 
 FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {

@@ -74,6 +74,24 @@ struct FluidDomainSize {
 };
 FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell);
 
+// The same along the fluid domain's height: `bins` bins of equal height from its inlet z0 to its
+// outlet z1 (m), each with the cells a mesh of the surface edge would have there (a count per
+// bin, no unit): the fluid volume over volume_per_cell x edge^3 (the spheres at their treated
+// radii, bridges and caps left out), plus kCellsPerSurfaceEdgeSquared per edge^2 of the spheres'
+// and walls' area (cells next to a surface are smaller than in the bulk), plus those its narrow
+// gaps add. What pieces of about equal cells are cut from.
+// kCellsPerSurfaceEdgeSquared is a calibration: on a = 4, N = 80, 0.2 d, no gap rule, 3 d empty
+// ends, the packed bed's heights held 2.1 times the cells its fluid volume gives at 0.24 edge^3
+// per cell and the empty ends 1.25 times (2026-11-29, docs/findings.md), which 4 cells per edge^2
+// of surface makes about even; validated on other beds in docs/mesh_case_benchmark.md (weak
+// scaling: the ranks' cells).
+inline constexpr double kCellsPerSurfaceEdgeSquared = 4.0;
+struct FluidDomainProfile {
+  double z0 = 0.0, z1 = 0.0;  // m
+  std::vector<double> cells;  // bins
+};
+FluidDomainProfile fluid_domain_profile(const Bed& bed, const SurfaceParams& p, double volume_per_cell, int bins);
+
 struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)
   TriangleMesh bed;    // the closed treated particles, normals outward (m)

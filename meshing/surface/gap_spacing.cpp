@@ -69,11 +69,17 @@ double GapSpacing::medial_distance(const Eigen::Vector3d& p, const Eigen::Vector
 }
 
 double GapSpacing::added_cells(double volume_per_cell, double z0, double z1) const {
+  return added_cells_profile(volume_per_cell, z0, z1, 1)[0];
+}
+
+std::vector<double> GapSpacing::added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const {
   const double pi = std::acos(-1.0), golden_angle = pi * (3.0 - std::sqrt(5.0));
   const double per_coarsest = 1.0 / (volume_per_cell * coarsest_ * coarsest_ * coarsest_);
   const long n = static_cast<long>(centres_.size());
-  double total = 0.0;
-#pragma omp parallel for reduction(+ : total) schedule(dynamic, 8)
+  std::vector<double> profile(bins, 0.0);
+  double* total = profile.data();
+  const double per_bin = (z1 - z0) / bins;
+#pragma omp parallel for reduction(+ : total[:bins]) schedule(dynamic, 8)
   for (long i = 0; i < n; ++i) {
     if (!kept_[i]) continue;
     // A Fibonacci lattice whose spacing is a third of the smallest refined patch's radius.
@@ -90,10 +96,11 @@ double GapSpacing::added_cells(double volume_per_cell, double z0, double z1) con
       // The column out to the medial surface widens with the sphere.
       const double t = medial_distance(p, normal, static_cast<int>(i)), widening = 1.0 + t / r;
       const double column = r / 3.0 * (widening * widening * widening - 1.0);
-      total += area / static_cast<double>(m) * column * (1.0 / (volume_per_cell * edge * edge * edge) - per_coarsest);
+      const int bin = std::min(bins - 1, static_cast<int>((p.z() - z0) / per_bin));
+      total[bin] += area / static_cast<double>(m) * column * (1.0 / (volume_per_cell * edge * edge * edge) - per_coarsest);
     }
   }
-  return total;
+  return profile;
 }
 
 }  // namespace bedforge::meshing

@@ -35,6 +35,9 @@ class GapSpacing {
   // smallest refined patch (radius sqrt(cells_per_gap x finest x radius)). Low on purpose: the
   // walls' side of their gaps and the cells gmsh grades between patches are left out.
   double added_cells(double volume_per_cell, double z0, double z1) const;
+  // The same in `bins` bins of equal height from z0 to z1, each counting the surface samples in
+  // it (bins x 1).
+  std::vector<double> added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const;
 
  private:
   // Distance from p to the nearest surface other than sphere `self`'s, up to cells_per_gap x

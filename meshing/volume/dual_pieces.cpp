@@ -99,6 +99,24 @@ PlaneLayer plane_layer(const PolyMesh& m, const std::string& plane, int rings) {
   return layer;
 }
 
+PlaneLayer whole_slab(const PolyMesh& m) {
+  PlaneLayer all;
+  all.points = m.points;
+  all.cells = tetrahedra(m);
+  for (int k = 0; k < static_cast<int>(m.patches.size()); ++k) {
+    all.names.push_back(m.patches[k].name);
+    for (int f = m.patches[k].start; f < m.patches[k].start + m.patches[k].size; ++f)
+      all.boundary.push_back(m.faces[f]), all.patch.push_back(k);
+  }
+  return all;
+}
+
+PolyMesh slab_of(const PlaneLayer& all) {
+  std::vector<std::string> types;
+  for (const auto& name : all.names) types.push_back(patch_type(name));
+  return poly_mesh_from_cells(all.points, all.cells, all.boundary, all.patch, all.names, types);
+}
+
 void write_plane_layer(const std::filesystem::path& path, const PlaneLayer& layer) {
   write_file_atomically(path, [&](std::ostream& out) {
     out.write(kMagic, sizeof kMagic - 1);

@@ -37,6 +37,12 @@ inline constexpr const char* kLayerEdge = "layer_edge";
 // std::runtime_error when the slab has no such patch.
 PlaneLayer plane_layer(const PolyMesh& slab, const std::string& plane, int rings = 2);
 
+// All of a slab's tetrahedra and boundary faces as a layer (no kLayerEdge faces), and the slab
+// back from one (its cells renumbered as poly_mesh_from_cells numbers them): what a piece keeps
+// on disk so that a rerun need not mesh it again.
+PlaneLayer whole_slab(const PolyMesh& slab);
+PolyMesh slab_of(const PlaneLayer& whole);
+
 // A layer as a binary file (written through a temporary file and a rename, so a reader never
 // sees half of one) and read back; InputError naming the file when it cannot be read.
 void write_plane_layer(const std::filesystem::path& path, const PlaneLayer& layer);

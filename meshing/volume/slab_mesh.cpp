@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <numeric>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -170,15 +171,29 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const Volu
 
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int slabs) {
   std::vector<double> planes;
+  if (slabs < 2) return planes;
   const double d = reference_diameter(bed);
-  const double lo = s.clip ? s.clip_bottom_d : 0.0, hi = s.clip ? s.clip_top_d : bed_height(bed) / d;
+  // The estimated cells along the domain in bins of 0.02 d (at least 100 per slab); the volume
+  // per cell scales every bin alike, so any will do for the split.
+  const double span_d = (s.clip ? s.clip_top_d - s.clip_bottom_d
+                                : bed_height(bed) / d + s.inlet_length_d + s.outlet_length_d);
+  const int bins = std::clamp(static_cast<int>(std::ceil(span_d / 0.02)), 100 * slabs, 1 << 22);
+  const FluidDomainProfile profile = fluid_domain_profile(bed, s, 1.0, bins);
+  std::vector<double> below(bins + 1, 0.0);  // cells below each bin's bottom
+  std::partial_sum(profile.cells.begin(), profile.cells.end(), below.begin() + 1);
+  const double height = (profile.z1 - profile.z0) / bins;
   std::vector<double> ends;  // d
   for (std::size_t i = 0; i < bed.size(); ++i)
     for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
       ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
   std::sort(ends.begin(), ends.end());
   for (int k = 1; k < slabs; ++k) {
-    const double asked = lo + (hi - lo) * k / slabs;
+    // Where the cells below reach k / slabs of them, within its bin by linear interpolation.
+    const double target = below.back() * k / slabs;
+    const int b = std::clamp(static_cast<int>(std::upper_bound(below.begin(), below.end(), target) - below.begin()) - 1,
+                             0, bins - 1);
+    const double share = profile.cells[b] > 0.0 ? (target - below[b]) / profile.cells[b] : 0.0;
+    const double asked = (profile.z0 + (b + std::clamp(share, 0.0, 1.0)) * height) / d;
     double best = asked, widest = -1.0;
     for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
       const double mid = 0.5 * (ends[j] + ends[j + 1]);
@@ -190,9 +205,9 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int sl
   return planes;
 }
 
-SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, int slabs) {
+SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k) {
   const double d = reference_diameter(bed);
-  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
+  const int slabs = static_cast<int>(planes.size()) + 1;
   SurfaceParams q = surface;
   q.clip = true;
   q.clip_bottom_d = k > 0 ? planes[k - 1] : surface.clip ? surface.clip_bottom_d : -surface.inlet_length_d;
@@ -200,9 +215,11 @@ SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, 
   return q;
 }
 
-VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
-                     const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path, bool release_memory) {
-  const SurfaceParams q = slab_surface(bed, surface, k, slabs);
+VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k,
+                     double d_ref, const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path,
+                     bool release_memory) {
+  const int slabs = static_cast<int>(planes.size()) + 1;
+  const SurfaceParams q = slab_surface(bed, surface, planes, k);
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
   const FluidSurface fs = [&] {
@@ -235,11 +252,12 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
   const auto t0 = std::chrono::steady_clock::now();
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
+  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
   for (int k = 0; k < slabs; ++k) {
     progress.update(fmt::format("slab {} of {}: surface and cells", k + 1, slabs));
     // Memory a slab frees stays with the allocator for the next slab and the join: handing it
     // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
-    VolumeMesh slab = mesh_slab(bed, surface, k, slabs, d_ref, p, bad_cells_path, false);
+    VolumeMesh slab = mesh_slab(bed, surface, planes, k, d_ref, p, bad_cells_path, false);
     progress.update(fmt::format("slab {} of {}: {} cells joined", k + 1, slabs, slab.mesh.cells), (k + 1.0) / slabs);
     joined.add(slab.mesh, k == 0, k + 1 == slabs, k);
     reports.push_back(std::move(slab.report));

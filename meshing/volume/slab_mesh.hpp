@@ -27,29 +27,30 @@ bool slabs_possible(const SurfaceParams& surface, const VolumeMeshParams& params
 constexpr double kSurfaceTrianglesPerSlab = 1.0e6;
 int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, const VolumeMeshParams& params);
 
-// Heights above the floor (d) of the planes between `slabs` slabs: the bed cut into equal
-// heights (the empty inlet and outlet sections, or a clip window's ends, go to the first and the
-// last slab), each moved within surface.clip_shift_d to the middle of the widest interval
-// between the spheres' tops and bottoms (at their own and their shrunk radius): a plane just
-// clear of a sphere's top cuts it in a thin cap and leaves an acute wedge of fluid beside it.
-// (For pieces on the polyhedral dual this did not suffice: processor_patches.hpp.) Empty when
-// slabs < 2.
+// Heights above the floor (d) of the planes between `slabs` slabs: the fluid domain (from its
+// inlet to its outlet, or a clip window's ends) cut into slabs of about equal cells by the
+// surface stage's own estimate (fluid_domain_profile: the fluid volume and the cells its narrow
+// gaps add), each plane then moved within surface.clip_shift_d to the middle of the widest
+// interval between the spheres' tops and bottoms (at their own and their shrunk radius): a plane
+// just clear of a sphere's top cuts it in a thin cap and leaves an acute wedge of fluid beside
+// it. Empty when slabs < 2.
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 
-// The surface parameters of slab `k` (from 0, bottom up) of `slabs`: a clip window from the
-// plane below it to the plane above it (slab_planes_d), the whole domain's ends (or the scene's
+// The surface parameters of slab `k` (from 0, bottom up) between `planes` (slab_planes_d): a clip
+// window from the plane below it to the plane above it, the whole domain's ends (or the scene's
 // clip window's) outside. The surface stage may move a plane a little to keep it clear of the
 // spheres, alike for the slabs on either side.
-SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, int k, int slabs);
+SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k);
 
-// Slab `k` of `slabs` meshed on its own: its surface (slab_surface) and build_volume_mesh with
+// Slab `k` between `planes` meshed on its own: its surface (slab_surface) and build_volume_mesh with
 // `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
 // in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
 // (where the surface stage put them), "surface_triangles" and "cells". InputError naming
 // mesh.slabs when the slab cannot be cut from the bed; ConvergenceError naming the slab when
 // its cells fail the gate (written to `bad_cells_path`).
-VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, int k, int slabs, double d_ref,
-                     const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path, bool release_memory);
+VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k,
+                     double d_ref, const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path,
+                     bool release_memory);
 
 // The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;

@@ -137,8 +137,41 @@ TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
   EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
 }
 
+// A rerun after a failed piece meshes only that piece again: the others keep their tetrahedra
+// (kept beside the case until the run's pieces are all done) and, on polyhedra, make their dual
+// again with the new piece's cells next to them, so the pieces still match (checkMesh).
+TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
+  const fs::path dir = run("piece_rerun", false, "polyhedra", "[mesh]\npieces = 2\n");
+  EXPECT_FALSE(fs::exists(dir / "case/piece_layers")) << "a run that succeeded leaves no pieces' files";
+  // The ranks on their own, as a scheduler's job would run them: their files stay.
+  const std::string ranks = kOpenFoam + "mpirun -np 2 " + BEDFORGE_BINARY + " piece " + dir.string();
+  Result r = shell(ranks);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("kept from an earlier run"), std::string::npos) << "no tetrahedra were kept yet: " << r.output;
+  // Piece 1 fails (as if its rank had been killed): its directory and its tetrahedra are gone.
+  fs::remove_all(dir / "case/processor1");
+  fs::remove(dir / "case/piece_layers/piece1_tetrahedra.bin");
+  // The run again, every stage redone: the bed and the settings are the same, so piece 0 keeps
+  // its tetrahedra and only piece 1 is meshed.
+  const fs::path scene = fs::path(fresh_dir("piece_rerun_scene").string() + "_again.toml");
+  std::ofstream(scene) << read(dir / "scene.toml");
+  r = bedforge("--quiet run " + scene.string() + " -o " + dir.string() + " --overwrite --force");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto piece0 = nlohmann::json::parse(read(dir / "case/processor0/bedforge_piece.json"));
+  const auto piece1 = nlohmann::json::parse(read(dir / "case/processor1/bedforge_piece.json"));
+  EXPECT_TRUE(piece0["slab"].value("reused", false)) << piece0.dump();
+  EXPECT_FALSE(piece1["slab"].value("reused", false)) << piece1.dump();
+  EXPECT_TRUE(piece1["slab"].contains("cells")) << "meshed again: " << piece1.dump();
+  EXPECT_FALSE(fs::exists(dir / "case/piece_layers"));
+  const Result check = shell(kOpenFoam + "cd " + (dir / "case").string() + " && mpirun -np 2 checkMesh -parallel");
+  ASSERT_EQ(check.status, 0) << check.output;
+  EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
+}
+
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
-// no case to write into, and contacts a plane would cut open; no processor directory is left.
+// no case to write into, pieces beyond the machine's memory, a piece on polyhedra made without
+// its neighbours, and contacts a plane would cut open; no processor directory is left.
 TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_dir("piece_refused");
   ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
@@ -152,6 +185,13 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("no case to write a piece into"), std::string::npos) << r.output;
   fs::create_directories(dir / "case/0");
+  // More ranks on this machine than its memory holds pieces for (a million, each with half of
+  // this bed's estimated cells): refused before meshing, with the count that would fit.
+  r = shell("OMPI_COMM_WORLD_LOCAL_SIZE=1000000 " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() +
+            " --piece 0 --pieces 2 --contacts shrink");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("mesh.pieces = 2: a piece would take at least"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("allowed: mesh.pieces >= "), std::string::npos) << r.output;
   // A piece on polyhedra made alone, with no neighbour's layer to take.
   r = shell("env -u OMPI_COMM_WORLD_SIZE " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() +
             " --piece 0 --pieces 2 --contacts shrink");

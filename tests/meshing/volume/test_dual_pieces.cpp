@@ -43,7 +43,7 @@ Pieces three_slabs() {
   const auto dir = test_support::fresh_dir("dual_pieces", true);
   Pieces p;
   for (int k = 0; k < 3; ++k) {
-    p.slabs.push_back(mesh_slab(b, sp, k, 3, 1.0, VolumeMeshParams{}, dir / "bad_cells.vtk", true).mesh);
+    p.slabs.push_back(mesh_slab(b, sp, slab_planes_d(b, sp, 3), k, 1.0, VolumeMeshParams{}, dir / "bad_cells.vtk", true).mesh);
     p.inlet.push_back(k > 0 ? plane_layer(p.slabs[k], "inlet") : PlaneLayer{});
     p.outlet.push_back(k < 2 ? plane_layer(p.slabs[k], "outlet") : PlaneLayer{});
   }

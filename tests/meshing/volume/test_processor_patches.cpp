@@ -36,7 +36,7 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   std::vector<PolyMesh> piece;
   std::vector<long> boundary_faces;
   for (int k = 0; k < pieces; ++k) {
-    piece.push_back(mesh_slab(b, sp, k, pieces, 1.0, p, dir / "bad_cells.vtk", true).mesh);
+    piece.push_back(mesh_slab(b, sp, slab_planes_d(b, sp, pieces), k, 1.0, p, dir / "bad_cells.vtk", true).mesh);
     long faces = 0;
     for (const auto& q : piece.back().patches) faces += q.size;
     boundary_faces.push_back(faces);
