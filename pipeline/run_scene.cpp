@@ -61,8 +61,9 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // A case in pieces: no whole surface or mesh in this process, the ranks make the pieces.
   const bool in_pieces = scene.mesh.pieces > 1;
-  // (The pieces' ranks all run on this machine: together they need what one piece would.)
-  if (plan.mesh.build) refuse_mesh_beyond_memory(scene, available_memory_bytes());
+  // A case in pieces is refused by its ranks, each against its own machine's memory (mpirun may
+  // spread them over several: piece_directory).
+  if (plan.mesh.build && !in_pieces) refuse_mesh_beyond_memory(scene, available_memory_bytes());
   // Without OpenFOAM the case is written and not solved, said now and by the exit status.
   const std::string missing = plan.case_.build && scene.case_params.run
                                   ? cases::missing_openfoam_program(scene.case_params.processors)
@@ -110,7 +111,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // Now with the bed's narrow gaps, whose cells the scene alone cannot foresee: before the surface.
   MeshEstimate estimate;
-  if (plan.mesh.build) {
+  if (plan.mesh.build && !in_pieces) {
     const double available = available_memory_bytes();
     estimate = refuse_mesh_beyond_memory(scene, bed, available);
     console.line(estimate_line(estimate, available));

@@ -52,6 +52,16 @@ const std::string kOpenFoam =
     "export WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam}; "
     "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; ";
 
+// The pieces of dir/case gathered into one mesh (reconstructParMesh) pass checkMesh with `cells`.
+void expect_gathered(const fs::path& dir, long cells) {
+  const Result gathered =
+      shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh -constant "
+            "> log.reconstructParMesh 2>&1 && checkMesh");
+  ASSERT_EQ(gathered.status, 0) << read(dir / "case/log.reconstructParMesh");
+  EXPECT_NE(gathered.output.find("Mesh OK."), std::string::npos) << gathered.output;
+  EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
+}
+
 }  // namespace
 
 TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
@@ -106,12 +116,7 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
   EXPECT_NE(said_gradient(read(dir / "case/log.Allrun")), 0.0);
   EXPECT_NEAR(said_gradient(read(dir / "case/log.Allrun")), gradient, 1e-5 * gradient);
   // The whole mesh can be gathered from the pieces: reconstructParMesh, then checkMesh on it.
-  const Result gathered =
-      shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh -constant "
-            "> log.reconstructParMesh 2>&1 && checkMesh");
-  ASSERT_EQ(gathered.status, 0) << read(dir / "case/log.reconstructParMesh");
-  EXPECT_NE(gathered.output.find("Mesh OK."), std::string::npos) << gathered.output;
-  EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
+  expect_gathered(dir, cells);
 }
 
 TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
@@ -129,12 +134,7 @@ TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
   EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
   EXPECT_NE(check.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << check.output;
   // The whole mesh can still be gathered: reconstructParMesh, then checkMesh on it.
-  const Result gathered =
-      shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh -constant "
-            "> log.reconstructParMesh 2>&1 && checkMesh");
-  ASSERT_EQ(gathered.status, 0) << read(dir / "case/log.reconstructParMesh");
-  EXPECT_NE(gathered.output.find("Mesh OK."), std::string::npos) << gathered.output;
-  EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
+  expect_gathered(dir, cells);
 }
 
 // A rerun after a failed piece meshes only that piece again: the others keep their tetrahedra

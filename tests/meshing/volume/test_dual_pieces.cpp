@@ -18,18 +18,13 @@
 #include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 #include "support/packed_bed.hpp"
+#include "support/processor_faces.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace bedforge;
 using namespace bedforge::meshing;
 
 namespace {
-
-const PolyMesh::Patch& patch(const PolyhedralMesh& m, const std::string& name) {
-  for (const auto& p : m.patches)
-    if (p.name == name) return p;
-  throw std::runtime_error("no patch " + name);
-}
 
 struct Pieces {
   std::vector<PolyMesh> slabs;
@@ -83,15 +78,15 @@ TEST(DualPieces, ThreePiecesMakeTheWholeDualWithMatchingProcessorPatches) {
   EXPECT_EQ(differ, 0) << "of " << volumes.size() << " cells";
   // The domain's own inlet and outlet are only on the end pieces; every piece lists them.
   for (int k = 0; k < 3; ++k) {
-    EXPECT_EQ(patch(piece[k], "inlet").size > 0, k == 0);
-    EXPECT_EQ(patch(piece[k], "outlet").size > 0, k == 2);
-    EXPECT_THROW(patch(piece[k], kLayerEdge), std::runtime_error);
+    EXPECT_EQ(test_support::patch_named(piece[k], "inlet").size > 0, k == 0);
+    EXPECT_EQ(test_support::patch_named(piece[k], "outlet").size > 0, k == 2);
+    EXPECT_THROW(test_support::patch_named(piece[k], kLayerEdge), std::runtime_error);
   }
   const double max_non_orthogonality = QualityGate{}.max_non_orthogonality_deg;
   for (int k = 0; k < 2; ++k) {
     const PolyhedralMesh &lower = piece[k], &upper = piece[k + 1];
-    const auto& a = patch(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
-    const auto& c = patch(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
+    const auto& a = test_support::patch_named(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
+    const auto& c = test_support::patch_named(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
     EXPECT_EQ(a.neighbour_processor, k + 1);
     EXPECT_EQ(c.neighbour_processor, k);
     ASSERT_EQ(a.size, c.size);
@@ -99,11 +94,7 @@ TEST(DualPieces, ThreePiecesMakeTheWholeDualWithMatchingProcessorPatches) {
     const CellGeometry gl = cell_geometry(lower), gu = cell_geometry(upper);
     long mismatched = 0, inverted = 0, too_oblique = 0;
     for (int f = 0; f < a.size; ++f) {
-      const std::vector<int> x = points_of(lower, a.start + f), y = points_of(upper, c.start + f);
-      bool same = x.size() == y.size();
-      for (std::size_t j = 0; same && j < x.size(); ++j)
-        same = lower.points[x[j]] == upper.points[y[(x.size() - j) % x.size()]];
-      mismatched += !same;
+      mismatched += !test_support::same_face_reversed(lower, a.start + f, upper, c.start + f);
       const FaceGeometry fl = face_geometry(lower.points, lower.faces[a.start + f]);
       const Eigen::Vector3d cl = gl.centres[lower.owner[a.start + f]], cu = gu.centres[upper.owner[c.start + f]];
       inverted += (fl.centre - cl).dot(fl.area) <= 0.0;

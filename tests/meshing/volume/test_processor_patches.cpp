@@ -11,20 +11,11 @@
 
 #include "meshing/volume/slab_mesh.hpp"
 #include "support/packed_bed.hpp"
+#include "support/processor_faces.hpp"
 #include "support/temp_dir.hpp"
 
 using namespace bedforge;
 using namespace bedforge::meshing;
-
-namespace {
-
-const PolyMesh::Patch& patch(const PolyMesh& m, const std::string& name) {
-  for (const auto& p : m.patches)
-    if (p.name == name) return p;
-  throw std::runtime_error("no patch " + name);
-}
-
-}  // namespace
 
 TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   const Bed b = test_support::packed_bed(60, 4.0, 2);
@@ -71,25 +62,21 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
     }
     EXPECT_EQ(start, static_cast<int>(piece[k].faces.size()));
     // The domain's own inlet and outlet are only on the end pieces.
-    EXPECT_EQ(patch(piece[k], "inlet").size > 0, k == 0);
-    EXPECT_EQ(patch(piece[k], "outlet").size > 0, k == pieces - 1);
+    EXPECT_EQ(test_support::patch_named(piece[k], "inlet").size > 0, k == 0);
+    EXPECT_EQ(test_support::patch_named(piece[k], "outlet").size > 0, k == pieces - 1);
   }
   // Each shared plane: face for face, point for point.
   for (int k = 0; k + 1 < pieces; ++k) {
     const PolyMesh &lower = piece[k], &upper = piece[k + 1];
-    const auto& a = patch(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
-    const auto& c = patch(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
+    const auto& a = test_support::patch_named(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
+    const auto& c = test_support::patch_named(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
     EXPECT_EQ(a.neighbour_processor, k + 1);
     EXPECT_EQ(c.neighbour_processor, k);
     ASSERT_EQ(a.size, c.size);
     ASSERT_GT(a.size, 50);
     long mismatched = 0;
     for (int f = 0; f < a.size; ++f) {
-      const std::vector<int> x = points_of(lower, a.start + f), y = points_of(upper, c.start + f);
-      bool same = x.size() == y.size();
-      for (std::size_t j = 0; same && j < x.size(); ++j)
-        same = lower.points[x[j]] == upper.points[y[(x.size() - j) % x.size()]];
-      mismatched += !same;
+      mismatched += !test_support::same_face_reversed(lower, a.start + f, upper, c.start + f);
       // Flat on the plane, each normal out of its own piece.
       EXPECT_GT(face_geometry(lower.points, lower.faces[a.start + f]).area.z(), 0.0);
       EXPECT_LT(face_geometry(upper.points, upper.faces[c.start + f]).area.z(), 0.0);
