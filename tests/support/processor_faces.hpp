@@ -2,6 +2,8 @@
 // Helpers for tests of the pieces of a decomposed case (processor patches).
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "meshing/volume/poly_mesh.hpp"
 
@@ -13,6 +15,15 @@ const bedforge::meshing::PolyMesh::Patch& patch_named(const Mesh& mesh, const st
   for (const auto& p : mesh.patches)
     if (p.name == name) return p;
   throw std::runtime_error("no patch " + name);
+}
+
+// The processor patches of pieces k and k + 1 that face each other: procBoundary<k>to<k+1> of
+// `lower` and procBoundary<k+1>to<k> of `upper`.
+template <class Mesh>
+std::pair<const bedforge::meshing::PolyMesh::Patch&, const bedforge::meshing::PolyMesh::Patch&> facing_patches(
+    const Mesh& lower, const Mesh& upper, int k) {
+  return {patch_named(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1)),
+          patch_named(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k))};
 }
 
 // Whether face `fa` of `a` and face `fb` of `b` are one face seen from either side, as decomposePar

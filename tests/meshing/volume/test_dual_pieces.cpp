@@ -85,8 +85,7 @@ TEST(DualPieces, ThreePiecesMakeTheWholeDualWithMatchingProcessorPatches) {
   const double max_non_orthogonality = QualityGate{}.max_non_orthogonality_deg;
   for (int k = 0; k < 2; ++k) {
     const PolyhedralMesh &lower = piece[k], &upper = piece[k + 1];
-    const auto& a = test_support::patch_named(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
-    const auto& c = test_support::patch_named(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
+    const auto [a, c] = test_support::facing_patches(lower, upper, k);
     EXPECT_EQ(a.neighbour_processor, k + 1);
     EXPECT_EQ(c.neighbour_processor, k);
     ASSERT_EQ(a.size, c.size);

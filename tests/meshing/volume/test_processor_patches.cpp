@@ -68,8 +68,7 @@ TEST(ProcessorPatches, ThreePiecesMatchTheirSharedPlanesFaceForFace) {
   // Each shared plane: face for face, point for point.
   for (int k = 0; k + 1 < pieces; ++k) {
     const PolyMesh &lower = piece[k], &upper = piece[k + 1];
-    const auto& a = test_support::patch_named(lower, "procBoundary" + std::to_string(k) + "to" + std::to_string(k + 1));
-    const auto& c = test_support::patch_named(upper, "procBoundary" + std::to_string(k + 1) + "to" + std::to_string(k));
+    const auto [a, c] = test_support::facing_patches(lower, upper, k);
     EXPECT_EQ(a.neighbour_processor, k + 1);
     EXPECT_EQ(c.neighbour_processor, k);
     ASSERT_EQ(a.size, c.size);
