@@ -196,3 +196,14 @@ TEST(Scene, ATargetVoidFractionMakesAPeriodicSection) {
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
   }
 }
+
+// The cluster guide's scene (docs/cluster.md), which no test can run here (1e5 spheres on 256
+// ranks), is read as a case in pieces is: its keys exist and its settings are ones pieces allow.
+TEST(Scene, TheClusterGuidesSceneIsACaseInPieces) {
+  const Scene s = read_scene_file(std::filesystem::path(BEDFORGE_SOURCE_DIR) / "docs/cluster/column_1e5.toml");
+  EXPECT_EQ(s.count, 100000);
+  EXPECT_EQ(s.mesh.pieces, 256);
+  EXPECT_EQ(s.surface.treatment, meshing::SurfaceParams::Treatment::shrink);
+  EXPECT_TRUE(s.wants("case"));
+  EXPECT_TRUE(s.case_params.run);
+}
