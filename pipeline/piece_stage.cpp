@@ -53,8 +53,7 @@ meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const s
     const fs::file_time_type at = fs::last_write_time(path, ec);
     if (!ec && at != seen) {
       seen = at;
-      meshing::PlaneLayer layer = meshing::read_plane_layer(path);
-      if (layer.tag == job) return layer;
+      if (meshing::read_plane_layer_tag(path) == job) return meshing::read_plane_layer(path);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }

@@ -27,19 +27,12 @@ void set_faces(PolyhedralMesh& m, int first, const std::vector<std::vector<int>>
   }
 }
 
-template <class Mesh>
-PolyMesh::Patch& patch_named(Mesh& m, const std::string& name) {
-  for (auto& p : m.patches)
-    if (p.name == name) return p;
-  throw std::runtime_error(fmt::format("cyclic patches: the mesh has no patch {}", name));
-}
-
 }  // namespace
 
 template <class Mesh>
 double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::string& upper_name) {
-  PolyMesh::Patch& lower = patch_named(m, lower_name);
-  PolyMesh::Patch& upper = patch_named(m, upper_name);
+  PolyMesh::Patch& lower = m.patches[patch_number(m, lower_name)];
+  PolyMesh::Patch& upper = m.patches[patch_number(m, upper_name)];
   using XY = std::pair<double, double>;
   auto xy = [&](int p) { return XY{m.points[p].x(), m.points[p].y()}; };
   // The lower patch's points by x and y, and each lower face by its sorted points.

@@ -19,12 +19,6 @@ namespace bedforge::meshing {
 
 namespace {
 
-int patch_index(const PolyMesh& m, const std::string& name) {
-  for (std::size_t k = 0; k < m.patches.size(); ++k)
-    if (m.patches[k].name == name) return static_cast<int>(k);
-  throw std::runtime_error(fmt::format("dual pieces: the slab has no {} patch", name));
-}
-
 constexpr char kMagic[] = "bedforge plane layer 1\n";
 
 template <class T>
@@ -50,10 +44,20 @@ bool get_string(std::istream& in, std::string& s) {
   return true;
 }
 
+// The layer file's magic and tag into `tag`; false when it is not there.
+bool read_layer_header(std::istream& in, std::string& tag) {
+  std::string magic(sizeof kMagic - 1, '\0');
+  return in.read(magic.data(), static_cast<std::streamsize>(magic.size())) && magic == kMagic && get_string(in, tag);
+}
+
+InputError not_a_layer(const std::filesystem::path& path) {
+  return InputError(fmt::format("{}: not a plane layer bedforge wrote, or cut short", path.string()));
+}
+
 }  // namespace
 
 PlaneLayer plane_layer(const PolyMesh& m, const std::string& plane, int rings) {
-  const int on_plane = patch_index(m, plane);
+  const int on_plane = patch_number(m, plane);
   const std::vector<VolumeCell> tets = tetrahedra(m);
   // Ring by ring: the tetrahedra touching the plane, then those touching their points, ...
   std::vector<char> ring(m.points.size(), 0), in(tets.size(), 0);
@@ -131,17 +135,22 @@ void write_plane_layer(const std::filesystem::path& path, const PlaneLayer& laye
   });
 }
 
+std::string read_plane_layer_tag(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string tag;
+  if (!read_layer_header(in, tag)) throw not_a_layer(path);
+  return tag;
+}
+
 PlaneLayer read_plane_layer(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   PlaneLayer layer;
-  std::string magic(sizeof kMagic - 1, '\0');
   std::uint64_t names = 0;
-  bool ok = in.read(magic.data(), static_cast<std::streamsize>(magic.size())) && magic == kMagic &&
-            get_string(in, layer.tag) && in.read(reinterpret_cast<char*>(&names), sizeof names) && names < 1000;
+  bool ok = read_layer_header(in, layer.tag) && in.read(reinterpret_cast<char*>(&names), sizeof names) && names < 1000;
   for (std::uint64_t k = 0; ok && k < names; ++k) ok = get_string(in, layer.names.emplace_back());
   ok = ok && get_vector(in, layer.points) && get_vector(in, layer.cells) && get_vector(in, layer.boundary) &&
        get_vector(in, layer.patch) && layer.patch.size() == layer.boundary.size();
-  if (!ok) throw InputError(fmt::format("{}: not a plane layer bedforge wrote, or cut short", path.string()));
+  if (!ok) throw not_a_layer(path);
   return layer;
 }
 
@@ -160,7 +169,7 @@ SlabWithLayers slab_with_layers(const PolyMesh& slab, const PlaneLayer* below, c
     types.push_back(name == kLayerEdge ? "patch" : patch_type(name));
     return static_cast<int>(names.size()) - 1;
   };
-  const int inlet = patch_index(slab, "inlet"), outlet = patch_index(slab, "outlet");
+  const int inlet = patch_number(slab, "inlet"), outlet = patch_number(slab, "outlet");
   // The slab's own boundary, but for the planes the layers close.
   for (int k = 0; k < static_cast<int>(slab.patches.size()); ++k) {
     if ((k == inlet && below) || (k == outlet && above)) continue;

@@ -44,9 +44,11 @@ PlaneLayer whole_slab(const PolyMesh& slab);
 PolyMesh slab_of(const PlaneLayer& whole);
 
 // A layer as a binary file (written through a temporary file and a rename, so a reader never
-// sees half of one) and read back; InputError naming the file when it cannot be read.
+// sees half of one) and read back, whole or its tag alone (which run wrote it, without reading
+// its cells); InputError naming the file when it cannot be read.
 void write_plane_layer(const std::filesystem::path& path, const PlaneLayer& layer);
 PlaneLayer read_plane_layer(const std::filesystem::path& path);
+std::string read_plane_layer_tag(const std::filesystem::path& path);
 
 // A slab with its neighbours' layers joined on: the tetrahedra of all three, the planes between
 // them internal, the layers' faces towards the rest of their slabs in patch kLayerEdge (last).

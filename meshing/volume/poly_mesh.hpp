@@ -5,6 +5,7 @@
 #include <array>
 #include <initializer_list>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,18 @@ struct PolyhedralMesh {
   int cells = 0;
   int internal_faces() const { return static_cast<int>(neighbour.size()); }
 };
+
+// The index of `mesh`'s patch called `name` (PolyMesh or PolyhedralMesh); std::runtime_error
+// naming the patch and the patches there are when it has none.
+template <class Mesh>
+int patch_number(const Mesh& mesh, const std::string& name) {
+  std::string there;
+  for (std::size_t k = 0; k < mesh.patches.size(); ++k) {
+    if (mesh.patches[k].name == name) return static_cast<int>(k);
+    there += (k ? ", " : "") + mesh.patches[k].name;
+  }
+  throw std::runtime_error("the mesh has no patch `" + name + "` (its patches: " + there + ")");
+}
 
 // Face f's point labels, whichever way the mesh stores its faces.
 inline std::vector<int> points_of(const PolyMesh& m, int f) { return {m.faces[f].begin(), m.faces[f].end()}; }

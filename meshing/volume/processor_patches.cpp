@@ -45,12 +45,7 @@ void order_processor_faces(const std::vector<Eigen::Vector3d>& points, Processor
 void make_processor_patches(PolyMesh& m, int piece, int pieces) {
   if (piece < 0 || piece >= pieces)
     throw std::runtime_error(fmt::format("processor patches: piece {} of {} does not exist", piece, pieces));
-  auto index = [&](const std::string& name) {
-    for (std::size_t k = 0; k < m.patches.size(); ++k)
-      if (m.patches[k].name == name) return static_cast<int>(k);
-    throw std::runtime_error(fmt::format("processor patches: piece {} has no {} patch", piece, name));
-  };
-  const int inlet = index("inlet"), outlet = index("outlet");
+  const int inlet = patch_number(m, "inlet"), outlet = patch_number(m, "outlet");
   std::vector<ProcessorPatch> out;
   ProcessorPatch below = processor_patch(piece, piece - 1), above = processor_patch(piece, piece + 1);
   for (int k = 0; k < static_cast<int>(m.patches.size()); ++k) {

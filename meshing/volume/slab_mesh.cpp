@@ -117,12 +117,6 @@ struct Joined {
       for (int j = 0; j < c.n; ++j) c.v[j] = global[c.v[j]];
     cells.insert(cells.end(), slab_cells.begin(), slab_cells.end());
   }
-
-  static int patch_number(const PolyMesh& m, const std::string& name) {
-    for (std::size_t p = 0; p < m.patches.size(); ++p)
-      if (m.patches[p].name == name) return static_cast<int>(p);
-    throw std::runtime_error(fmt::format("volume mesh: a slab has no `{}` patch", name));
-  }
 };
 
 // The joined mesh as gmsh's MSH 2.2, binary (a third of the text's size, and no number
