@@ -147,16 +147,19 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const meshing::SurfaceParams surface = read_surface_sections(d.scene);
   const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
-  // Before any meshing: this machine's ranks' pieces must fit in its memory.
+  // Before any meshing: this machine's ranks' pieces must fit in its memory. The estimate and
+  // the planes between the pieces come from one sampling of the bed's gaps.
+  const meshing::FluidDomainProfile profile = meshing::slab_profile(d.bed, surface, pieces, kEstimateVolumePerCell);
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-  refuse_pieces_beyond_memory(estimate_mesh(surface, mesh, params, d.bed), pieces, local ? std::atoi(local) : 1,
-                              available_memory_bytes());
+  refuse_pieces_beyond_memory(estimate_mesh(surface, mesh, params, profile.size, reference_diameter(d.bed)), pieces,
+                              local ? std::atoi(local) : 1, available_memory_bytes());
   // The seed from bed.csv: a run starts its ranks before it writes report.json.
   const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());
   const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", kVersion,
                                        seed.is_number() ? std::to_string(seed.get<unsigned long long>()) : "none",
                                        piece, pieces);
-  const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface, mesh, params, piece,
+  const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface,
+                                       meshing::slab_planes_d(d.bed, surface, profile, pieces), mesh, params, piece,
                                        pieces, dir / "case", note, console);
   console.line(fmt::format("piece {} of {}: {} cells in {}{}", piece, pieces, r["cells"].get<long>(),
                            (dir / "case" / fmt::format("processor{}", piece)).string(),

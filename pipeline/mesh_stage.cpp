@@ -52,7 +52,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 
 namespace {
 
-constexpr double kDensestVoidFraction = 0.36, kVolumePerCell = 0.24;
+constexpr double kDensestVoidFraction = 0.36;
 // simpleFoam's two processes held together 897 and 1038 bytes per tetrahedron on the polyhedral
 // dual, 1300 and 1431 on the tetrahedra themselves (5.95 M and 2.73 M tetrahedra, 2026-11-28,
 // docs/findings.md): as much as the mesh stage or more.
@@ -66,7 +66,7 @@ MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::Vo
   MeshEstimate e;
   e.fluid_volume_m3 = fluid_volume_m3;
   e.gap_cells = gap_cells;
-  e.cells = fluid_volume_m3 / (kVolumePerCell * h * h * h) + gap_cells;
+  e.cells = fluid_volume_m3 / (kEstimateVolumePerCell * h * h * h) + gap_cells;
   e.mesh_peak_bytes = e.cells * mesh_bytes;
   const double solver_bytes = c.polyhedra ? kSolverBytesPerCellDual : kSolverBytesPerCellTetrahedra;
   e.peak_bytes = solver ? e.cells * solver_bytes : e.mesh_peak_bytes;
@@ -119,9 +119,15 @@ MeshEstimate estimate_mesh(const Scene& scene) {
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d) {
+  return with_cells(surface, mesh, case_params, fluid.volume_m3, fluid.gap_cells, d);
+}
+
+MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, const Bed& bed) {
-  const meshing::FluidDomainSize f = meshing::fluid_domain_size(bed, surface, kVolumePerCell);
-  return with_cells(surface, mesh, case_params, f.volume_m3, f.gap_cells, reference_diameter(bed));
+  return estimate_mesh(surface, mesh, case_params,
+                       meshing::fluid_domain_profile(bed, surface, kEstimateVolumePerCell, 1).size,
+                       reference_diameter(bed));
 }
 
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {

@@ -38,7 +38,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 per cell of the empty tube's meshes, 0.20-0.24 h^3 from 0.2 d to 0.07 d; beds
 //                 have more, being refined at contacts: a = 10, N = 4000 at 0.1 d made 8.65 M
 //                 cells where this gives 5.6 M); once the bed is packed, plus the cells its
-//                 narrow gaps add with surface.cells_per_gap (meshing::fluid_domain_size;
+//                 narrow gaps add with surface.cells_per_gap (meshing::fluid_domain_profile;
 //                 gmsh made 1.03-1.39 times these cells in nine runs with cells_per_gap 3-8,
 //                 docs/findings.md);
 //   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
@@ -62,6 +62,12 @@ MeshEstimate estimate_mesh(const Scene& scene);
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, const Bed& bed);
+// The same from the fluid domain's size as meshing::fluid_domain_profile gives it at
+// kEstimateVolumePerCell (m^3, cells), `d` the bed's reference diameter (m).
+MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d);
+// The estimate's volume per cell in the bulk, edge^3 (above).
+inline constexpr double kEstimateVolumePerCell = 0.24;
 // The console's line for `e` against `available_bytes`, and its report entry (stages.mesh.estimate).
 std::string estimate_line(const MeshEstimate& e, double available_bytes);
 nlohmann::json to_json(const MeshEstimate& e);

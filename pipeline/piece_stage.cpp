@@ -62,10 +62,12 @@ meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const s
 }  // namespace
 
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
-                           const meshing::VolumeMeshParams& mesh, const cases::CaseParams& case_params, int piece,
-                           int pieces, const std::filesystem::path& case_dir, const std::string& note,
-                           const Console& console) {
+                           const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, int piece, int pieces,
+                           const std::filesystem::path& case_dir, const std::string& note, const Console& console) {
   const StageMeter meter;
+  if (static_cast<int>(planes.size()) + 1 != pieces)
+    throw std::invalid_argument(fmt::format("piece stage: {} planes for {} pieces", planes.size(), pieces));
   if (!std::filesystem::is_directory(case_dir / "0"))
     throw InputError(fmt::format("{}: no case to write a piece into (no 0/ fields); write the case first, e.g. "
                                  "`bedforge run` with case.run = false",
@@ -104,14 +106,13 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   // On polyhedra the dual is made again (its neighbours' may be new), from the tetrahedra kept.
   const fs::path kept = layer_path(case_dir, piece, "tetrahedra");
   meshing::VolumeMesh slab;
-  if (case_params.polyhedra && fs::exists(kept)) {
+  if (case_params.polyhedra && fs::exists(kept) && meshing::read_plane_layer_tag(kept) == cells_key) {
     progress.update(fmt::format("piece {} of {}: an earlier run's cells", piece + 1, pieces));
-    const meshing::PlaneLayer earlier = meshing::read_plane_layer(kept);
-    if (earlier.tag == cells_key) slab.mesh = meshing::slab_of(earlier), slab.report = {{"reused", true}};
+    slab.mesh = meshing::slab_of(meshing::read_plane_layer(kept)), slab.report = {{"reused", true}};
   }
   if (slab.mesh.cells == 0) {
     progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
-    slab = meshing::mesh_slab(bed, surface, meshing::slab_planes_d(bed, surface, pieces), piece, d, mesh,
+    slab = meshing::mesh_slab(bed, surface, planes, piece, d, mesh,
                               case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
     if (case_params.polyhedra) {
       meshing::PlaneLayer all = meshing::whole_slab(slab.mesh);

@@ -13,7 +13,8 @@
 namespace bedforge::pipeline {
 
 // One piece of a decomposed case, the work of one rank: slab `piece` (from 0, bottom up) of
-// `pieces` of the fluid domain of `bed` under `surface` (meshing::mesh_slab with `mesh`), written
+// `pieces` of the fluid domain of `bed` under `surface`, between `planes` (d, pieces - 1 of them,
+// meshing::slab_planes_d; meshing::mesh_slab with `mesh`), written
 // as case_dir/processor<piece> (cases::write_case_piece; the case's 0/ must be written) with
 // processor patches to the neighbouring pieces. On gmsh's cells: the slab's, its planes made
 // processor patches (meshing::make_processor_patches). On their polyhedral dual
@@ -33,9 +34,9 @@ namespace bedforge::pipeline {
 // plane (meshing::slabs_possible), or a piece on polyhedra made alone finds no neighbour's layer;
 // the errors of mesh_slab otherwise, naming the piece.
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
-                           const meshing::VolumeMeshParams& mesh, const cases::CaseParams& case_params, int piece,
-                           int pieces, const std::filesystem::path& case_dir, const std::string& note,
-                           const Console& console);
+                           const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, int piece, int pieces,
+                           const std::filesystem::path& case_dir, const std::string& note, const Console& console);
 
 // The inlet's and outlet's heights (m) of the fluid domain of `bed` under `surface` (its clip
 // window's ends when it has one), as its pieces and the case that holds them take them.

@@ -181,25 +181,14 @@ LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
 
 }  // namespace
 
-FluidDomainSize fluid_domain_size(const Bed& given, const SurfaceParams& p, double volume_per_cell) {
-  const LaidOut laid = lay_out(given, p);
-  const Bed& bed = laid.bed();
-  const TreatedBed& tb = laid.treated;
-  FluidDomainSize s;
-  s.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
-  const std::optional<GapSpacing> gaps = gap_spacing(p, reference_diameter(bed), bed.centres, tb.radius, tb.kept,
-                                                     *bed.container);
-  if (gaps) s.gap_cells = gaps->added_cells(volume_per_cell, tb.planes.z0, tb.planes.z1);
-  return s;
-}
-
 FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p, double volume_per_cell, int bins) {
   const LaidOut laid = lay_out(given, p);
   const Bed& bed = laid.bed();
   const TreatedBed& tb = laid.treated;
-  FluidDomainProfile out{tb.planes.z0, tb.planes.z1, {}};
+  FluidDomainProfile out{{}, tb.planes.z0, tb.planes.z1, {}};
+  out.size.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
   const double d = reference_diameter(bed), edge = p.edge_length_d * d, height = (out.z1 - out.z0) / bins;
-  const double per_volume = 1.0 / (volume_per_cell * edge * edge * edge);
+  const double per_volume = 1.0 / (edge * edge * edge);
   // The fluid: each bin's cross-section less the spheres' slices in it; and the surfaces' cells,
   // the walls' and the spheres' zones (2 pi r times the zone's height).
   const double per_area = kCellsPerSurfaceEdgeSquared / (edge * edge);
@@ -217,8 +206,9 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   }
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);
   if (gaps) {
-    const std::vector<double> added = gaps->added_cells_profile(volume_per_cell, out.z0, out.z1, bins);
-    for (int b = 0; b < bins; ++b) out.cells[b] += added[b];
+    // The added cells go as one over the volume per cell (GapSpacing::added_cells_profile).
+    const std::vector<double> added = gaps->added_cells_profile(1.0, out.z0, out.z1, bins);
+    for (int b = 0; b < bins; ++b) out.cells[b] += added[b], out.size.gap_cells += added[b] / volume_per_cell;
   }
   return out;
 }

@@ -64,29 +64,29 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
                                       const std::vector<double>& radii, const std::vector<char>& kept,
                                       const Container& container);
 
-// The fluid domain of `bed` under `p`, known before its surface is meshed: the treated bed's
-// exact fluid volume (m^3) and the tetrahedra its narrow gaps add to a mesh of the surface edge
-// everywhere (GapSpacing::added_cells with `volume_per_cell`; 0 without cells_per_gap).
-// Throws treat_contacts's InputErrors.
+// The fluid domain of `bed` under `p`, known before its surface is meshed, from one sampling of
+// its narrow gaps. Throws treat_contacts's InputErrors.
+//   size   the treated bed's exact fluid volume (m^3) and the tetrahedra its narrow gaps add to a
+//          mesh of the surface edge everywhere (GapSpacing::added_cells at `volume_per_cell`
+//          edge^3 per cell; 0 without cells_per_gap): what the mesh estimate takes;
+//   cells  along the height, `bins` bins of equal height from the inlet z0 to the outlet z1 (m),
+//          each with a weight for the cells a mesh would have there (no unit): the fluid volume
+//          over one edge^3 (the spheres at their treated radii, bridges and caps left out), plus
+//          kCellsPerSurfaceEdgeSquared per edge^2 of the spheres' and walls' area (cells next to
+//          a surface are smaller than in the bulk), plus the gaps' added cells at one edge^3 per
+//          cell. What pieces of about equal cells are cut from; only the weights' ratios matter.
+// kCellsPerSurfaceEdgeSquared is a calibration, of the surface term against the volume's one
+// per edge^3: on a = 4, N = 80, 0.2 d, no gap rule, 3 d empty ends, the packed bed's heights held
+// 2.1 times the cells its fluid volume gives at 0.24 edge^3 per cell and the empty ends 1.25
+// times (2026-11-29, docs/findings.md), and 4 made the slabs' cells about even; validated on
+// other beds in docs/mesh_case_benchmark.md (weak scaling: the ranks' cells).
+inline constexpr double kCellsPerSurfaceEdgeSquared = 4.0;
 struct FluidDomainSize {
   double volume_m3 = 0.0;
   double gap_cells = 0.0;
 };
-FluidDomainSize fluid_domain_size(const Bed& bed, const SurfaceParams& p, double volume_per_cell);
-
-// The same along the fluid domain's height: `bins` bins of equal height from its inlet z0 to its
-// outlet z1 (m), each with the cells a mesh of the surface edge would have there (a count per
-// bin, no unit): the fluid volume over volume_per_cell x edge^3 (the spheres at their treated
-// radii, bridges and caps left out), plus kCellsPerSurfaceEdgeSquared per edge^2 of the spheres'
-// and walls' area (cells next to a surface are smaller than in the bulk), plus those its narrow
-// gaps add. What pieces of about equal cells are cut from.
-// kCellsPerSurfaceEdgeSquared is a calibration: on a = 4, N = 80, 0.2 d, no gap rule, 3 d empty
-// ends, the packed bed's heights held 2.1 times the cells its fluid volume gives at 0.24 edge^3
-// per cell and the empty ends 1.25 times (2026-11-29, docs/findings.md), which 4 cells per edge^2
-// of surface makes about even; validated on other beds in docs/mesh_case_benchmark.md (weak
-// scaling: the ranks' cells).
-inline constexpr double kCellsPerSurfaceEdgeSquared = 4.0;
 struct FluidDomainProfile {
+  FluidDomainSize size;
   double z0 = 0.0, z1 = 0.0;  // m
   std::vector<double> cells;  // bins
 };

@@ -36,7 +36,7 @@ class GapSpacing {
   // walls' side of their gaps and the cells gmsh grades between patches are left out.
   double added_cells(double volume_per_cell, double z0, double z1) const;
   // The same in `bins` bins of equal height from z0 to z1, each counting the surface samples in
-  // it (bins x 1).
+  // it (bins x 1). Both are proportional to 1 / volume_per_cell.
   std::vector<double> added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const;
 
  private:

@@ -163,16 +163,23 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const Volu
   return std::max(1, static_cast<int>(std::ceil(static_cast<double>(surface_triangles) / kSurfaceTrianglesPerSlab)));
 }
 
+FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& s, int slabs, double volume_per_cell) {
+  const double span_d = (s.clip ? s.clip_top_d - s.clip_bottom_d
+                                : bed_height(bed) / reference_diameter(bed) + s.inlet_length_d + s.outlet_length_d);
+  const int bins = std::clamp(static_cast<int>(std::ceil(span_d / 0.02)), 100 * std::max(slabs, 1), 1 << 22);
+  return fluid_domain_profile(bed, s, volume_per_cell, bins);
+}
+
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int slabs) {
+  return slabs < 2 ? std::vector<double>{} : slab_planes_d(bed, s, slab_profile(bed, s, slabs, 1.0), slabs);
+}
+
+std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const FluidDomainProfile& profile,
+                                  int slabs) {
   std::vector<double> planes;
   if (slabs < 2) return planes;
   const double d = reference_diameter(bed);
-  // The estimated cells along the domain in bins of 0.02 d (at least 100 per slab); the volume
-  // per cell scales every bin alike, so any will do for the split.
-  const double span_d = (s.clip ? s.clip_top_d - s.clip_bottom_d
-                                : bed_height(bed) / d + s.inlet_length_d + s.outlet_length_d);
-  const int bins = std::clamp(static_cast<int>(std::ceil(span_d / 0.02)), 100 * slabs, 1 << 22);
-  const FluidDomainProfile profile = fluid_domain_profile(bed, s, 1.0, bins);
+  const int bins = static_cast<int>(profile.cells.size());
   std::vector<double> below(bins + 1, 0.0);  // cells below each bin's bottom
   std::partial_sum(profile.cells.begin(), profile.cells.end(), below.begin() + 1);
   const double height = (profile.z1 - profile.z0) / bins;

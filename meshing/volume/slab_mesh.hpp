@@ -33,8 +33,13 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 // gaps add), each plane then moved within surface.clip_shift_d to the middle of the widest
 // interval between the spheres' tops and bottoms (at their own and their shrunk radius): a plane
 // just clear of a sphere's top cuts it in a thin cap and leaves an acute wedge of fluid beside
-// it. Empty when slabs < 2.
+// it. Empty when slabs < 2. The second form takes the profile slab_profile made for as many slabs.
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
+std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, const FluidDomainProfile& profile,
+                                  int slabs);
+// The fluid domain's profile (fluid_domain_profile, its size at `volume_per_cell`) in bins fine
+// enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab.
+FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, int slabs, double volume_per_cell);
 
 // The surface parameters of slab `k` (from 0, bottom up) between `planes` (slab_planes_d): a clip
 // window from the plane below it to the plane above it, the whole domain's ends (or the scene's
