@@ -194,11 +194,21 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     const int status = std::system(cmd.c_str());
     progress.finish();
     if (status != 0) {
-      // A rank's own message says which piece and why.
+      // A rank's own message says which piece and why; or mpirun's, that it had too few slots.
       std::ifstream in(log);
       std::string line, said;
-      while (std::getline(in, line))
+      bool too_few_slots = false;
+      while (std::getline(in, line)) {
         if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
+        too_few_slots = too_few_slots || line.find("not enough slots available") != std::string::npos;
+      }
+      if (too_few_slots)
+        throw InputError(fmt::format(
+            "mesh.pieces = {}: mpirun has fewer slots than {} ranks here (see {}); allowed: mesh.pieces at most the "
+            "slots (this machine's cores, or the batch job's tasks), or more ranks than cores with "
+            "OMPI_MCA_rmaps_base_oversubscribe=1 in the environment (each rank still holds only its piece; the "
+            "ranks share the cores)",
+            pieces, pieces, log.string()));
       // Stopped as the rank stopped: bad input, a gate not passed, or a defect.
       const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
                                            self.filename().string(), said.empty() ? "no rank said why" : said,

@@ -47,8 +47,9 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
 // one (std::runtime_error otherwise). The ranks' files (case/piece_layers) are removed once all
-// have succeeded; a failed run leaves them for the next, which remakes only the failed pieces. Set
-// OMPI_MCA_rmaps_base_oversubscribe=1 for more ranks than cores.
+// have succeeded; a failed run leaves them for the next, which remakes only the failed pieces.
+// InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
+// need OMPI_MCA_rmaps_base_oversubscribe=1).
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console);
 

@@ -169,6 +169,22 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
   EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
 }
 
+// More ranks than mpirun has slots (cores, or a batch job's tasks): the run says so, naming
+// mesh.pieces and how to run more ranks than cores, not as an internal error.
+TEST(PieceStage, MoreRanksThanMpirunHasSlotsAreRefusedNamingThePieces) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
+  const fs::path dir = fresh_dir("piece_slots"), scene = fresh_dir("piece_slots_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml") << kScene << "run = false\n[mesh]\npieces = 4096\n";
+  const Result r = shell(kOpenFoam + "env -u OMPI_MCA_rmaps_base_oversubscribe " + BEDFORGE_BINARY + " --quiet run " +
+                         (scene / "s.toml").string() + " -o " + dir.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("mesh.pieces = 4096: mpirun has fewer slots than 4096 ranks here"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("OMPI_MCA_rmaps_base_oversubscribe=1"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "case/processor0"));
+}
+
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
 // no case to write into, pieces beyond the machine's memory, a piece on polyhedra made without
 // its neighbours, and contacts a plane would cut open; no processor directory is left.
