@@ -6,6 +6,31 @@
 
 namespace bedforge::pipeline {
 
+namespace {
+
+// Runs the written case `out.info` and adds its flow to `out` and to the stage's `line`.
+void run_flow(CaseStage& out, std::string& line, const Console& console) {
+  Progress progress("case", console.progress);
+  const cases::FlowResult& flow = out.flow.emplace(cases::run_case(out.info, progress));
+  out.report["flow"] = flow.to_json();
+  if (flow.solved_cells != out.info.cells) line += fmt::format("; solved on {} cells ({})", flow.solved_cells, flow.mesher);
+  if (flow.volume_lost) line += fmt::format(", {:.1f} % of the surface's fluid volume lost", 100.0 * *flow.volume_lost);
+  line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = ",
+                      flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
+                      flow.residual_p, flow.pressure_gradient_bed_pa_m);
+  if (flow.exact_pa_m)
+    line += fmt::format("the exact {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
+  else
+    line += fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps", flow.ratio_to_eisfeld_schnitzlein_bed);
+  if (flow.ratio_to_eisfeld_schnitzlein)
+    line += fmt::format(" ({:.3f} x at the meshed eps)", *flow.ratio_to_eisfeld_schnitzlein);
+  line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.wall_share_of_drag);
+  if (!flow.exact_pa_m)
+    line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);
+}
+
+}  // namespace
+
 CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_ptr<const meshing::TriangleMesh> surface,
                      const Bed& bed,
                      const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
@@ -53,27 +78,16 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
     line += fmt::format(", bed section eps {:.4f}", out.info.section.void_fraction_bed);
     if (out.info.section.void_fraction) line += fmt::format(" (meshed {:.4f})", *out.info.section.void_fraction);
   }
-  if (p.run) {
-    Progress progress("case", console.progress);
-    const cases::FlowResult& flow = out.flow.emplace(cases::run_case(out.info, progress));
-    out.report["flow"] = flow.to_json();
-    if (flow.solved_cells != out.info.cells) line += fmt::format("; solved on {} cells ({})", flow.solved_cells, flow.mesher);
-    if (flow.volume_lost) line += fmt::format(", {:.1f} % of the surface's fluid volume lost", 100.0 * *flow.volume_lost);
-    line += fmt::format("; simpleFoam {} in {} iterations (residuals U {:.1e}, p {:.1e}), dp/L {:.4g} Pa/m = ",
-                        flow.converged ? "converged" : "NOT converged", flow.iterations, flow.residual_u,
-                        flow.residual_p, flow.pressure_gradient_bed_pa_m);
-    if (flow.exact_pa_m)
-      line += fmt::format("the exact {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
-    else
-      line += fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps", flow.ratio_to_eisfeld_schnitzlein_bed);
-    if (flow.ratio_to_eisfeld_schnitzlein)
-      line += fmt::format(" ({:.3f} x at the meshed eps)", *flow.ratio_to_eisfeld_schnitzlein);
-    line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.wall_share_of_drag);
-    if (!flow.exact_pa_m)
-      line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);
-  }
+  if (p.run) run_flow(out, line, console);
   finish_stage(out.report, meter, line, console);
   return out;
+}
+
+void solve_case_stage(CaseStage& written, const Console& console) {
+  const StageMeter meter;
+  std::string line = fmt::format("case: {} solved", written.info.directory.string());
+  run_flow(written, line, console);
+  finish_stage(written.report, meter, line, console);
 }
 
 }  // namespace bedforge::pipeline

@@ -46,4 +46,9 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
                      bool spheres_as_packed, const Console& console, const CasePieces* pieces = nullptr);
 
+// Runs a case that case_stage wrote without running it (a convergence level in pieces, sized on
+// its cells before it is solved): its flow into `written` (flow, report["flow"]) and a stage line
+// of its own, whose time is the solve's.
+void solve_case_stage(CaseStage& written, const Console& console);
+
 }  // namespace bedforge::pipeline

@@ -8,11 +8,13 @@
 #include <exception>
 #include <optional>
 
+#include "core/atomic_file.hpp"
 #include "core/bed_io.hpp"
 #include "core/stage_meter.hpp"
 #include "core/version.hpp"
 #include "pipeline/case_stage.hpp"
 #include "pipeline/mesh_stage.hpp"
+#include "pipeline/piece_stage.hpp"
 #include "pipeline/surface_stage.hpp"
 
 namespace bedforge::pipeline {
@@ -127,6 +129,35 @@ struct Sized {
   double scale, h;
 };
 
+// Where level k's case is: `level_dir` itself; or in a study in pieces level_dir/case, beside
+// the bed.csv and scene.toml (the scene with the level's lengths) that the level's ranks read.
+fs::path level_case_dir(const fs::path& level_dir, bool in_pieces) { return in_pieces ? level_dir / "case" : level_dir; }
+// A file that a solved level's case holds: its cells, or in pieces the first piece's.
+fs::path level_mesh_file(const fs::path& level_dir, bool in_pieces) {
+  return level_case_dir(level_dir, in_pieces) / (in_pieces ? "processor0/constant/polyMesh/owner" : "constant/polyMesh/owner");
+}
+
+// Level k's case written in pieces by ranks of their own (piece_stage.hpp), not run: its bed and
+// its scene with the level's lengths into `level_dir` for the ranks, then the case.
+CaseStage write_level_in_pieces(const Scene& scene, const Bed& bed, const LevelLengths& lengths,
+                                const fs::path& level_dir, const Console& console) {
+  const Provenance prov{kVersion, scene.seed, scene.to_json()};
+  toml::table table = scene.table;
+  apply_overrides(table, {{"surface.edge_length_d", lengths.surface.edge_length_d},
+                          {"surface.contact_edge_length_d", lengths.surface.contact_edge_length_d},
+                          {"surface.cells_per_gap", lengths.surface.cells_per_gap},
+                          {"mesh.max_size_d", lengths.mesh.max_size_d}});
+  const std::string toml_text = scene_to_toml(table);
+  fs::create_directories(level_dir);
+  write_file_atomically(level_dir / "bed.csv", bed_to_csv(bed, prov));
+  write_file_atomically(level_dir / "scene.toml", toml_text);
+  cases::CaseParams params = scene.case_params;
+  params.run = false;  // sized first, solved once
+  const CasePieces pieces = case_pieces(bed, lengths.surface, scene.mesh.pieces, level_dir, console);
+  return case_stage(nullptr, nullptr, bed, params, prov, toml_text, {}, level_dir / "case", true,
+                    scene.surface.keeps_spheres(), console, &pieces);
+}
+
 // Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
 // do not set the cell size in proportion (points per sphere and per contact loop and the wall
 // rules stay), so the scale is searched in log-log secant steps, starting from `finer`
@@ -138,19 +169,28 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
   StudyLevel l;
   l.level = k;
   double scale = finer.scale * std::pow(target_h_m / finer.h, 1.0 / alpha);
+  const bool in_pieces = scene.mesh.pieces > 1;
   try {
     std::optional<MeshStage> m;
+    std::optional<CaseStage> written;  // in pieces: the case the last attempt's ranks wrote
     double surface_mesh_s = 0.0;  // of the last attempt, the mesh solved on
     double last_scale = finer.scale, last_h = finer.h;
     for (int attempt = 1;; ++attempt) {
-      const auto [surface, mesh] = level_lengths(scene, scale);
-      const SurfaceStage s = surface_stage(bed, surface, case_dir.parent_path() / "bad_triangles.vtp", console);
-      m.reset();  // the previous attempt's mesh is not needed any more
-      m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, surface, mesh, {}, case_dir.parent_path() / "bad_cells.vtk",
-                     console);
-      surface_mesh_s = s.report["time_s"].get<double>() + m->report["time_s"].get<double>();
-      const double h = std::cbrt(m->volume->quality.total_volume /
-                                 static_cast<double>(cells_to_solve(m->volume->mesh, scene.case_params.polyhedra)));
+      const LevelLengths lengths = level_lengths(scene, scale);
+      double h = 0.0;
+      if (in_pieces) {
+        written = write_level_in_pieces(scene, bed, lengths, case_dir, console);
+        surface_mesh_s = written->report["time_s"].get<double>();
+        h = std::cbrt(written->info.fluid_volume_m3.value() / static_cast<double>(written->info.cells));
+      } else {
+        const SurfaceStage s = surface_stage(bed, lengths.surface, case_dir.parent_path() / "bad_triangles.vtp", console);
+        m.reset();  // the previous attempt's mesh is not needed any more
+        m = mesh_stage(s.surface->fluid, s.surface->exact_volume_m3, bed, lengths.surface, lengths.mesh, {},
+                       case_dir.parent_path() / "bad_cells.vtk", console);
+        surface_mesh_s = s.report["time_s"].get<double>() + m->report["time_s"].get<double>();
+        h = std::cbrt(m->volume->quality.total_volume /
+                      static_cast<double>(cells_to_solve(m->volume->mesh, scene.case_params.polyhedra)));
+      }
       l.sizing.push_back({scale, h});
       const double off = h / target_h_m - 1.0;
       console.line(fmt::format("convergence: level {}, mesh lengths x {:.3g}: cells of {:.4g} d, {:+.1f} % off the "
@@ -167,10 +207,16 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
     const Provenance prov{kVersion, scene.seed, scene.to_json()};
     cases::CaseParams params = scene.case_params;
     params.snappy = false;  // a coarser level is solved on its gmsh cells only
-    const meshing::PolyMesh* cells = &m->volume->mesh;
-    const CaseStage c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {},
-                                   case_dir, true, scene.surface.keeps_spheres(), console);
-    StudyLevel solved = study_level(c, k, scale, surface_mesh_s);
+    std::optional<CaseStage> c;
+    if (in_pieces) {
+      c = std::move(written);
+      solve_case_stage(*c, console);
+    } else {
+      const meshing::PolyMesh* cells = &m->volume->mesh;
+      c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {}, case_dir,
+                     true, scene.surface.keeps_spheres(), console);
+    }
+    StudyLevel solved = study_level(*c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);
     l = std::move(solved);
   } catch (const std::exception& e) {
@@ -208,13 +254,14 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
     if (earlier.is_object())
       for (const auto& l : earlier.value("levels", nlohmann::json::array()))
         if (l.value("level", 0) == k && l.value("cache_key", "") == key) before = l;
-    if (before.is_object() && !before.contains("failure") && fs::exists(level_dir / "constant/polyMesh/owner")) {
+    if (before.is_object() && !before.contains("failure") && fs::exists(level_mesh_file(level_dir, scene.mesh.pieces > 1))) {
       StudyLevel l = study_level_from_json(before, finest.exact_pa_m);
       l.reused = true;
       finer = {l.sizing.back().first, l.sizing.back().second};
       alpha = l.alpha;
       console.line(fmt::format("convergence: level {} of {} reused from {} ({} cells, dp/L {:.5g} Pa/m)", k, p.levels,
-                               level_dir.string(), l.cells, l.pressure_gradient_pa_m));
+                               level_case_dir(level_dir, scene.mesh.pieces > 1).string(), l.cells,
+                               l.pressure_gradient_pa_m));
       study.levels.push_back(std::move(l));
       continue;
     }

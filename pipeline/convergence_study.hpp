@@ -79,7 +79,9 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
 // solved (study_level(case, 1, 1.0, ...)). Each coarser level k scales the scene's lengths
 // (level_lengths) by the factor that makes its cells ratio^(k - 1) times the size of the
 // finest's (searched: up to 4 surfaces and meshes, to within 3 %), builds its surface and mesh
-// in memory and solves its case in `dir`/level_k. A level that fails (a gate, the solver) is
+// in memory and solves its case in `dir`/level_k; with mesh.pieces > 1 its ranks make it in
+// pieces instead (case_pieces), from the bed and the scene with the level's lengths written to
+// `dir`/level_k, its case in `dir`/level_k/case, sized on the pieces' cells and then solved. A level that fails (a gate, the solver) is
 // reported with its reason, and the others go on. A level of `earlier` (the study an earlier
 // run left in `dir`, as to_json wrote it; null for none) with the same cache key, whose case is
 // still there, is taken as it is: adding a level, or going back to fewer, solves nothing again.

@@ -103,10 +103,6 @@ void check_pieces(const Scene& sc) {
     throw InputError(fmt::format("mesh.pieces = {} with case.mesher = \"snappy\" (or case.snappy): the pieces are "
                                  "gmsh's cells; allowed: case.mesher = \"gmsh\"",
                                  n));
-  if (sc.case_params.convergence.levels > 0)
-    throw InputError(fmt::format("mesh.pieces = {} with case.convergence.levels = {}: a study's levels in pieces are not "
-                                 "made yet; allowed: case.convergence.levels = 0, or mesh.pieces = 0",
-                                 n, sc.case_params.convergence.levels));
 }
 
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the

@@ -196,8 +196,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"mesh.pieces",
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
         "piece`, started by the run) as `case/processorK` with processor patches, and solved on as many processes "
-        "without decomposePar; no process holds the whole mesh. 0 or 1: one piece. Shrink or none, no prism layers, "
-        "no convergence study, no snappyHexMesh, no `stl` or `mesh` output (there is no whole surface or mesh)"}},
+        "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise. 0 or 1: one "
+        "piece. Shrink or none, no prism layers, no snappyHexMesh, no `stl` or `mesh` output (there is no whole "
+        "surface or mesh)"}},
       // [mesh.gate]
       {"mesh.gate.max_non_orthogonality_deg", {"quality gate: largest face non-orthogonality (checkMesh's definition)"}},
       {"mesh.gate.max_skewness", {"quality gate: largest skewness (checkMesh's definition)", "1"}},

@@ -30,12 +30,15 @@ const char* kScene =
     "[case]\nprocessors = 2\n";
 
 // `bedforge run` of kScene, the case solved or only written, on `cells`, with `mesh` the [mesh]
-// section (slabs joined by default), into a fresh directory `name`.
+// section (slabs joined by default) and a convergence study of `levels`, into a fresh directory
+// `name`.
 fs::path run(const std::string& name, bool solve, const std::string& cells = "polyhedra",
-             const std::string& mesh = "[mesh]\nslabs = 2\n") {
+             const std::string& mesh = "[mesh]\nslabs = 2\n", int levels = 0) {
   const fs::path dir = fresh_dir(name), scene = fresh_dir(name + "_scene");
   fs::create_directories(scene);
-  std::ofstream(scene / "s.toml") << kScene << (solve ? "run = true\n" : "run = false\n") << "cells = \"" << cells
+  std::string text = kScene;
+  text.replace(text.find("levels = 0"), 10, "levels = " + std::to_string(levels));
+  std::ofstream(scene / "s.toml") << text << (solve ? "run = true\n" : "run = false\n") << "cells = \"" << cells
                                   << "\"\n" << mesh;
   const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
   EXPECT_EQ(r.status, 0) << r.output;
@@ -64,7 +67,11 @@ void expect_gathered(const fs::path& dir, long cells) {
 
 }  // namespace
 
-TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
+// Also a study in pieces: its coarser levels are made by ranks too, each level's case in pieces in
+// its own directory beside the bed and scene its ranks read, each level's cells the size the
+// study asked for (ratio 1.3 between levels, to the study's sizing tolerance of 3 % where its
+// four attempts reached it), and the run ends in the study's grid convergence index.
+TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabsAndItsStudyInPieces) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam, mpirun) not on PATH";
   // The same slabs joined into one mesh, solved on two processes through decomposePar.
   const fs::path joined = run("piece_joined", true);
@@ -73,7 +80,7 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
   const long joined_cells = report["stages"]["case"]["cells"].get<long>();
 
   // mesh.pieces = 2: the run writes the case, two ranks its pieces, and Allrun solves them.
-  const fs::path dir = run("piece_pieces", true, "polyhedra", "[mesh]\npieces = 2\n");
+  const fs::path dir = run("piece_pieces", true, "polyhedra", "[mesh]\npieces = 2\n", 3);
   const auto pieces_report = nlohmann::json::parse(read(dir / "report.json"));
   const auto& c = pieces_report["stages"]["case"];
   EXPECT_FALSE(pieces_report["stages"].contains("mesh")) << "no whole mesh is made";
@@ -117,6 +124,28 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabs) {
   EXPECT_NEAR(said_gradient(read(dir / "case/log.Allrun")), gradient, 1e-5 * gradient);
   // The whole mesh can be gathered from the pieces: reconstructParMesh, then checkMesh on it.
   expect_gathered(dir, cells);
+
+  // The study's levels in pieces.
+  const auto& study = c["convergence"];
+  ASSERT_TRUE(study["complete"].get<bool>()) << study.dump();
+  EXPECT_TRUE(std::isfinite(study["grid_convergence"]["gci_fine"].get<double>())) << study.dump();
+  EXPECT_TRUE(c.contains("answer"));
+  const auto& levels = study["levels"];
+  ASSERT_EQ(levels.size(), 3u);
+  EXPECT_EQ(levels[0]["cells"].get<long>(), cells);
+  for (int k = 1; k < 3; ++k) {
+    const fs::path level = dir / fmt::format("convergence/level_{}", k + 1);
+    for (const char* piece : {"case/processor0", "case/processor1"})
+      EXPECT_TRUE(fs::exists(level / piece / "constant/polyMesh/owner")) << level / piece;
+    EXPECT_TRUE(fs::exists(level / "bed.csv"));
+    EXPECT_FALSE(fs::exists(level / "case/constant/polyMesh/owner")) << "no whole mesh of the level";
+    EXPECT_LT(levels[k]["cells"].get<long>(), levels[k - 1]["cells"].get<long>());
+    EXPECT_TRUE(levels[k]["converged"].get<bool>());
+    const double h = levels[k]["cell_size_m"].get<double>(), wanted = levels[0]["cell_size_m"].get<double>() * std::pow(1.3, k);
+    if (levels[k]["sizing"].size() < 4) {
+      EXPECT_NEAR(h / wanted, 1.0, 0.03) << "level " << k + 1;
+    }
+  }
 }
 
 TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
@@ -224,19 +253,15 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
       << r.output;
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
   // A scene asking for pieces the route cannot make is refused when read, naming mesh.pieces:
-  // the default scene's bridges, then with shrink its convergence study.
+  // the default scene's bridges.
   std::string scene = read(fs::path(BEDFORGE_SOURCE_DIR) / "scenes/default.toml");
   scene.replace(scene.find("algorithm = \"hxt\""), 17, "algorithm = \"hxt\"\npieces = 2");
-  for (const std::string said : {"contacts.treatment and contacts.wall_treatment", "case.convergence.levels = 3"}) {
-    const fs::path out = fresh_dir("piece_refused_run"), file = fresh_dir("piece_refused_scene");
-    fs::create_directories(file);
-    std::ofstream(file / "s.toml") << scene;
-    r = bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
-    EXPECT_EQ(r.status, 2) << r.output;
-    EXPECT_NE(r.output.find("mesh.pieces = 2"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find(said), std::string::npos) << r.output;
-    EXPECT_FALSE(fs::exists(out / "bed.csv"));
-    if (const auto at = scene.find("treatment = \"bridge\""); at != std::string::npos)
-      scene.replace(at, 20, "treatment = \"shrink\"");
-  }
+  const fs::path out = fresh_dir("piece_refused_run"), file = fresh_dir("piece_refused_scene");
+  fs::create_directories(file);
+  std::ofstream(file / "s.toml") << scene;
+  r = bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("mesh.pieces = 2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("contacts.treatment and contacts.wall_treatment"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "bed.csv"));
 }
