@@ -204,14 +204,14 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       last_scale = scale, last_h = h;
       scale *= std::pow(target_h_m / h, 1.0 / alpha);
     }
-    const Provenance prov{kVersion, scene.seed, scene.to_json()};
-    cases::CaseParams params = scene.case_params;
-    params.snappy = false;  // a coarser level is solved on its gmsh cells only
     std::optional<CaseStage> c;
     if (in_pieces) {
       c = std::move(written);
       solve_case_stage(*c, console);
     } else {
+      const Provenance prov{kVersion, scene.seed, scene.to_json()};
+      cases::CaseParams params = scene.case_params;
+      params.snappy = false;  // a coarser level is solved on its gmsh cells only
       const meshing::PolyMesh* cells = &m->volume->mesh;
       c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {}, case_dir,
                      true, scene.surface.keeps_spheres(), console);
@@ -244,6 +244,7 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
   // on (Celik et al. 2008 ask r >= 1.3 of the grids, not of the settings that make them).
   Sized finer{1.0, finest.cell_size_m};
   double alpha = kFirstSizingExponent;
+  const bool in_pieces = scene.mesh.pieces > 1;
   for (int k = 2; k <= p.levels; ++k) {
     const double target = finest.cell_size_m * std::pow(p.ratio, k - 1);
     const fs::path level_dir = dir / fmt::format("level_{}", k);
@@ -254,13 +255,13 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
     if (earlier.is_object())
       for (const auto& l : earlier.value("levels", nlohmann::json::array()))
         if (l.value("level", 0) == k && l.value("cache_key", "") == key) before = l;
-    if (before.is_object() && !before.contains("failure") && fs::exists(level_mesh_file(level_dir, scene.mesh.pieces > 1))) {
+    if (before.is_object() && !before.contains("failure") && fs::exists(level_mesh_file(level_dir, in_pieces))) {
       StudyLevel l = study_level_from_json(before, finest.exact_pa_m);
       l.reused = true;
       finer = {l.sizing.back().first, l.sizing.back().second};
       alpha = l.alpha;
       console.line(fmt::format("convergence: level {} of {} reused from {} ({} cells, dp/L {:.5g} Pa/m)", k, p.levels,
-                               level_case_dir(level_dir, scene.mesh.pieces > 1).string(), l.cells,
+                               level_case_dir(level_dir, in_pieces).string(), l.cells,
                                l.pressure_gradient_pa_m));
       study.levels.push_back(std::move(l));
       continue;

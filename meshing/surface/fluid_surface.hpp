@@ -67,7 +67,7 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
 // The fluid domain of `bed` under `p`, known before its surface is meshed, from one sampling of
 // its narrow gaps. Throws treat_contacts's InputErrors.
 //   size   the treated bed's exact fluid volume (m^3) and the tetrahedra its narrow gaps add to a
-//          mesh of the surface edge everywhere (GapSpacing::added_cells at `volume_per_cell`
+//          mesh of the surface edge everywhere (GapSpacing::added_cells_profile at `volume_per_cell`
 //          edge^3 per cell; 0 without cells_per_gap): what the mesh estimate takes;
 //   cells  along the height, `bins` bins of equal height from the inlet z0 to the outlet z1 (m),
 //          each with a weight for the cells a mesh would have there (no unit): the fluid volume

@@ -68,10 +68,6 @@ double GapSpacing::medial_distance(const Eigen::Vector3d& p, const Eigen::Vector
   return t;
 }
 
-double GapSpacing::added_cells(double volume_per_cell, double z0, double z1) const {
-  return added_cells_profile(volume_per_cell, z0, z1, 1)[0];
-}
-
 std::vector<double> GapSpacing::added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const {
   const double pi = std::acos(-1.0), golden_angle = pi * (3.0 - std::sqrt(5.0));
   const double per_coarsest = 1.0 / (volume_per_cell * coarsest_ * coarsest_ * coarsest_);

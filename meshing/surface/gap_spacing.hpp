@@ -34,9 +34,8 @@ class GapSpacing {
   // same columns at the coarsest edge. The surface is sampled finely enough to resolve the
   // smallest refined patch (radius sqrt(cells_per_gap x finest x radius)). Low on purpose: the
   // walls' side of their gaps and the cells gmsh grades between patches are left out.
-  double added_cells(double volume_per_cell, double z0, double z1) const;
-  // The same in `bins` bins of equal height from z0 to z1, each counting the surface samples in
-  // it (bins x 1). Both are proportional to 1 / volume_per_cell.
+  // Given in `bins` bins of equal height from z0 to z1, each counting the surface samples in it
+  // (bins x 1); proportional to 1 / volume_per_cell.
   std::vector<double> added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const;
 
  private:

@@ -73,11 +73,11 @@ TEST(GapSpacing, AddedCellsMatchTheAxisymmetricIntegral) {
   // after D / (1 + cos t).
   const double wall = axisymmetric([&](double t) { return gap + r * (1.0 - std::cos(t)); },
                                    [&](double t) { return (gap + r * (1.0 - std::cos(t))) / (1.0 + std::cos(t)); });
-  const double lattice = g.added_cells(v, -10.0, 10.0);
+  const double lattice = g.added_cells_profile(v, -10.0, 10.0, 1)[0];
   EXPECT_GT(pair, 1e3);
   // Bound: 1 %; the lattice's error here was 0.023 % when this test was written.
   EXPECT_NEAR(lattice / (2.0 * pair + wall), 1.0, 0.01) << lattice << " " << 2.0 * pair + wall;
   // Only what lies between the heights counts: above the spheres' centres, half (0.497 when
   // this test was written: the lattice is not symmetric about the equator).
-  EXPECT_NEAR(g.added_cells(v, 0.0, 10.0) / lattice, 0.5, 0.02);
+  EXPECT_NEAR(g.added_cells_profile(v, 0.0, 10.0, 1)[0] / lattice, 0.5, 0.02);
 }
