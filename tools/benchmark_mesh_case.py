@@ -75,6 +75,13 @@ periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N
         top (default 2, the central slab of the analysis); then slices of --slice-count spheres packed to the full beds'
         mean central void fraction (a period of about --slice-period d), seed after seed until --slices reach it;
         each bed's finest dp/L, extrapolation, GCI and cells; the slices' mean against the full beds' spread.
+pieces: issue 58's case in pieces: the default bed with shrink in one piece, then in P pieces on P ranks (each of
+        --pieces-ranks): each rank's peak and time, checkMesh in parallel, dp/L on 2 ranks against one piece's.
+pieces_large: the same bed 3 times longer (--pieces-large-spheres spheres), the case written, not solved, in P pieces
+        for each of --pieces-ranks: the per-rank peak against 1/P of one rank's on a bed whose pieces hold more
+        than the 62 spheres per rank the default bed leaves at 8 ranks.
+weak_scaling: --weak-spheres spheres per rank, the column P times longer on P ranks (each of --weak-ranks).
+projection: the largest rank's peak and time, fitted on the pieces sections' ranks, projected to 1e5 and 1e6 spheres.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -100,7 +107,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice", "pieces", "weak_scaling", "projection"]
+            "periodic_slice", "pieces", "pieces_large", "weak_scaling", "projection"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -707,19 +714,20 @@ def one_rank_piece(path, env):
     return time.time() - t0
 
 
-def pieces(tmp, ranks):
-    """Issue 58 on one machine: the default bed with shrink in one piece (mesh stage, then the case
-    stage's dual and the solve), then in P pieces on P ranks (`[mesh] pieces = P`, mpirun oversubscribed
-    where P exceeds the cores): each rank's peak and time, the run's wall time, dp/L on 2 ranks
-    against one piece's. P = 1 is one rank's piece of the one-piece run's case (`bedforge piece`)."""
+def pieces(tmp, ranks, spheres=500, solved=(0, 2)):
+    """Issue 58 on one machine: the default bed with shrink (`spheres` of them) in one piece (mesh stage,
+    then the case stage's dual, and the solve when 0 is in `solved`), then in P pieces on P ranks
+    (`[mesh] pieces = P`, mpirun oversubscribed where P exceeds the cores): each rank's peak and time,
+    the run's wall time, dp/L where P is in `solved` against one piece's. P = 1 is one rank's piece of
+    the one-piece run's case (`bedforge piece`). The one-piece run is left out when `solved` is empty."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
     rows = []
-    for p in [0] + ranks:
-        path = os.path.join(tmp, f"pieces_{p}")
-        wall = timed_run(path, pieces_scene(p if p > 1 else 0, p in (0, 2)), env)
+    for p in ([0] if solved else []) + ranks:
+        path = os.path.join(tmp, f"pieces_{spheres}_{p}")
+        wall = timed_run(path, pieces_scene(p if p > 1 else 0, p in solved, spheres), env)
         rep = json.load(open(os.path.join(path, "report.json")))
         case = rep["stages"]["case"]
-        row = {"pieces": p, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
+        row = {"pieces": p, "spheres": spheres, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
                "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
         if "flow" in case:
             row["dp_pa_m"] = case["flow"]["pressure_gradient_bed_pa_m"]
@@ -791,26 +799,32 @@ def weak_scaling_lines(rows):
 def projection(results):
     """Issue 58's projection to 1e5 and 1e6 spheres on 64 to 1024 ranks, from the pieces section's measured ranks (no
     runs): the largest rank's peak and time fitted as a + b x spheres per rank (least squares over 1 to 8 ranks)."""
-    rows = [r for r in results["pieces"] if r["pieces"] >= 1]
-    spheres = 500  # the pieces section's bed
-    x = [spheres / r["pieces"] for r in rows]
+    rows = [r for key in ("pieces", "pieces_large") for r in results.get(key, []) if r["pieces"] >= 1]
+    x = [r.get("spheres", 500) / r["pieces"] for r in rows]  # rows before the bed size was recorded: 500
     fit = {}
     for key, field in (("peak_mb", "peak_mb"), ("time_s", "time_s")):
         y = [max(k[field] for k in r["ranks"]) for r in rows]
         mx, my = sum(x) / len(x), sum(y) / len(y)
         b = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sum((xi - mx) ** 2 for xi in x)
         fit[key] = {"a": my - b * mx, "b": b, "max_residual": max(abs(yi - (my - b * mx) - b * xi) for xi, yi in zip(x, y))}
+    # A slab's thickness goes as its spheres over the column's cross-section, so a rank's slab is no
+    # thinner than the thinnest measured (the fewest spheres per rank, at the measured a = 5) while
+    # a <= 5 sqrt(spheres per rank / those fewest).
     table = [{"spheres": n, "ranks": p, "per_rank": n / p, "peak_gb": (fit["peak_mb"]["a"] + fit["peak_mb"]["b"] * n / p) / 1024,
-              "time_s": fit["time_s"]["a"] + fit["time_s"]["b"] * n / p}
+              "time_s": fit["time_s"]["a"] + fit["time_s"]["b"] * n / p, "widest_a": 5.0 * math.sqrt(n / p / min(x))}
              for n in (100000, 1000000) for p in (64, 128, 256, 512, 1024)]
-    return {**commit_and_date(), "from": rows[0]["commit"], "fit": fit, "table": table}
+    return {**commit_and_date(), "from": sorted({r["commit"] for r in rows}), "fit": fit, "table": table,
+            "spheres_per_rank": [min(x), max(x)]}
 
 
 def projection_lines(r):
     f = r["fit"]
+    made_from = r["from"] if isinstance(r["from"], str) else ", ".join(r["from"])
+    low, high = r.get("spheres_per_rank", [62, 500])  # results before the range was recorded: the 500-sphere bed's
     lines = ["## Projection past one machine: 1e5 and 1e6 spheres on 64 to 1024 ranks (issue 58)", "",
-             f"Made at {r['commit']} on {r['date']} from the pieces section's ranks (made at {r['from']}), no runs. The "
-             "largest rank's peak and time fitted as a + b x spheres per rank over 1 to 8 ranks: peak "
+             f"Made at {r['commit']} on {r['date']} from the pieces sections' ranks (made at {made_from}), no runs. The "
+             f"largest rank's peak and time fitted as a + b x spheres per rank over 1 to 8 ranks ({low:.0f} to "
+             f"{high:.0f} spheres per rank): peak "
              f"{f['peak_mb']['a']:.0f} MB + {f['peak_mb']['b']:.2f} MB per sphere (largest residual "
              f"{f['peak_mb']['max_residual']:.0f} MB), time {f['time_s']['a']:.0f} s + {f['time_s']['b']:.3f} s per sphere "
              f"(largest residual {f['time_s']['max_residual']:.0f} s; 4 and 8 ranks ran oversubscribed on 2 cores, so "
@@ -818,32 +832,44 @@ def projection_lines(r):
              "gap; a wider column has relatively less wall, about as many cells per sphere), a rank's cost grows with "
              "its spheres alone (its pieces' planes and layers are a few per cent), each rank has one core and its "
              "memory to itself, and the pack stage (one process) and simpleFoam (850 bytes per polyhedron together, "
-             "mesh_stage.hpp) are not counted. Not measured past 500 spheres or 8 ranks.", "",
-             "| spheres | ranks | spheres per rank | largest rank's peak (GB) | its time (s) |", "|---|---|---|---|---|"]
+             f"mesh_stage.hpp) are not counted. Not measured past {high:.0f} spheres per rank or 8 ranks. The pieces are "
+             f"axial slabs, whose thickness goes as the spheres per rank over the column's cross-section: the measured "
+             f"slabs were no thinner than {low:.0f} spheres' worth at a = 5, and the last column gives the widest "
+             "column (a = D / d) whose slabs stay as thick; a wider bed on that many ranks has thinner slabs, more of "
+             "its cost in the planes, and wants blocks (not made yet).", "",
+             "| spheres | ranks | spheres per rank | largest rank's peak (GB) | its time (s) | widest column (a) |",
+             "|---|---|---|---|---|---|"]
     for t in r["table"]:
-        lines.append(f"| {t['spheres']:.0e} | {t['ranks']} | {t['per_rank']:.0f} | {t['peak_gb']:.1f} | {t['time_s']:.0f} |")
+        widest = f"{t['widest_a']:.0f}" if "widest_a" in t else ""
+        lines.append(f"| {t['spheres']:.0e} | {t['ranks']} | {t['per_rank']:.0f} | {t['peak_gb']:.1f} | {t['time_s']:.0f} | "
+                     f"{widest} |")
     lines.append("")
     return lines
 
 
 def pieces_lines(rows):
-    """Issue 58's section: one piece against P pieces on P ranks, and its targets as far as measured."""
-    one = next(r for r in rows if r["pieces"] == 0)
-    mesh_peak = one["stage_peak_mb"].get("mesh", 0.0)
-    lines = ["## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)", "",
-             f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = 500, seed 1, 0.15 d, "
-             "4 cells per gap) with contacts shrunk (the pieces' planes cannot cut bridges yet), one mesh. *One "
-             "piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. *P pieces*: "
-             "`[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each rank meshing "
-             "its slab, making its dual and writing `processorK`; P = 1 is one rank's piece of the one-piece run's "
-             "case. Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up. dp/L on 2 ranks "
-             "(solved in pieces, no decomposePar) against one piece's.", "",
+    """Issue 58's section: one piece (when run) against P pieces on P ranks, and its targets as far as measured."""
+    one = next((r for r in rows if r["pieces"] == 0), None)
+    spheres = rows[0].get("spheres", 500)  # rows before the bed size was recorded: the default bed's
+    title = ("## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)" if one else
+             f"## A case in pieces on a bed of {spheres} spheres: the memory per rank (issue 58)")
+    lines = [title, "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = {spheres}, seed 1, "
+             "0.15 d, 4 cells per gap) with contacts shrunk (the pieces' planes cannot cut bridges yet), one mesh. " +
+             ("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if one else
+              "The case written, not solved. ") +
+             "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
+             "rank meshing its slab, making its dual and writing `processorK`; P = 1 is one rank's piece of the "
+             "one-piece run's case. Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up." +
+             (" dp/L on 2 ranks (solved in pieces, no decomposePar) against one piece's." if one else ""), "",
              "| route | polyhedra | largest rank's peak (MB) | x 1/P of P = 1 | ranks' time (s) | run's wall time (s) | "
              "checkMesh | dp/L (Pa/m) |",
              "|---|---|---|---|---|---|---|---|"]
     single = next((r for r in rows if r["pieces"] == 1), None)
-    lines.append(f"| one piece | {one['cells']} | {mesh_peak:.0f} (mesh stage), {one['stage_peak_mb'].get('case', 0):.0f} "
-                 f"(case stage) | | | {one['wall_s']:.0f} | | {one.get('dp_pa_m', float('nan')):.4g} |")
+    if one:
+        lines.append(f"| one piece | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0.0):.0f} (mesh stage), "
+                     f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | | | {one['wall_s']:.0f} | | "
+                     f"{one.get('dp_pa_m', float('nan')):.4g} |")
     for r in rows:
         if r["pieces"] < 1:
             continue
@@ -858,7 +884,7 @@ def pieces_lines(rows):
               "planes that cut bridges, issue 56):", ""]
     verdict = lambda ok: "**met**" if ok else "**not met**"
     two = next((r for r in rows if r["pieces"] == 2 and "dp_pa_m" in r), None)
-    if two and "dp_pa_m" in one:
+    if two and one and "dp_pa_m" in one:
         change = 100 * (two["dp_pa_m"] / one["dp_pa_m"] - 1)
         lines.append(f"- dp/L on 2 ranks within 0.5 % of one piece's: {change:+.2f} %, {verdict(abs(change) <= 0.5)}; "
                      f"the cells differ by {two['cells'] - one['cells']:+d} ({100 * (two['cells'] / one['cells'] - 1):+.2f} %: "
@@ -1337,6 +1363,8 @@ def write(results):
         lines += slice_lines(results["periodic_slice"])
     if "pieces" in results:
         lines += pieces_lines(results["pieces"])
+    if "pieces_large" in results:
+        lines += pieces_lines(results["pieces_large"])
     if "weak_scaling" in results:
         lines += weak_scaling_lines(results["weak_scaling"])
     if "projection" in results:
@@ -1448,6 +1476,7 @@ def main():
     ap.add_argument("--slice-full-exclude", type=float, default=2.0,
                     help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
     ap.add_argument("--pieces-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces: ranks (pieces) to run")
+    ap.add_argument("--pieces-large-spheres", type=int, default=1500, help="pieces_large: the bed's spheres")
     ap.add_argument("--weak-ranks", type=int, nargs="+", default=[1, 2, 4], help="weak_scaling: ranks (pieces) to run")
     ap.add_argument("--weak-spheres", type=int, default=200, help="weak_scaling: spheres per rank")
     args = ap.parse_args()
@@ -1522,6 +1551,9 @@ def main():
             write(results)
         if "pieces" in args.only:
             results["pieces"] = pieces(tmp, args.pieces_ranks)
+            write(results)
+        if "pieces_large" in args.only:
+            results["pieces_large"] = pieces(tmp, args.pieces_ranks, args.pieces_large_spheres, solved=())
             write(results)
         if "weak_scaling" in args.only:
             results["weak_scaling"] = weak_scaling(tmp, args.weak_ranks, args.weak_spheres)
