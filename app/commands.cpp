@@ -102,6 +102,7 @@ int run_command_line(int argc, char** argv) {
   // One rank's piece of a decomposed case: started by `mpirun -np P bedforge piece DIR`, each
   // process takes its piece from Open MPI's rank unless told.
   int piece = -1, pieces = 0;
+  std::vector<double> planes_d;
   CLI::App* piece_cmd =
       on_directory("piece",
                    "mesh one axial piece of DIR/bed.csv and write it as DIR/case/processorK with processor patches "
@@ -113,6 +114,9 @@ int run_command_line(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   piece_cmd->add_option("--pieces", pieces, "int: the number of pieces (default: OMPI_COMM_WORLD_SIZE)")
       ->check(CLI::PositiveNumber);
+  piece_cmd->add_option("--planes-d", planes_d,
+                        "numbers: the heights of the planes between the pieces, d above the floor, one fewer than the "
+                        "pieces (default: at about equal cells by the mesh estimate)");
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   CLI::App* case_cmd = on_directory("case",
@@ -172,7 +176,7 @@ int run_command_line(int argc, char** argv) {
     from_mpi(pieces, "--pieces", "OMPI_COMM_WORLD_SIZE");
     if (piece >= pieces)
       throw InputError(fmt::format("--piece {}: allowed: 0 to {} (--pieces {})", piece, pieces - 1, pieces));
-    pipeline::piece_directory(dir, flags.overrides(), piece, pieces, console);
+    pipeline::piece_directory(dir, flags.overrides(), piece, pieces, planes_d, console);
   }
 #endif
 #ifdef BEDFORGE_HAVE_GMSH

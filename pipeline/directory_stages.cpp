@@ -142,13 +142,15 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 void piece_directory(const fs::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
-                     const Console& console) {
+                     const std::vector<double>& planes_d, const Console& console) {
   Directory d = open_directory(dir, overrides);
   const meshing::SurfaceParams surface = read_surface_sections(d.scene);
   const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
-  // Before any meshing: this machine's ranks' pieces must fit in its memory. The estimate and
-  // the planes between the pieces come from one sampling of the bed's gaps.
+  // Before any meshing: the planes given must lie inside the fluid domain, and this machine's
+  // ranks' pieces must fit in its memory. The estimate and the planes between the pieces come
+  // from one sampling of the bed's gaps.
+  if (!planes_d.empty()) meshing::check_given_planes_d(d.bed, surface, planes_d, pieces, "--planes-d");
   const meshing::FluidDomainProfile profile = meshing::slab_profile(d.bed, surface, pieces, kEstimateVolumePerCell);
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
   refuse_pieces_beyond_memory(estimate_mesh(surface, mesh, params, profile.size, reference_diameter(d.bed)), pieces,
@@ -159,8 +161,8 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
                                        seed.is_number() ? std::to_string(seed.get<unsigned long long>()) : "none",
                                        piece, pieces);
   const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface,
-                                       meshing::slab_planes_d(d.bed, surface, profile, pieces), mesh, params, piece,
-                                       pieces, dir / "case", note, console);
+                                       planes_d.empty() ? meshing::slab_planes_d(d.bed, surface, profile, pieces) : planes_d,
+                                       mesh, params, piece, pieces, dir / "case", note, console);
   console.line(fmt::format("piece {} of {}: {} cells in {}{}", piece, pieces, r["cells"].get<long>(),
                            (dir / "case" / fmt::format("processor{}", piece)).string(),
                            r.value("reused", false) || r["slab"].value("reused", false)

@@ -26,10 +26,12 @@ void surface_directory(const std::filesystem::path& dir, const std::vector<Overr
 void mesh_directory(const std::filesystem::path& dir, const std::vector<Override>& overrides, const Console& console);
 
 // Piece `piece` of `pieces` of DIR/bed.csv's fluid domain as DIR/case/processor<piece>
-// (piece_stage.hpp), the case written into DIR/case first. Every piece's report goes beside its
-// cells, not into DIR/report.json, which the ranks would race for.
+// (piece_stage.hpp), the case written into DIR/case first, between `planes_d` (d above the floor;
+// empty: meshing::slab_planes_d's; InputError naming --planes-d when they are not pieces - 1
+// increasing heights inside the domain). Every piece's report goes beside its cells, not into
+// DIR/report.json, which the ranks would race for.
 void piece_directory(const std::filesystem::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
-                     const Console& console);
+                     const std::vector<double>& planes_d, const Console& console);
 #endif
 
 #ifdef BEDFORGE_HAVE_GMSH

@@ -1,6 +1,7 @@
 #include "pipeline/piece_stage.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -93,7 +94,8 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
   // an earlier run made from the same, so only the pieces that failed are meshed again.
   const std::string cells_key = stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
-                                           {"mesh", meshing::to_json(mesh)}, {"piece", piece}, {"pieces", pieces}});
+                                           {"mesh", meshing::to_json(mesh)}, {"planes_d", planes}, {"piece", piece},
+                                           {"pieces", pieces}});
   const std::string piece_key = stage_key({{"cells", cells_key}, {"case", cases::to_json(case_params)}});
   const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
   if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json")) {
@@ -182,40 +184,60 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   CasePieces out;
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
-  out.write = [pieces, run_dir, &console](cases::CaseInfo& info) {
-    const fs::path self = fs::read_symlink("/proc/self/exe"), log = info.directory / "log.pieces";
+  // The ranks are given `planes` (d; empty: their own, meshing::slab_planes_d's), each try its log.
+  const auto run_ranks = [pieces, run_dir, &console](const fs::path& case_dir, const std::vector<double>& planes) {
+    const fs::path self = fs::read_symlink("/proc/self/exe"),
+                   log = case_dir / (planes.empty() ? "log.pieces" : "log.pieces_planes_moved");
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
     // Open MPI refuses root unless told (containers, CI), as in Allrun.
     const std::string cmd = fmt::format(
         "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; "
-        "mpirun -np {} '{}' --quiet --no-progress piece '{}' > '{}' 2>&1",
-        pieces, self.string(), run_dir.string(), log.string());
+        "mpirun -np {} '{}' --quiet --no-progress piece '{}'{}{} > '{}' 2>&1",
+        pieces, self.string(), run_dir.string(), planes.empty() ? "" : " --planes-d ", fmt::join(planes, " "),
+        log.string());
     const int status = std::system(cmd.c_str());
     progress.finish();
-    if (status != 0) {
-      // A rank's own message says which piece and why; or mpirun's, that it had too few slots.
-      std::ifstream in(log);
-      std::string line, said;
-      bool too_few_slots = false;
-      while (std::getline(in, line)) {
-        if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
-        too_few_slots = too_few_slots || line.find("not enough slots available") != std::string::npos;
+    if (status == 0) return;
+    // A rank's own message says which piece and why; or mpirun's, that it had too few slots.
+    std::ifstream in(log);
+    std::string line, said;
+    bool too_few_slots = false;
+    while (std::getline(in, line)) {
+      if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
+      too_few_slots = too_few_slots || line.find("not enough slots available") != std::string::npos;
+    }
+    if (too_few_slots)
+      throw InputError(fmt::format(
+          "mesh.pieces = {}: mpirun has fewer slots than {} ranks here (see {}); allowed: mesh.pieces at most the "
+          "slots (this machine's cores, or the batch job's tasks), or more ranks than cores with "
+          "OMPI_MCA_rmaps_base_oversubscribe=1 in the environment (each rank still holds only its piece; the "
+          "ranks share the cores)",
+          pieces, pieces, log.string()));
+    // Stopped as the rank stopped: bad input, a gate not passed, or a defect.
+    const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
+                                         self.filename().string(), said.empty() ? "no rank said why" : said,
+                                         log.string());
+    if (said.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
+    if (said.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
+    throw std::runtime_error(what);
+  };
+  out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
+    try {
+      run_ranks(info.directory, {});
+    } catch (const ConvergenceError& first) {
+      // A piece that fails the gate where the whole mesh passes has its planes to blame (as in
+      // meshing::build_slabbed_volume_mesh): the ranks try once more with the planes moved.
+      const std::vector<double> planes = meshing::slab_planes_d(bed, surface, pieces),
+                                moved = meshing::moved_slab_planes_d(bed, surface, planes);
+      console.line(fmt::format("pieces: {}; meshing them again with the planes moved from {:.3f} to {:.3f} d",
+                               first.what(), fmt::join(planes, ", "), fmt::join(moved, ", ")));
+      try {
+        run_ranks(info.directory, moved);
+      } catch (const ConvergenceError& second) {
+        throw ConvergenceError(fmt::format("{}; and with the planes moved from {:.3f} to {:.3f} d: {}", first.what(),
+                                           fmt::join(planes, ", "), fmt::join(moved, ", "), second.what()));
       }
-      if (too_few_slots)
-        throw InputError(fmt::format(
-            "mesh.pieces = {}: mpirun has fewer slots than {} ranks here (see {}); allowed: mesh.pieces at most the "
-            "slots (this machine's cores, or the batch job's tasks), or more ranks than cores with "
-            "OMPI_MCA_rmaps_base_oversubscribe=1 in the environment (each rank still holds only its piece; the "
-            "ranks share the cores)",
-            pieces, pieces, log.string()));
-      // Stopped as the rank stopped: bad input, a gate not passed, or a defect.
-      const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
-                                           self.filename().string(), said.empty() ? "no rank said why" : said,
-                                           log.string());
-      if (said.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
-      if (said.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
-      throw std::runtime_error(what);
     }
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
     long cells = 0;

@@ -46,10 +46,12 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
-// one (std::runtime_error otherwise). The ranks' files (case/piece_layers) are removed once all
+// one (std::runtime_error otherwise). When a rank's piece fails the gate, the ranks run once
+// more with the planes moved (meshing::moved_slab_planes_d, given as `piece --planes-d`; their
+// output in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files (case/piece_layers) are removed once all
 // have succeeded; a failed run leaves them for the next, which remakes only the failed pieces.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
-// need OMPI_MCA_rmaps_base_oversubscribe=1).
+// need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console);
 

@@ -191,13 +191,15 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"mesh.slabs",
        {"axial slabs meshed one after the other by gmsh and joined into one conforming mesh, so gmsh's memory follows "
         "a slab, not the bed; 0: one slab per million surface triangles when `contacts.treatment` is shrink or none "
-        "and there are no prism layers, else 1 (a plane between slabs would open bridges, caps and unions)",
+        "and there are no prism layers, else 1 (a plane between slabs would open bridges, caps and unions); slabs "
+        "that fail the quality gate are meshed once more with their planes moved to other gaps between the spheres' "
+        "ends",
         "", kWhySlabs}},
       {"mesh.pieces",
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
         "piece`, started by the run) as `case/processorK` with processor patches, and solved on as many processes "
-        "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise. 0 or 1: one "
-        "piece. Shrink or none, no prism layers, no snappyHexMesh, no `stl` or `mesh` output (there is no whole "
+        "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise; pieces that "
+        "fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Shrink or none, no prism layers, no snappyHexMesh, no `stl` or `mesh` output (there is no whole "
         "surface or mesh)"}},
       // [mesh.gate]
       {"mesh.gate.max_non_orthogonality_deg", {"quality gate: largest face non-orthogonality (checkMesh's definition)"}},

@@ -149,6 +149,35 @@ void write_msh22(const std::filesystem::path& path, const Joined& j) {
   if (!out) throw std::runtime_error(fmt::format("volume mesh: cannot write {}", path.string()));
 }
 
+// The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, sorted.
+std::vector<double> sphere_ends_d(const Bed& bed, const SurfaceParams& s) {
+  const double d = reference_diameter(bed);
+  std::vector<double> ends;
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
+      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
+  std::sort(ends.begin(), ends.end());
+  return ends;
+}
+
+// The middle of the widest interval between successive `ends` (sorted, d) whose middle lies
+// within `shift` of `asked`, leaving out the interval that holds `avoid` (NaN: none); `asked`
+// itself when there is no such interval.
+double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid) {
+  double best = asked, widest = -1.0;
+  for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
+    const double mid = 0.5 * (ends[j] + ends[j + 1]);
+    if (ends[j] <= avoid && avoid <= ends[j + 1]) continue;
+    if (std::abs(mid - asked) <= shift && ends[j + 1] - ends[j] > widest) best = mid, widest = ends[j + 1] - ends[j];
+  }
+  return best;
+}
+
+// The slabbed mesh between `planes` (d): each slab meshed and joined, the joined mesh checked.
+VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
+                               double d_ref, const VolumeMeshParams& p, const std::filesystem::path& msh_path,
+                               const std::filesystem::path& bad_cells_path, Progress& progress);
+
 }  // namespace
 
 bool slabs_possible(const SurfaceParams& s, const VolumeMeshParams& p) {
@@ -183,11 +212,7 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
   std::vector<double> below(bins + 1, 0.0);  // cells below each bin's bottom
   std::partial_sum(profile.cells.begin(), profile.cells.end(), below.begin() + 1);
   const double height = (profile.z1 - profile.z0) / bins;
-  std::vector<double> ends;  // d
-  for (std::size_t i = 0; i < bed.size(); ++i)
-    for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
-      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
-  std::sort(ends.begin(), ends.end());
+  const std::vector<double> ends = sphere_ends_d(bed, s);
   for (int k = 1; k < slabs; ++k) {
     // Where the cells below reach k / slabs of them, within its bin by linear interpolation.
     const double target = below.back() * k / slabs;
@@ -195,15 +220,29 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
                              0, bins - 1);
     const double share = profile.cells[b] > 0.0 ? (target - below[b]) / profile.cells[b] : 0.0;
     const double asked = (profile.z0 + (b + std::clamp(share, 0.0, 1.0)) * height) / d;
-    double best = asked, widest = -1.0;
-    for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
-      const double mid = 0.5 * (ends[j] + ends[j + 1]);
-      if (std::abs(mid - asked) <= s.clip_shift_d && ends[j + 1] - ends[j] > widest)
-        best = mid, widest = ends[j + 1] - ends[j];
-    }
-    planes.push_back(best);
+    planes.push_back(widest_interval_middle(ends, asked, s.clip_shift_d, std::nan("")));
   }
   return planes;
+}
+
+std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes) {
+  const std::vector<double> ends = sphere_ends_d(bed, s);
+  std::vector<double> moved;
+  for (double plane : planes) moved.push_back(widest_interval_middle(ends, plane, s.clip_shift_d, plane));
+  return moved;
+}
+
+void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int slabs,
+                          const std::string& name) {
+  const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
+  const bool increasing = std::adjacent_find(planes.begin(), planes.end(), std::greater_equal<>()) == planes.end();
+  const bool inside = std::all_of(planes.begin(), planes.end(),
+                                  [&](double z) { return z > whole.clip_bottom_d && z < whole.clip_top_d; });
+  if (static_cast<int>(planes.size()) + 1 != slabs || !increasing || !inside)
+    throw InputError(fmt::format("{} {}: allowed: {} height{} (d above the floor), increasing, between the fluid "
+                                 "domain's ends {:.3f} and {:.3f} d",
+                                 name, fmt::join(planes, " "), slabs - 1, slabs == 2 ? "" : "s", whole.clip_bottom_d,
+                                 whole.clip_top_d));
 }
 
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k) {
@@ -250,10 +289,34 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
                                      const VolumeMeshParams& p, const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
+  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
+  try {
+    return mesh_and_join_slabs(bed, surface, planes, d_ref, p, msh_path, bad_cells_path, progress);
+  } catch (const ConvergenceError& first) {
+    // The planes are where the slabs differ from one mesh of the whole domain: tried once more
+    // with each moved to another interval between the spheres' ends.
+    const std::vector<double> moved = moved_slab_planes_d(bed, surface, planes);
+    try {
+      VolumeMesh out = mesh_and_join_slabs(bed, surface, moved, d_ref, p, msh_path, bad_cells_path, progress);
+      out.report["planes_moved"] = {{"from_d", planes}, {"to_d", moved}, {"because", first.what()}};
+      return out;
+    } catch (const ConvergenceError& second) {
+      throw ConvergenceError(fmt::format("{}; and with the planes between the slabs moved from {:.3f} to {:.3f} d: {}",
+                                         first.what(), fmt::join(planes, ", "), fmt::join(moved, ", "),
+                                         second.what()));
+    }
+  }
+}
+
+namespace {
+
+VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
+                               double d_ref, const VolumeMeshParams& p, const std::filesystem::path& msh_path,
+                               const std::filesystem::path& bad_cells_path, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
+  const int slabs = static_cast<int>(planes.size()) + 1;
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
-  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
   for (int k = 0; k < slabs; ++k) {
     progress.update(fmt::format("slab {} of {}: surface and cells", k + 1, slabs));
     // Memory a slab frees stays with the allocator for the next slab and the join: handing it
@@ -311,5 +374,7 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
   release_free_memory();  // the quality measures' face geometry
   return out;
 }
+
+}  // namespace
 
 }  // namespace bedforge::meshing

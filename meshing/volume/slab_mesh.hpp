@@ -1,5 +1,6 @@
 #pragma once
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/bed.hpp"
@@ -37,6 +38,14 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, const FluidDomainProfile& profile,
                                   int slabs);
+// Where `planes` (d) go when the slabs between them fail the quality gate: each to the middle
+// of the widest interval between the spheres' ends within surface.clip_shift_d of it, other than
+// the interval it lies in (where it stays when there is no other).
+std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes);
+// InputError naming `name` (the option or key that gave them) unless `planes` are slabs - 1
+// heights (d above the floor), increasing, inside the fluid domain of `bed` under `surface`.
+void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int slabs,
+                          const std::string& name);
 // The fluid domain's profile (fluid_domain_profile, its size at `volume_per_cell`) in bins fine
 // enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab.
 FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, int slabs, double volume_per_cell);
@@ -64,7 +73,9 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 // and `fluid`) to `msh_path` when not empty. std::runtime_error when two slabs' shared plane is
 // not triangulated alike (a defect of ours); ConvergenceError naming the slab when one fails
 // the gate, or naming the cells at the joins when the joined mesh does, after writing them to
-// `bad_cells_path`.
+// `bad_cells_path`. On such a failure the slabs are meshed once more between planes moved by
+// moved_slab_planes_d (the report then says so under "planes_moved": from_d, to_d and the first
+// failure); the error names both attempts.
 VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
                                      const VolumeMeshParams& params, const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress);

@@ -214,9 +214,33 @@ TEST(PieceStage, MoreRanksThanMpirunHasSlotsAreRefusedNamingThePieces) {
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
 }
 
+// A piece failing the gate where the whole mesh would pass has its planes to blame: the ranks
+// mesh again with the planes moved, and when that fails too the run stops (exit 3) naming both
+// attempts. Here a gate no tetrahedral mesh of a bed passes (10 deg), so both fail (one
+// algorithm and one optimiser pass each, to fail fast).
+TEST(PieceStage, APieceFailingTheGateIsMeshedAgainWithThePlanesMovedAndTheErrorNamesBoth) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
+  const fs::path dir = fresh_dir("piece_gate"), scene = fresh_dir("piece_gate_scene");
+  fs::create_directories(scene);
+  std::string text = kScene;
+  text.replace(text.find("edge_length_d = 0.2"), 19, "edge_length_d = 0.35");
+  std::ofstream(scene / "s.toml") << text << "run = false\n[mesh]\npieces = 2\nfallback = false\nmax_optimize_passes = 1\n"
+                                  << "[mesh.gate]\nmax_non_orthogonality_deg = 10\n";
+  const Result r = bedforge("run " + (scene / "s.toml").string() + " -o " + dir.string());
+  EXPECT_EQ(r.status, 3) << r.output;
+  const auto moved = r.output.find("and with the planes moved from ");
+  ASSERT_NE(moved, std::string::npos) << r.output;
+  // Each attempt's failure is a rank's, naming its piece's slab and the gate.
+  EXPECT_LT(r.output.find("of 2 ("), moved) << r.output;
+  EXPECT_GT(r.output.rfind("of 2 ("), moved) << r.output;
+  EXPECT_NE(r.output.find("meshing them again with the planes moved"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "case/processor0/constant/polyMesh/owner"));
+}
+
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
-// no case to write into, pieces beyond the machine's memory, a piece on polyhedra made without
-// its neighbours, and contacts a plane would cut open; no processor directory is left.
+// no case to write into, pieces beyond the machine's memory, planes that do not fit the pieces,
+// a piece on polyhedra made without its neighbours, and contacts a plane would cut open; no
+// processor directory is left.
 TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_dir("piece_refused");
   ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
@@ -237,6 +261,10 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("mesh.pieces = 2: a piece would take at least"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("allowed: mesh.pieces >= "), std::string::npos) << r.output;
+  // Planes given for the pieces: one fewer than the pieces, increasing, inside the domain.
+  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --contacts shrink --planes-d 0.5 1.0");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--planes-d 0.5 1: allowed: 1 height (d above the floor)"), std::string::npos) << r.output;
   // A piece on polyhedra made alone, with no neighbour's layer to take.
   r = shell("env -u OMPI_COMM_WORLD_SIZE " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() +
             " --piece 0 --pieces 2 --contacts shrink");

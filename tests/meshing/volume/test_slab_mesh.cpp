@@ -7,7 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
 #include "meshing/volume/gmsh_model.hpp"
 #include "meshing/surface/surface_checks.hpp"
 #include "support/packed_bed.hpp"
@@ -96,4 +100,68 @@ TEST(SlabMesh, SlabsHoldAboutEqualCells) {
   EXPECT_LT(balanced, 1.3);
   // Equal heights of the bed (just off the heights, clear of the spheres' ends as the slabs need).
   EXPECT_LT(balanced, spread({H / 3 + 0.013, 2 * H / 3 + 0.011}));
+}
+
+// Moved planes: each to another interval between the spheres' ends (both radii, as the surface
+// stage keeps clear of), no farther than clip_shift_d, and clear of every end.
+TEST(SlabMesh, MovedPlanesLieInAnotherIntervalBetweenTheSpheresEnds) {
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  SurfaceParams sp;  // shrink
+  const std::vector<double> planes = slab_planes_d(b, sp, 3), moved = moved_slab_planes_d(b, sp, planes);
+  ASSERT_EQ(moved.size(), planes.size());
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    EXPECT_LE(std::abs(moved[k] - planes[k]), sp.clip_shift_d);
+    // The nearest end on either side of each plane; the moved plane lies outside the interval the plane was in.
+    double below = -1e9, above = 1e9, clearance = 1e9;
+    for (std::size_t i = 0; i < b.size(); ++i)
+      for (double r : {0.5, 0.5 * sp.shrink_factor})
+        for (double end : {b.centres[i].z() - r, b.centres[i].z() + r}) {
+          if (end <= planes[k]) below = std::max(below, end);
+          if (end >= planes[k]) above = std::min(above, end);
+          clearance = std::min(clearance, std::abs(end - moved[k]));
+        }
+    EXPECT_TRUE(moved[k] < below || moved[k] > above) << "plane " << k << " at " << planes[k] << " d stayed in "
+                                                      << below << "-" << above;
+    EXPECT_GT(clearance, 0.0);
+  }
+}
+
+TEST(SlabMesh, GivenPlanesAreRefusedUnlessIncreasingInsideTheDomainAndOneFewerThanTheSlabs) {
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  SurfaceParams sp;
+  const double top = bed_height(b) + sp.outlet_length_d;
+  EXPECT_NO_THROW(check_given_planes_d(b, sp, {1.0, 2.0}, 3, "--planes-d"));
+  for (const std::vector<double>& bad : std::vector<std::vector<double>>{{1.0}, {2.0, 1.0}, {1.0, 1.0}, {1.0, top + 0.1}})
+    try {
+      check_given_planes_d(b, sp, bad, 3, "--planes-d");
+      ADD_FAILURE() << "accepted " << bad.size() << " planes";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--planes-d"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("2 heights"), std::string::npos) << e.what();
+    }
+}
+
+// A slab failing the gate: meshed once more between moved planes, and when that fails too, the
+// error names both attempts (a gate no tetrahedral mesh of a bed passes: 10 deg).
+TEST(SlabMesh, ASlabFailingTheGateIsTriedAgainWithThePlanesMovedAndTheErrorNamesBoth) {
+  Progress quiet("mesh", false);
+  const Bed b = test_support::packed_bed(30, 3.0, 1);
+  SurfaceParams sp;  // shrink
+  sp.edge_length_d = 0.3;
+  VolumeMeshParams p;
+  p.gate.max_non_orthogonality_deg = 10.0;
+  p.fallback = false, p.max_optimize_passes = 1;  // to fail fast
+  const fs::path dir = test_support::fresh_dir("slabs_moved", true);
+  try {
+    build_slabbed_volume_mesh(b, sp, 2, 1.0, p, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
+    ADD_FAILURE() << "a 10 deg gate passed";
+  } catch (const ConvergenceError& e) {
+    const std::string what = e.what();
+    const std::string moved = fmt::format("moved from {:.3f} to {:.3f} d", slab_planes_d(b, sp, 2)[0],
+                                          moved_slab_planes_d(b, sp, slab_planes_d(b, sp, 2))[0]);
+    EXPECT_NE(what.find(moved), std::string::npos) << what;
+    // Each attempt's failure names its slab: one before the moved planes, one after.
+    EXPECT_LT(what.find(" of 2 ("), what.find(moved)) << what;
+    EXPECT_GT(what.rfind(" of 2 ("), what.find(moved)) << what;
+  }
 }
