@@ -78,8 +78,9 @@ periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N
 pieces: issue 58's case in pieces: the default bed with shrink in one piece, then in P pieces on P ranks (each of
         --pieces-ranks): each rank's peak and time, checkMesh in parallel, dp/L on 2 ranks against one piece's.
 pieces_large: the same bed 3 times longer (--pieces-large-spheres spheres), the case written, not solved, in P pieces
-        for each of --pieces-ranks: the per-rank peak against 1/P of one rank's on a bed whose pieces hold more
-        than the 62 spheres per rank the default bed leaves at 8 ranks.
+        for each of --pieces-large-ranks (from 2: one rank's whole piece of 1500 spheres fell back to gmsh's
+        slow Delaunay): the per-rank peak against 2/P of 2 ranks' on a bed whose pieces hold more than the 62
+        spheres per rank the default bed leaves at 8 ranks.
 weak_scaling: --weak-spheres spheres per rank, the column P times longer on P ranks (each of --weak-ranks).
 projection: the largest rank's peak and time, fitted on the pieces sections' ranks, projected to 1e5 and 1e6 spheres.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
@@ -862,10 +863,11 @@ def pieces_lines(rows):
              "rank meshing its slab, making its dual and writing `processorK`; P = 1 is one rank's piece of the "
              "one-piece run's case. Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up." +
              (" dp/L on 2 ranks (solved in pieces, no decomposePar) against one piece's." if one else ""), "",
-             "| route | polyhedra | largest rank's peak (MB) | x 1/P of P = 1 | ranks' time (s) | run's wall time (s) | "
-             "checkMesh | dp/L (Pa/m) |",
+             "| route | polyhedra | largest rank's peak (MB) | x {0}/P of P = {0} | ranks' time (s) | run's wall time (s) | "
+             "checkMesh | dp/L (Pa/m) |".format(min((r["pieces"] for r in rows if r["pieces"] >= 1), default=1)),
              "|---|---|---|---|---|---|---|---|"]
-    single = next((r for r in rows if r["pieces"] == 1), None)
+    # The peaks are held against the fewest ranks run: one rank, or where one rank's piece would not fit, two.
+    fewest = min((r for r in rows if r["pieces"] >= 1), key=lambda r: r["pieces"], default=None)
     if one:
         lines.append(f"| one piece | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0.0):.0f} (mesh stage), "
                      f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | | | {one['wall_s']:.0f} | | "
@@ -874,7 +876,7 @@ def pieces_lines(rows):
         if r["pieces"] < 1:
             continue
         peak = max(k["peak_mb"] for k in r["ranks"])
-        scaled = f"{peak / (single_peak(single) / r['pieces']):.2f}" if single else ""
+        scaled = f"{peak / (largest_peak(fewest) * fewest['pieces'] / r['pieces']):.2f}"
         times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
         check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
         dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if "dp_pa_m" in r else ""
@@ -889,11 +891,13 @@ def pieces_lines(rows):
         lines.append(f"- dp/L on 2 ranks within 0.5 % of one piece's: {change:+.2f} %, {verdict(abs(change) <= 0.5)}; "
                      f"the cells differ by {two['cells'] - one['cells']:+d} ({100 * (two['cells'] / one['cells'] - 1):+.2f} %: "
                      "gmsh's threads make other tetrahedra on each run; the pieces themselves add none).")
-    if single:
-        ratios = [(r["pieces"], max(k["peak_mb"] for k in r["ranks"]) / (single_peak(single) / r["pieces"]))
-                  for r in rows if 2 <= r["pieces"] <= 8]
+    if fewest:
+        p0 = fewest["pieces"]
+        ratios = [(r["pieces"], largest_peak(r) / (largest_peak(fewest) * p0 / r["pieces"]))
+                  for r in rows if p0 < r["pieces"] <= 8]
         if ratios:
-            lines.append("- The largest rank's peak within 20 % of 1/P of one rank's, 2 to 8 ranks: " +
+            against = "1/P of one rank's, 2" if p0 == 1 else f"{p0}/P of {p0} ranks', {p0 * 2}"
+            lines.append(f"- The largest rank's peak within 20 % of {against} to 8 ranks: " +
                          ", ".join(f"{x:.2f} at {p}" for p, x in ratios) +
                          f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}.")
     checked = [r for r in rows if r["pieces"] > 1]
@@ -905,7 +909,7 @@ def pieces_lines(rows):
     return lines
 
 
-def single_peak(row):
+def largest_peak(row):
     return max(k["peak_mb"] for k in row["ranks"])
 
 
@@ -1477,6 +1481,7 @@ def main():
                     help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
     ap.add_argument("--pieces-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces: ranks (pieces) to run")
     ap.add_argument("--pieces-large-spheres", type=int, default=1500, help="pieces_large: the bed's spheres")
+    ap.add_argument("--pieces-large-ranks", type=int, nargs="+", default=[2, 4, 8], help="pieces_large: ranks to run")
     ap.add_argument("--weak-ranks", type=int, nargs="+", default=[1, 2, 4], help="weak_scaling: ranks (pieces) to run")
     ap.add_argument("--weak-spheres", type=int, default=200, help="weak_scaling: spheres per rank")
     args = ap.parse_args()
@@ -1553,7 +1558,7 @@ def main():
             results["pieces"] = pieces(tmp, args.pieces_ranks)
             write(results)
         if "pieces_large" in args.only:
-            results["pieces_large"] = pieces(tmp, args.pieces_ranks, args.pieces_large_spheres, solved=())
+            results["pieces_large"] = pieces(tmp, args.pieces_large_ranks, args.pieces_large_spheres, solved=())
             write(results)
         if "weak_scaling" in args.only:
             results["weak_scaling"] = weak_scaling(tmp, args.weak_ranks, args.weak_spheres)
