@@ -153,12 +153,18 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     below.reset(), above.reset();
     release_free_memory();  // the tetrahedra
     std::vector<int> cell_points;
-    meshing::PolyhedralMesh dual = meshing::dual_piece(
-        meshing::dual_mesh(whole.mesh, meshing::tetrahedron_centroids(whole.mesh), cases::kDualFeatureAngleDeg,
-                           &cell_points),
-        cell_points, whole.side, piece, pieces);
+    meshing::PolyhedralMesh dual = meshing::dual_mesh(whole.mesh, meshing::tetrahedron_centroids(whole.mesh),
+                                                      cases::kDualFeatureAngleDeg, &cell_points);
+    const std::vector<int> side = std::move(whole.side);
     whole = meshing::SlabWithLayers();
     release_free_memory();
+    // The piece's own polyhedra, held to checkMesh's limits with its neighbours' cells around
+    // them, whose centres the faces across the planes see (as `checkMesh -parallel` does).
+    std::vector<bool> own(dual.cells);
+    for (int c = 0; c < dual.cells; ++c) own[c] = side[cell_points[c]] == 0;
+    meshing::gate_polyhedra(dual, own, bed, d, fmt::format("piece {} of {}'s polyhedra", piece + 1, pieces),
+                            case_dir / fmt::format("bad_polyhedra_piece{}.vtk", piece));
+    dual = meshing::dual_piece(dual, cell_points, side, piece, pieces);
     report["cells"] = dual.cells;
     meter.record(report);
     cases::write_case_piece(case_dir, piece, dual, case_params.binary, note, report);

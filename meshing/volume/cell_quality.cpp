@@ -1,16 +1,22 @@
 #include "meshing/volume/cell_quality.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <fstream>
 #include <numbers>
+#include <unordered_map>
 
 namespace bedforge::meshing {
 
 namespace {
-constexpr double kRootVSmall = 1e-150;  // OpenFOAM's ROOTVSMALL, guards divisions as it does
-}
 
-CellQuality cell_quality(const PolyMesh& m) {
+constexpr double kRootVSmall = 1e-150;  // OpenFOAM's ROOTVSMALL, guards divisions as it does
+
+template <class Mesh>
+CellQuality cell_quality_of(const Mesh& m) {
   CellQuality q;
   CellGeometry geometry = cell_geometry(m);
   const std::vector<Eigen::Vector3d>& cc = geometry.centres;
@@ -18,6 +24,7 @@ CellQuality cell_quality(const PolyMesh& m) {
   q.non_orthogonality_deg.assign(m.cells, 0.0);
   q.skewness.assign(m.cells, 0.0);
   q.aspect_ratio.assign(m.cells, 0.0);
+  q.min_face_pyramid.assign(m.cells, std::numeric_limits<double>::max());
   q.non_orthogonality_histogram.assign(9, 0);
   std::vector<Eigen::Vector3d> sum_mag_area(m.cells, Eigen::Vector3d::Zero());
   double sum_cos = 0.0;
@@ -29,9 +36,17 @@ CellQuality cell_quality(const PolyMesh& m) {
     const bool internal = f < m.neighbour.size();
     sum_mag_area[own] += area.cwiseAbs();
     const Eigen::Vector3d cpf = fc - cc[own];
+    // Face pyramids as primitiveMeshTools::facePyramidVolume: the face seen from each of its
+    // cells' centres, positive when the face points away from that centre.
+    const auto pyramid = [&](int cell, double volume) {
+      q.min_face_pyramid[cell] = std::min(q.min_face_pyramid[cell], volume);
+      q.inverted_face_pyramids += volume < 0.0;
+    };
+    pyramid(own, area.dot(cpf) / 3.0);
     Eigen::Vector3d d;
     if (internal) {
       const int nei = m.neighbour[f];
+      pyramid(nei, area.dot(cc[nei] - fc) / 3.0);
       sum_mag_area[nei] += area.cwiseAbs();
       d = cc[nei] - cc[own];
       const double c = std::clamp(d.dot(area) / (d.norm() * area.norm() + kRootVSmall), -1.0, 1.0);
@@ -75,12 +90,70 @@ CellQuality cell_quality(const PolyMesh& m) {
   return q;
 }
 
+// Legacy VTK of the given cells as the polygons of their faces (any cell type, PolyMesh or
+// PolyhedralMesh), each carrying its cell's quality and nearest particle, for ParaView.
+template <class Mesh>
+void write_bad_cells(const std::filesystem::path& path, const Mesh& m, const CellQuality& q,
+                     const std::vector<int>& bad, const std::vector<int>& nearest) {
+  std::unordered_map<int, int> rank;  // cell -> position in `bad`
+  for (std::size_t k = 0; k < bad.size(); ++k) rank.emplace(bad[k], static_cast<int>(k));
+  std::vector<std::pair<int, int>> polygons;  // (position in bad, face)
+  for (std::size_t f = 0; f < m.owner.size(); ++f)
+    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1})
+      if (const auto it = rank.find(c); c >= 0 && it != rank.end()) polygons.emplace_back(it->second, static_cast<int>(f));
+  std::sort(polygons.begin(), polygons.end());
+  std::size_t corners = 0;
+  for (const auto& [k, f] : polygons) corners += points_of(m, f).size();
+  std::ofstream out(path);
+  out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate, as their faces\nASCII\nDATASET POLYDATA\n";
+  out << "POINTS " << corners << " double\n";
+  for (const auto& [k, f] : polygons)
+    for (int v : points_of(m, f))
+      out << fmt::format("{:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
+  out << "POLYGONS " << polygons.size() << " " << polygons.size() + corners << "\n";
+  std::size_t next = 0;
+  for (const auto& [k, f] : polygons) {
+    const std::size_t n = points_of(m, f).size();
+    out << n;
+    for (std::size_t j = 0; j < n; ++j) out << " " << next++;
+    out << "\n";
+  }
+  out << "CELL_DATA " << polygons.size() << "\n";
+  auto field = [&](const char* name, const auto& value) {
+    out << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
+    for (const auto& [k, f] : polygons) out << fmt::format("{:.6g}\n", static_cast<double>(value(k)));
+  };
+  field("cell", [&](int k) { return bad[k]; });
+  field("non_orthogonality_deg", [&](int k) { return q.non_orthogonality_deg[bad[k]]; });
+  field("skewness", [&](int k) { return q.skewness[bad[k]]; });
+  field("aspect_ratio", [&](int k) { return q.aspect_ratio[bad[k]]; });
+  field("volume_m3", [&](int k) { return q.volume[bad[k]]; });
+  field("min_face_pyramid_m3", [&](int k) { return q.min_face_pyramid[bad[k]]; });
+  field("nearest_particle", [&](int k) { return nearest[k]; });
+}
+
+template <class Mesh>
+DefectLocations locate_bad_cells_of(const Bed& bed, const Mesh& m, const CellQuality& q, const std::vector<int>& bad,
+                                    const std::filesystem::path& path) {
+  const std::vector<Eigen::Vector3d> centres = cell_geometry(m).centres;
+  std::vector<Eigen::Vector3d> at;
+  for (int c : bad) at.push_back(centres[c]);
+  DefectLocations where = locate_defects(bed, at, "cells");
+  if (!path.empty()) write_bad_cells(path, m, q, bad, where.nearest);
+  return where;
+}
+
+}  // namespace
+
+CellQuality cell_quality(const PolyMesh& mesh) { return cell_quality_of(mesh); }
+CellQuality cell_quality(const PolyhedralMesh& mesh) { return cell_quality_of(mesh); }
+
 std::vector<int> CellQuality::bad_cells(const QualityGate& gate, double d_ref) const {
   std::vector<int> bad;
   const double min_vol = gate.min_volume_d3 * d_ref * d_ref * d_ref;
   for (std::size_t c = 0; c < volume.size(); ++c)
     if (non_orthogonality_deg[c] > gate.max_non_orthogonality_deg || skewness[c] > gate.max_skewness ||
-        aspect_ratio[c] > gate.max_aspect_ratio || volume[c] < min_vol)
+        aspect_ratio[c] > gate.max_aspect_ratio || volume[c] < min_vol || min_face_pyramid[c] < 0.0)
       bad.push_back(static_cast<int>(c));
   return bad;
 }
@@ -93,7 +166,17 @@ nlohmann::json CellQuality::to_json(double d_ref) const {
           {"max_skewness", max_skewness},
           {"max_aspect_ratio", max_aspect_ratio},
           {"min_volume_d3", min_volume / (d_ref * d_ref * d_ref)},
+          {"inverted_face_pyramids", inverted_face_pyramids},
           {"volume_m3", total_volume}};
+}
+
+DefectLocations locate_bad_cells(const Bed& bed, const PolyMesh& m, const CellQuality& q, const std::vector<int>& bad,
+                                 const std::filesystem::path& path) {
+  return locate_bad_cells_of(bed, m, q, bad, path);
+}
+DefectLocations locate_bad_cells(const Bed& bed, const PolyhedralMesh& m, const CellQuality& q,
+                                 const std::vector<int>& bad, const std::filesystem::path& path) {
+  return locate_bad_cells_of(bed, m, q, bad, path);
 }
 
 }  // namespace bedforge::meshing

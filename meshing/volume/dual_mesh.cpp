@@ -6,12 +6,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "core/edge_key.hpp"
+#include "core/error.hpp"
 #include "core/point_key.hpp"
 
 namespace bedforge::meshing {
@@ -280,6 +282,39 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
   d.cells = n_points;
   if (cell_points) *cell_points = std::move(order);
   return d;
+}
+
+long gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
+                    const std::string& what, const std::filesystem::path& bad_cells_path) {
+  const CellQuality q = cell_quality(dual);
+  const QualityGate& gate = kCheckMeshLimits;
+  long count = 0;
+  double non_orthogonality = 0.0, skewness = 0.0, aspect_ratio = 0.0;
+  double volume = std::numeric_limits<double>::max(), pyramid = std::numeric_limits<double>::max();
+  std::vector<int> bad;
+  for (int c : q.bad_cells(gate, d_ref))
+    if (judged.empty() || judged[c]) bad.push_back(c);
+  for (int c = 0; c < dual.cells; ++c)
+    if (judged.empty() || judged[c]) {
+      ++count;
+      non_orthogonality = std::max(non_orthogonality, q.non_orthogonality_deg[c]);
+      skewness = std::max(skewness, q.skewness[c]), aspect_ratio = std::max(aspect_ratio, q.aspect_ratio[c]);
+      volume = std::min(volume, q.volume[c]), pyramid = std::min(pyramid, q.min_face_pyramid[c]);
+    }
+  if (bad.empty()) {
+    std::filesystem::remove(bad_cells_path);  // an earlier run's, which no longer describes the mesh
+    return count;
+  }
+  const DefectLocations where = locate_bad_cells(bed, dual, q, bad, bad_cells_path);
+  const double d3 = d_ref * d_ref * d_ref;
+  throw ConvergenceError(fmt::format(
+      "{}: {} of {} cells fail checkMesh's limits (max non-orthogonality {:.1f} deg, limit {}; max skewness {:.2f}, "
+      "limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}; smallest face pyramid "
+      "{:.2e} d^3, limit 0), most near {}; cells written to {}. The tetrahedra passed the quality gate; case.cells = "
+      "\"tetrahedra\" runs on them, and other surface edge lengths ([surface]) make other polyhedra",
+      what, bad.size(), count, non_orthogonality, gate.max_non_orthogonality_deg, skewness, gate.max_skewness,
+      aspect_ratio, gate.max_aspect_ratio, volume / d3, gate.min_volume_d3, pyramid / d3, where.summary,
+      bad_cells_path.string()));
 }
 
 }  // namespace bedforge::meshing

@@ -1,4 +1,10 @@
 #pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/bed.hpp"
+#include "meshing/volume/cell_quality.hpp"
 #include "meshing/volume/poly_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -25,5 +31,20 @@ namespace bedforge::meshing {
 // that is not a manifold there).
 PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d>& cell_centres,
                          double feature_angle_deg, std::vector<int>* cell_points = nullptr);
+
+// Holds a case's polyhedra to checkMesh's limits (kCheckMeshLimits), so that a bad cell is
+// found, located and refused by bedforge rather than by Allrun's checkMesh after the run.
+//   dual            the polyhedra, m
+//   judged          per cell of `dual`, whether it is held to the limits (empty: every cell): a
+//                   piece's own cells, judged with its neighbours' cells around them, as
+//                   `checkMesh -parallel` judges them across the processor patches
+//   bed, d_ref      name the particles near bad cells; d_ref (m) scales the volume limit
+//   what            the mesh, as the error names it (e.g. "piece 2 of 4's polyhedra")
+//   bad_cells_path  where the failing cells go, as legacy VTK (an earlier file there is removed
+//                   when every cell passes)
+// Returns the number of judged cells. ConvergenceError saying how many cells fail which limit,
+// near which particles, and where they were written.
+long gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
+                    const std::string& what, const std::filesystem::path& bad_cells_path);
 
 }  // namespace bedforge::meshing

@@ -18,9 +18,12 @@ namespace bedforge::meshing {
 // and the pieces' cells together are the whole mesh's dual.
 
 // A slab's tetrahedra within rings of points of one of its planes: those touching the plane, then
-// those touching their points. Two rings, so that every boundary face around a point next
-// to the plane is there, which the dual needs to mark that point's feature edges as the whole
-// mesh would.
+// those touching their points, and so on. Three rings: with two, every boundary face around a
+// point next to the plane is there, which the dual needs to mark that point's feature edges as
+// the whole mesh would, so the piece's own cells are the whole mesh's; the third keeps the
+// layer's edge (whose meeting with a wall the dual takes for a feature) away from the points
+// next to those, so that the neighbour's cells across the plane are the whole mesh's too, and
+// the faces between them are judged as checkMesh judges them (gate_polyhedra).
 struct PlaneLayer {
   std::vector<Eigen::Vector3d> points;  // m
   std::vector<VolumeCell> cells;        // tetrahedra, into points
@@ -33,9 +36,10 @@ struct PlaneLayer {
 inline constexpr const char* kLayerEdge = "layer_edge";
 
 // The layer of `slab` (a PolyMesh of tetrahedra) at its patch `plane` ("inlet" or "outlet"),
-// `rings` rings deep (2, what the dual needs; more takes more of the slab, all of it at last).
+// `rings` rings deep (3, what the dual and its gate need; more takes more of the slab, all of it
+// at last).
 // std::runtime_error when the slab has no such patch.
-PlaneLayer plane_layer(const PolyMesh& slab, const std::string& plane, int rings = 2);
+PlaneLayer plane_layer(const PolyMesh& slab, const std::string& plane, int rings = 3);
 
 // All of a slab's tetrahedra and boundary faces as a layer (no kLayerEdge faces), and the slab
 // back from one (its cells renumbered as poly_mesh_from_cells numbers them): what a piece keeps

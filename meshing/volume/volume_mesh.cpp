@@ -11,7 +11,6 @@
 #include <numeric>
 #include <optional>
 #include <stdexcept>
-#include <unordered_map>
 #include <random>
 #include <thread>
 
@@ -247,56 +246,7 @@ void insert_layers(const PrismLayers& layers) {
   gmsh::model::setPhysicalName(3, gmsh::model::addPhysicalGroup(3, fluid_entities), "fluid");
 }
 
-// Legacy VTK of the given cells as the polygons of their faces (any cell type), each carrying
-// its cell's quality and nearest particle, for ParaView.
-void write_bad_cells(const std::filesystem::path& path, const PolyMesh& m, const CellQuality& q,
-                     const std::vector<int>& bad, const std::vector<int>& nearest) {
-  std::unordered_map<int, int> rank;  // cell -> position in `bad`
-  for (std::size_t k = 0; k < bad.size(); ++k) rank.emplace(bad[k], static_cast<int>(k));
-  std::vector<std::pair<int, int>> polygons;  // (position in bad, face)
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    for (int c : {m.owner[f], f < m.neighbour.size() ? m.neighbour[f] : -1})
-      if (const auto it = rank.find(c); c >= 0 && it != rank.end()) polygons.emplace_back(it->second, static_cast<int>(f));
-  std::sort(polygons.begin(), polygons.end());
-  std::size_t corners = 0;
-  for (const auto& [k, f] : polygons) corners += m.faces[f].size();
-  std::ofstream out(path);
-  out << "# vtk DataFile Version 3.0\nbedforge cells failing the quality gate, as their faces\nASCII\nDATASET POLYDATA\n";
-  out << "POINTS " << corners << " double\n";
-  for (const auto& [k, f] : polygons)
-    for (int v : m.faces[f])
-      out << fmt::format("{:.12g} {:.12g} {:.12g}\n", m.points[v].x(), m.points[v].y(), m.points[v].z());
-  out << "POLYGONS " << polygons.size() << " " << polygons.size() + corners << "\n";
-  std::size_t next = 0;
-  for (const auto& [k, f] : polygons) {
-    out << m.faces[f].size();
-    for (int j = 0; j < m.faces[f].size(); ++j) out << " " << next++;
-    out << "\n";
-  }
-  out << "CELL_DATA " << polygons.size() << "\n";
-  auto field = [&](const char* name, const auto& value) {
-    out << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
-    for (const auto& [k, f] : polygons) out << fmt::format("{:.6g}\n", static_cast<double>(value(k)));
-  };
-  field("cell", [&](int k) { return bad[k]; });
-  field("non_orthogonality_deg", [&](int k) { return q.non_orthogonality_deg[bad[k]]; });
-  field("skewness", [&](int k) { return q.skewness[bad[k]]; });
-  field("aspect_ratio", [&](int k) { return q.aspect_ratio[bad[k]]; });
-  field("volume_m3", [&](int k) { return q.volume[bad[k]]; });
-  field("nearest_particle", [&](int k) { return nearest[k]; });
-}
-
 }  // namespace
-
-DefectLocations locate_bad_cells(const Bed& bed, const PolyMesh& m, const CellQuality& q, const std::vector<int>& bad,
-                                 const std::filesystem::path& path) {
-  const std::vector<Eigen::Vector3d> centres = cell_centres(m);
-  std::vector<Eigen::Vector3d> at;
-  for (int c : bad) at.push_back(centres[c]);
-  DefectLocations where = locate_defects(bed, at, "cells");
-  if (!path.empty()) write_bad_cells(path, m, q, bad, where.nearest);
-  return where;
-}
 
 // Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
 // mesh before it: measured 1360 (a = 10, N = 4000, enlarge: 14.2 GB, 10.4 M cells) and 1230

@@ -66,10 +66,4 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
                              Progress& progress, bool release_memory = true);
 
-// Where the cells `bad` of `m` (quality `q`) lie: the particle nearest to each and the summary
-// of locate_defects; when `path` is not empty, the cells are also written there as legacy VTK,
-// the polygons of their faces each carrying its cell's quality and nearest particle, for ParaView.
-DefectLocations locate_bad_cells(const Bed& bed, const PolyMesh& m, const CellQuality& q, const std::vector<int>& bad,
-                                 const std::filesystem::path& path);
-
 }  // namespace bedforge::meshing

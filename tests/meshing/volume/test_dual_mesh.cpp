@@ -7,6 +7,7 @@
 #include <regex>
 
 #include "cases/poly_mesh_io.hpp"
+#include "core/error.hpp"
 #include "support/cli.hpp"
 #include "support/tet_grid.hpp"
 
@@ -171,6 +172,67 @@ void expect_polydualmesh_agrees(const PolyMesh& m) {
   ASSERT_GT(got.size(), 20u);
   for (std::size_t k = 0; k < got.size(); ++k)
     EXPECT_NEAR(got[k], expected[k], 1e-5 * std::abs(expected[k])) << "figure " << k;
+}
+
+// A figure checkMesh prints after `label` (e.g. "Max skewness = ") in the case in `dir`.
+double check_mesh_figure(const std::filesystem::path& dir, const std::string& label) {
+  const cli_test::Result r =
+      cli_test::shell("cd " + dir.string() + " && WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam} checkMesh");
+  const auto at = r.output.find(label);
+  if (at == std::string::npos) throw std::runtime_error("checkMesh printed no `" + label + "`:\n" + r.output);
+  return std::stod(r.output.substr(at + label.size()));
+}
+
+TEST(DualMesh, ItsQualityIsTheOneCheckMeshMeasures) {
+  // The figures bedforge gates a case's polyhedra by are checkMesh's own, on the same cells (to
+  // the sixth digit it prints).
+  if (cli_test::shell("command -v checkMesh").status != 0) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const PolyMesh m = shaken_box(4);
+  const PolyhedralMesh dual = dual_mesh(m, cell_centres(m), 80.0);
+  const auto dir = cli_test::fresh_dir("dual_quality");
+  write_case(dir);
+  cases::write_poly_mesh(dir / "constant/polyMesh", dual, true, "test");
+  const CellQuality q = cell_quality(dual);
+  EXPECT_NEAR(q.max_skewness, check_mesh_figure(dir, "Max skewness = "), 1e-5 * q.max_skewness);
+  EXPECT_NEAR(q.max_non_orthogonality_deg, check_mesh_figure(dir, "Mesh non-orthogonality Max: "),
+              1e-5 * q.max_non_orthogonality_deg);
+  EXPECT_NEAR(q.max_aspect_ratio, check_mesh_figure(dir, "Max aspect ratio = "), 1e-5 * q.max_aspect_ratio);
+  EXPECT_NEAR(q.min_volume, check_mesh_figure(dir, "Min volume = "), 1e-5 * q.min_volume);
+  EXPECT_GT(q.max_skewness, 0.1);  // the shaken box's dual is far from regular
+}
+
+TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreRefusedWhereJudged) {
+  // One cube with a face turned into it (an inverted face pyramid, as checkMesh reports it; its
+  // size, -11/48, is derived in test_poly_mesh.cpp).
+  PolyhedralMesh cube;
+  cube.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (const std::vector<int>& f : std::vector<std::vector<int>>{
+           {0, 3, 2, 1}, {7, 6, 5, 4}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}})
+    cube.faces.push_back(f);
+  cube.owner.assign(6, 0);
+  PolyMesh::Patch walls;
+  walls.name = "walls", walls.type = "wall", walls.size = 6;
+  cube.patches = {walls};
+  cube.cells = 1;
+  Bed bed;
+  bed.centres = {Eigen::Vector3d(0.5, 0.5, 2.0)};
+  bed.diameters = {1.0};
+  const auto dir = cli_test::fresh_dir("dual_gate");
+  std::filesystem::create_directories(dir);
+  const auto vtk = dir / "bad_polyhedra.vtk";
+  try {
+    gate_polyhedra(cube, {}, bed, 1.0, "the cube's polyhedra", vtk);
+    ADD_FAILURE() << "a cell with an inverted face pyramid passed";
+  } catch (const ConvergenceError& e) {
+    const std::string msg = e.what();
+    for (const char* said : {"the cube's polyhedra: 1 of 1 cells", "smallest face pyramid -2.29e-01 d^3, limit 0",
+                             "particle 0", "bad_polyhedra.vtk"})
+      EXPECT_NE(msg.find(said), std::string::npos) << said << " not in: " << msg;
+  }
+  EXPECT_TRUE(std::filesystem::exists(vtk));
+  // A cell not judged (a neighbour's, around a piece) does not fail the piece; the stale file goes.
+  EXPECT_EQ(gate_polyhedra(cube, {false}, bed, 1.0, "the cube's polyhedra", vtk), 0);
+  EXPECT_FALSE(std::filesystem::exists(vtk));
 }
 
 TEST(DualMesh, IsTheOnePolyDualMeshMakes) {

@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 
@@ -52,7 +54,52 @@ PolyhedralMesh dual_of_piece(const Pieces& p, int k) {
   return dual_piece(d, cell_points, s.side, k, 3);
 }
 
+// Each cell's skewness and non-orthogonality in the dual of `mesh`, by the cell's point (the
+// point's coordinates, the same bits in every piece that holds it), for the cells whose point
+// has side 0 in `side` (empty: every cell).
+using Figures = std::map<std::array<double, 3>, std::pair<double, double>>;
+Figures figures_by_point(const PolyMesh& mesh, const std::vector<int>& side) {
+  std::vector<int> cell_points;
+  const PolyhedralMesh d = dual_mesh(mesh, tetrahedron_centroids(mesh), 80.0, &cell_points);
+  const CellQuality q = cell_quality(d);
+  Figures out;
+  for (int c = 0; c < d.cells; ++c)
+    if (side.empty() || side[cell_points[c]] == 0) {
+      const Eigen::Vector3d& x = mesh.points[cell_points[c]];
+      out[{x.x(), x.y(), x.z()}] = {q.skewness[c], q.non_orthogonality_deg[c]};
+    }
+  return out;
+}
+
 }  // namespace
+
+TEST(DualPieces, EachPieceJudgesItsPolyhedraAsTheWholeDualJudgesThem) {
+  // The gate of a piece's polyhedra sees, cell for cell, the skewness and non-orthogonality that
+  // checkMesh sees on the whole mesh's dual: its own cells judged in the dual with its
+  // neighbours' layers, whose cells' centres its faces across the planes see.
+  const Pieces p = three_slabs();
+  const int all = 1 << 20;
+  const PlaneLayer below = plane_layer(p.slabs[0], "outlet", all), above = plane_layer(p.slabs[2], "inlet", all);
+  const Figures expected = figures_by_point(slab_with_layers(p.slabs[1], &below, &above).mesh, {});
+  Figures judged;
+  for (int k = 0; k < 3; ++k) {
+    const SlabWithLayers s =
+        slab_with_layers(p.slabs[k], k > 0 ? &p.outlet[k - 1] : nullptr, k < 2 ? &p.inlet[k + 1] : nullptr);
+    judged.merge(figures_by_point(s.mesh, s.side));
+  }
+  ASSERT_EQ(judged.size(), expected.size());
+  long differ = 0;
+  double worst = 0.0;
+  for (const auto& [x, figures] : expected) {
+    const auto it = judged.find(x);
+    ASSERT_NE(it, judged.end());
+    differ += std::abs(it->second.first - figures.first) > 1e-9 * (1.0 + figures.first) ||
+              std::abs(it->second.second - figures.second) > 1e-9 * 90.0;
+    worst = std::max(worst, figures.first);
+  }
+  EXPECT_EQ(differ, 0) << "of " << judged.size() << " cells";
+  EXPECT_GT(worst, 0.5);  // cells whose figures a wrong neighbour would change
+}
 
 TEST(DualPieces, ThreePiecesMakeTheWholeDualWithMatchingProcessorPatches) {
   const Pieces p = three_slabs();
@@ -119,7 +166,7 @@ TEST(DualPieces, ALayerRoundTripsThroughItsFileAndAForeignOneIsRefused) {
   ASSERT_EQ(back.cells.size(), layer.cells.size());
   EXPECT_EQ(back.cells.back().v, layer.cells.back().v);
   EXPECT_EQ(back.patch, layer.patch);
-  // Two rings of tetrahedra: more than those touching the plane.
+  // Rings of tetrahedra: more than those touching the plane.
   std::vector<char> on_plane(p.slabs[0].points.size(), 0);
   for (const PolyMesh::Patch& q : p.slabs[0].patches)
     if (q.name == "outlet")

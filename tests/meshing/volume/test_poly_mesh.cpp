@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -121,6 +122,48 @@ TEST(CellQuality, AFlattenedTetIsCaughtByTheGate) {
   EXPECT_GT(bad.max_aspect_ratio, 10.0 * good.max_aspect_ratio);
   const QualityGate gate;
   EXPECT_FALSE(bad.bad_cells(gate, 1.0).empty());
+}
+
+TEST(CellQuality, AFaceTurnedIntoItsCellIsAnInvertedPyramid) {
+  // A unit cube whose faces point out of it, then with one face turned inwards: its volume stays
+  // positive (5/6 - 1/6), so only the face pyramid (checkMesh's check) sees the turned face.
+  std::vector<Face> faces{{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  auto cube = [](std::vector<Face> f) {
+    PolyMesh m = one_cell(std::move(f));
+    m.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    return cell_quality(m);
+  };
+  const CellQuality good = cube(faces);
+  EXPECT_NEAR(good.volume[0], 1.0, 1e-12);
+  EXPECT_NEAR(good.min_face_pyramid[0], 1.0 / 6.0, 1e-12);  // each face with the centre: a sixth of the cube
+  EXPECT_EQ(good.inverted_face_pyramids, 0);
+  EXPECT_TRUE(good.bad_cells(QualityGate{}, 1.0).empty());
+  std::reverse(faces[1].begin(), faces[1].end());
+  const CellQuality turned = cube(faces);
+  EXPECT_NEAR(turned.volume[0], 2.0 / 3.0, 1e-12);
+  // OpenFOAM's centre weighs each face's pyramid from the faces' mean centre (z = 1/2), the
+  // turned one negatively: z = (4 x 1/4 + 1/16 - 7/16) / 2 = 5/16; the top face's pyramid from
+  // there is -(1 - 5/16) / 3.
+  EXPECT_NEAR(turned.min_face_pyramid[0], -11.0 / 48.0, 1e-12);
+  EXPECT_EQ(turned.inverted_face_pyramids, 1);
+  EXPECT_EQ(turned.bad_cells(QualityGate{}, 1.0), std::vector<int>{0});
+}
+
+TEST(CellQuality, PolygonFacesGiveTheFiguresOfTheSameFacesStoredFixed) {
+  // The same tetrahedra as a PolyMesh and as a PolyhedralMesh: every figure alike, cell by cell.
+  Grid g = kuhn_grid(2);
+  for (std::size_t v = 0; v < g.points.size(); ++v) g.points[v].x() += 0.1 * std::sin(3.0 * v);
+  const PolyMesh m = poly_mesh_from_tets(g.points, g.tets, g.boundary, g.patch, kNames, kTypes);
+  PolyhedralMesh p;
+  p.points = m.points, p.owner = m.owner, p.neighbour = m.neighbour, p.patches = m.patches, p.cells = m.cells;
+  for (const Face& f : m.faces) p.faces.push_back(std::span<const int>(f.begin(), f.end()));
+  const CellQuality a = cell_quality(m), b = cell_quality(p);
+  EXPECT_EQ(a.non_orthogonality_deg, b.non_orthogonality_deg);
+  EXPECT_EQ(a.skewness, b.skewness);
+  EXPECT_EQ(a.aspect_ratio, b.aspect_ratio);
+  EXPECT_EQ(a.volume, b.volume);
+  EXPECT_EQ(a.min_face_pyramid, b.min_face_pyramid);
+  EXPECT_GT(a.max_skewness, 0.0);  // the shaken grid is not regular
 }
 
 }  // namespace
