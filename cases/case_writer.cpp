@@ -118,7 +118,8 @@ nlohmann::json CaseInfo::to_json() const {
           {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
           {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr},
-          {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr}};
+          {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr},
+          {"polyhedra_quality", polyhedra_quality ? polyhedra_quality->to_json(d_ref_m) : nullptr}};
 }
 
 namespace {
@@ -581,12 +582,14 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     ubar = u * g.cross_section_area * (g.outlet_z - g.inlet_z) / *fluid_volume;
   }
   long cells = mesh ? mesh->cells : 0;  // as written
+  std::optional<meshing::JudgedQuality> polyhedra_quality;
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
     if (mesh && p.polyhedra && !p.snappy_cells) {
       meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, geometry->centres, kDualFeatureAngleDeg);
-      meshing::gate_polyhedra(dual, {}, bed, g.d_ref, "the case's polyhedra", case_dir.parent_path() / "bad_polyhedra.vtk");
+      polyhedra_quality = meshing::gate_polyhedra(dual, {}, bed, g.d_ref, "the case's polyhedra",
+                                                  case_dir.parent_path() / "bad_polyhedra.vtk");
       if (g.periodic) meshing::match_cyclic_patches(dual, "inlet", "outlet");
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
@@ -611,6 +614,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;
   info.mean_velocity_m_s = ubar;
+  info.polyhedra_quality = polyhedra_quality;
   if (!info.particles && !p.slip_walls)
     info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance

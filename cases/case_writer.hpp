@@ -10,6 +10,7 @@
 #include "cases/case_params.hpp"
 #include "core/bed.hpp"
 #include "meshing/volume/cell_quality.hpp"
+#include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/poly_mesh.hpp"
 
 namespace bedforge::cases {
@@ -82,6 +83,8 @@ struct CaseInfo {
   // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
   // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
   std::optional<double> mean_velocity_m_s = std::nullopt;
+  // On polyhedra written here: their worst figures, as the gate judged them (gate_polyhedra).
+  std::optional<meshing::JudgedQuality> polyhedra_quality = std::nullopt;
   nlohmann::json to_json() const;        // its report.json entry
 };
 

@@ -284,26 +284,27 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
   return d;
 }
 
-long gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
-                    const std::string& what, const std::filesystem::path& bad_cells_path) {
+JudgedQuality gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
+                             const std::string& what, const std::filesystem::path& bad_cells_path) {
   const CellQuality q = cell_quality(dual);
   const QualityGate& gate = kCheckMeshLimits;
-  long count = 0;
-  double non_orthogonality = 0.0, skewness = 0.0, aspect_ratio = 0.0;
-  double volume = std::numeric_limits<double>::max(), pyramid = std::numeric_limits<double>::max();
+  JudgedQuality worst;
+  worst.min_volume = worst.min_face_pyramid = std::numeric_limits<double>::max();
   std::vector<int> bad;
   for (int c : q.bad_cells(gate, d_ref))
     if (judged.empty() || judged[c]) bad.push_back(c);
   for (int c = 0; c < dual.cells; ++c)
     if (judged.empty() || judged[c]) {
-      ++count;
-      non_orthogonality = std::max(non_orthogonality, q.non_orthogonality_deg[c]);
-      skewness = std::max(skewness, q.skewness[c]), aspect_ratio = std::max(aspect_ratio, q.aspect_ratio[c]);
-      volume = std::min(volume, q.volume[c]), pyramid = std::min(pyramid, q.min_face_pyramid[c]);
+      ++worst.cells;
+      worst.max_non_orthogonality_deg = std::max(worst.max_non_orthogonality_deg, q.non_orthogonality_deg[c]);
+      worst.max_skewness = std::max(worst.max_skewness, q.skewness[c]);
+      worst.max_aspect_ratio = std::max(worst.max_aspect_ratio, q.aspect_ratio[c]);
+      worst.min_volume = std::min(worst.min_volume, q.volume[c]);
+      worst.min_face_pyramid = std::min(worst.min_face_pyramid, q.min_face_pyramid[c]);
     }
   if (bad.empty()) {
     std::filesystem::remove(bad_cells_path);  // an earlier run's, which no longer describes the mesh
-    return count;
+    return worst;
   }
   const DefectLocations where = locate_bad_cells(bed, dual, q, bad, bad_cells_path);
   const double d3 = d_ref * d_ref * d_ref;
@@ -312,9 +313,19 @@ long gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged,
       "limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}; smallest face pyramid "
       "{:.2e} d^3, limit 0), most near {}; cells written to {}. The tetrahedra passed the quality gate; case.cells = "
       "\"tetrahedra\" runs on them, and other surface edge lengths ([surface]) make other polyhedra",
-      what, bad.size(), count, non_orthogonality, gate.max_non_orthogonality_deg, skewness, gate.max_skewness,
-      aspect_ratio, gate.max_aspect_ratio, volume / d3, gate.min_volume_d3, pyramid / d3, where.summary,
-      bad_cells_path.string()));
+      what, bad.size(), worst.cells, worst.max_non_orthogonality_deg, gate.max_non_orthogonality_deg,
+      worst.max_skewness, gate.max_skewness, worst.max_aspect_ratio, gate.max_aspect_ratio, worst.min_volume / d3,
+      gate.min_volume_d3, worst.min_face_pyramid / d3, where.summary, bad_cells_path.string()));
+}
+
+nlohmann::json JudgedQuality::to_json(double d_ref) const {
+  const double d3 = d_ref * d_ref * d_ref;
+  return {{"cells", cells},
+          {"max_non_orthogonality_deg", max_non_orthogonality_deg},
+          {"max_skewness", max_skewness},
+          {"max_aspect_ratio", max_aspect_ratio},
+          {"min_volume_d3", min_volume / d3},
+          {"min_face_pyramid_d3", min_face_pyramid / d3}};
 }
 
 }  // namespace bedforge::meshing

@@ -42,9 +42,15 @@ PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d
 //   what            the mesh, as the error names it (e.g. "piece 2 of 4's polyhedra")
 //   bad_cells_path  where the failing cells go, as legacy VTK (an earlier file there is removed
 //                   when every cell passes)
-// Returns the number of judged cells. ConvergenceError saying how many cells fail which limit,
-// near which particles, and where they were written.
-long gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
+// Returns the judged cells' worst figures. ConvergenceError saying how many cells fail which
+// limit, near which particles, and where they were written.
+struct JudgedQuality {
+  long cells = 0;
+  double max_non_orthogonality_deg = 0.0, max_skewness = 0.0, max_aspect_ratio = 0.0;
+  double min_volume = 0.0, min_face_pyramid = 0.0;  // m^3
+  nlohmann::json to_json(double d_ref) const;
+};
+JudgedQuality gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
                     const std::string& what, const std::filesystem::path& bad_cells_path);
 
 }  // namespace bedforge::meshing

@@ -231,7 +231,7 @@ TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreRefusedWhereJudged) {
   }
   EXPECT_TRUE(std::filesystem::exists(vtk));
   // A cell not judged (a neighbour's, around a piece) does not fail the piece; the stale file goes.
-  EXPECT_EQ(gate_polyhedra(cube, {false}, bed, 1.0, "the cube's polyhedra", vtk), 0);
+  EXPECT_EQ(gate_polyhedra(cube, {false}, bed, 1.0, "the cube's polyhedra", vtk).cells, 0);
   EXPECT_FALSE(std::filesystem::exists(vtk));
 }
 
