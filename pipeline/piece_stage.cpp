@@ -163,7 +163,8 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     std::vector<bool> own(dual.cells);
     for (int c = 0; c < dual.cells; ++c) own[c] = side[cell_points[c]] == 0;
     report["polyhedra_quality"] =
-        meshing::gate_polyhedra(dual, own, bed, d, fmt::format("piece {} of {}'s polyhedra", piece + 1, pieces),
+        meshing::gate_polyhedra(dual, std::move(own), &cell_points, bed, d,
+                                fmt::format("piece {} of {}'s polyhedra", piece + 1, pieces),
                                 case_dir / fmt::format("bad_polyhedra_piece{}.vtk", piece))
             .to_json(d);
     dual = meshing::dual_piece(dual, cell_points, side, piece, pieces);

@@ -15,6 +15,10 @@ namespace {
 
 constexpr double kRootVSmall = 1e-150;  // OpenFOAM's ROOTVSMALL, guards divisions as it does
 
+// Face f's point labels in place, whichever way the mesh stores its faces.
+std::span<const int> face_points(const PolyMesh& m, int f) { return {m.faces[f].begin(), m.faces[f].end()}; }
+std::span<const int> face_points(const PolyhedralMesh& m, int f) { return m.faces[f]; }
+
 template <class Mesh>
 CellQuality cell_quality_of(const Mesh& m) {
   CellQuality q;
@@ -30,47 +34,27 @@ CellQuality cell_quality_of(const Mesh& m) {
   double sum_cos = 0.0;
 
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
-    const auto& t = m.faces[f];
-    const auto [fc, area] = face_geometry(m.points, t);
     const int own = m.owner[f];
     const bool internal = f < m.neighbour.size();
-    sum_mag_area[own] += area.cwiseAbs();
-    const Eigen::Vector3d cpf = fc - cc[own];
-    // Face pyramids as primitiveMeshTools::facePyramidVolume: the face seen from each of its
-    // cells' centres, positive when the face points away from that centre.
-    const auto pyramid = [&](int cell, double volume) {
-      q.min_face_pyramid[cell] = std::min(q.min_face_pyramid[cell], volume);
-      q.inverted_face_pyramids += volume < 0.0;
-    };
-    pyramid(own, area.dot(cpf) / 3.0);
-    Eigen::Vector3d d;
-    if (internal) {
-      const int nei = m.neighbour[f];
-      pyramid(nei, area.dot(cc[nei] - fc) / 3.0);
-      sum_mag_area[nei] += area.cwiseAbs();
-      d = cc[nei] - cc[own];
-      const double c = std::clamp(d.dot(area) / (d.norm() * area.norm() + kRootVSmall), -1.0, 1.0);
-      const double angle = std::acos(c) * 180.0 / std::numbers::pi;
-      sum_cos += c;
-      q.max_non_orthogonality_deg = std::max(q.max_non_orthogonality_deg, angle);
-      if (angle > 70.0) ++q.faces_over_70_deg;
-      ++q.non_orthogonality_histogram[std::min(8, static_cast<int>(angle / 10.0))];
-      q.non_orthogonality_deg[own] = std::max(q.non_orthogonality_deg[own], angle);
-      q.non_orthogonality_deg[nei] = std::max(q.non_orthogonality_deg[nei], angle);
-    } else {
-      const Eigen::Vector3d n = area / (area.norm() + kRootVSmall);
-      d = n * n.dot(cpf);
+    const int nei = internal ? m.neighbour[f] : -1;
+    const FaceFigures ff = face_figures(m.points, face_points(m, static_cast<int>(f)), cc[own], internal ? &cc[nei] : nullptr);
+    sum_mag_area[own] += ff.area.cwiseAbs();
+    q.max_skewness = std::max(q.max_skewness, ff.skewness);
+    for (const auto& [cell, pyramid] : {std::pair{own, ff.pyramid_owner}, std::pair{nei, ff.pyramid_neighbour}}) {
+      if (cell < 0) continue;
+      q.min_face_pyramid[cell] = std::min(q.min_face_pyramid[cell], pyramid);
+      q.inverted_face_pyramids += pyramid < 0.0;
+      q.skewness[cell] = std::max(q.skewness[cell], ff.skewness);
     }
-    // Skewness as primitiveMeshTools::faceSkewness / boundaryFaceSkewness.
-    const Eigen::Vector3d sv = internal ? Eigen::Vector3d(cpf - (area.dot(cpf) / (area.dot(d) + kRootVSmall)) * d)
-                                        : Eigen::Vector3d(cpf - d);
-    const Eigen::Vector3d sv_hat = sv / (sv.norm() + kRootVSmall);
-    double fd = 0.2 * d.norm() + kRootVSmall;
-    for (int v : t) fd = std::max(fd, std::abs(sv_hat.dot(m.points[v] - fc)));
-    const double skew = sv.norm() / fd;
-    q.max_skewness = std::max(q.max_skewness, skew);
-    q.skewness[own] = std::max(q.skewness[own], skew);
-    if (internal) q.skewness[m.neighbour[f]] = std::max(q.skewness[m.neighbour[f]], skew);
+    if (!internal) continue;
+    sum_mag_area[nei] += ff.area.cwiseAbs();
+    const double angle = ff.non_orthogonality_deg;
+    sum_cos += std::cos(angle * std::numbers::pi / 180.0);
+    q.max_non_orthogonality_deg = std::max(q.max_non_orthogonality_deg, angle);
+    if (angle > 70.0) ++q.faces_over_70_deg;
+    ++q.non_orthogonality_histogram[std::min(8, static_cast<int>(angle / 10.0))];
+    q.non_orthogonality_deg[own] = std::max(q.non_orthogonality_deg[own], angle);
+    q.non_orthogonality_deg[nei] = std::max(q.non_orthogonality_deg[nei], angle);
   }
 
   q.min_volume = q.volume.empty() ? 0.0 : q.volume[0];
@@ -144,6 +128,41 @@ DefectLocations locate_bad_cells_of(const Bed& bed, const Mesh& m, const CellQua
 }
 
 }  // namespace
+
+FaceFigures face_figures(const std::vector<Eigen::Vector3d>& points, std::span<const int> face,
+                         const Eigen::Vector3d& owner_centre, const Eigen::Vector3d* neighbour_centre) {
+  FaceFigures out;
+  const auto [fc, area] = face_geometry(points, face);
+  out.area = area;
+  const Eigen::Vector3d cpf = fc - owner_centre;
+  // Face pyramids as primitiveMeshTools::facePyramidVolume: the face seen from each of its
+  // cells' centres, positive when the face points away from that centre.
+  out.pyramid_owner = area.dot(cpf) / 3.0;
+  Eigen::Vector3d d;
+  if (neighbour_centre) {
+    out.pyramid_neighbour = area.dot(*neighbour_centre - fc) / 3.0;
+    d = *neighbour_centre - owner_centre;
+    const double c = std::clamp(d.dot(area) / (d.norm() * area.norm() + kRootVSmall), -1.0, 1.0);
+    out.non_orthogonality_deg = std::acos(c) * 180.0 / std::numbers::pi;
+  } else {
+    const Eigen::Vector3d n = area / (area.norm() + kRootVSmall);
+    d = n * n.dot(cpf);
+  }
+  // Skewness as primitiveMeshTools::faceSkewness / boundaryFaceSkewness.
+  const Eigen::Vector3d sv = neighbour_centre
+                                 ? Eigen::Vector3d(cpf - (area.dot(cpf) / (area.dot(d) + kRootVSmall)) * d)
+                                 : Eigen::Vector3d(cpf - d);
+  const Eigen::Vector3d sv_hat = sv / (sv.norm() + kRootVSmall);
+  double fd = 0.2 * d.norm() + kRootVSmall;
+  for (int v : face) fd = std::max(fd, std::abs(sv_hat.dot(points[v] - fc)));
+  out.skewness = sv.norm() / fd;
+  return out;
+}
+
+bool FaceFigures::fails(const QualityGate& gate) const {
+  return non_orthogonality_deg > gate.max_non_orthogonality_deg || skewness > gate.max_skewness ||
+         pyramid_owner < 0.0 || pyramid_neighbour < 0.0;
+}
 
 CellQuality cell_quality(const PolyMesh& mesh) { return cell_quality_of(mesh); }
 CellQuality cell_quality(const PolyhedralMesh& mesh) { return cell_quality_of(mesh); }

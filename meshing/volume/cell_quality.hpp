@@ -58,6 +58,19 @@ struct CellQuality {
 CellQuality cell_quality(const PolyMesh& mesh);
 CellQuality cell_quality(const PolyhedralMesh& mesh);
 
+// One face's figures, as CellQuality's definitions: its area vector (m^2), its non-orthogonality
+// (internal faces; 0 on the boundary), its skewness, and its pyramids from the owner's centre and
+// from the neighbour's (m^3; 0 for a boundary face's neighbour).
+//   points, face      the mesh's points (m) and the face's point labels
+//   owner_centre      the owner cell's centre (m); neighbour_centre: the neighbour's, null on the boundary
+struct FaceFigures {
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  double non_orthogonality_deg = 0.0, skewness = 0.0, pyramid_owner = 0.0, pyramid_neighbour = 0.0;
+  bool fails(const QualityGate& gate) const;  // a limit of `gate` that concerns faces, or an inverted pyramid
+};
+FaceFigures face_figures(const std::vector<Eigen::Vector3d>& points, std::span<const int> face,
+                         const Eigen::Vector3d& owner_centre, const Eigen::Vector3d* neighbour_centre);
+
 // Where the cells `bad` of `m` (quality `q`) lie: the particle nearest to each and the summary
 // of locate_defects; when `path` is not empty, the cells are also written there as legacy VTK,
 // the polygons of their faces each carrying its cell's quality and nearest particle, for ParaView.

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <tuple>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -284,15 +285,112 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
   return d;
 }
 
-JudgedQuality gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>& judged, const Bed& bed, double d_ref,
-                             const std::string& what, const std::filesystem::path& bad_cells_path) {
-  const CellQuality q = cell_quality(dual);
+namespace {
+
+// The cells of `m` merged by group (new_cell: per cell its group, groups numbered 0.. in the order
+// of their first cell): the faces between cells of one group go, the others are kept with their
+// cells renumbered, internal ones turned and sorted back into upper-triangular order, points no
+// face uses any more dropped.
+PolyhedralMesh merged_cells(const PolyhedralMesh& m, const std::vector<int>& new_cell, int cells) {
+  PolyhedralMesh out;
+  out.cells = cells;
+  struct Internal {
+    int owner, neighbour, face;
+    bool turned;
+  };
+  std::vector<Internal> internal;
+  for (int f = 0; f < m.internal_faces(); ++f) {
+    const int o = new_cell[m.owner[f]], n = new_cell[m.neighbour[f]];
+    if (o != n) internal.push_back({std::min(o, n), std::max(o, n), f, o > n});
+  }
+  std::sort(internal.begin(), internal.end(), [](const Internal& x, const Internal& y) {
+    return std::tie(x.owner, x.neighbour, x.face) < std::tie(y.owner, y.neighbour, y.face);
+  });
+  std::vector<int> point(m.points.size(), -1);
+  auto add = [&](std::span<const int> face, bool turned) {
+    std::vector<int> f(face.begin(), face.end());
+    if (turned) std::reverse(f.begin() + 1, f.end());  // the same first point, the normal turned
+    for (int& v : f) {
+      if (point[v] < 0) point[v] = static_cast<int>(out.points.size()), out.points.push_back(m.points[v]);
+      v = point[v];
+    }
+    out.faces.push_back(f);
+  };
+  for (const Internal& i : internal) {
+    add(m.faces[i.face], i.turned);
+    out.owner.push_back(i.owner);
+    out.neighbour.push_back(i.neighbour);
+  }
+  for (PolyMesh::Patch patch : m.patches) {
+    const int start = patch.start;
+    patch.start = static_cast<int>(out.owner.size());
+    for (int f = start; f < start + patch.size; ++f) {
+      add(m.faces[f], false);
+      out.owner.push_back(new_cell[m.owner[f]]);
+    }
+    out.patches.push_back(patch);
+  }
+  return out;
+}
+
+}  // namespace
+
+JudgedQuality gate_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, std::vector<int>* cell_points,
+                             const Bed& bed, double d_ref, const std::string& what,
+                             const std::filesystem::path& bad_cells_path) {
   const QualityGate& gate = kCheckMeshLimits;
+  const auto judged_bad = [&](const CellQuality& q) {
+    std::vector<int> bad;
+    for (int c : q.bad_cells(gate, d_ref))
+      if (judged.empty() || judged[c]) bad.push_back(c);
+    return bad;
+  };
+  CellQuality q = cell_quality(dual);
+  std::vector<int> bad = judged_bad(q);
+  long merged = 0;
+  if (!bad.empty()) {
+    // Cells across a failing internal face, both judged, become one cell (union by the lower).
+    std::vector<char> is_bad(dual.cells, 0);
+    for (int c : bad) is_bad[c] = 1;
+    std::vector<int> group(dual.cells);
+    std::iota(group.begin(), group.end(), 0);
+    const auto root = [&](int c) {
+      while (group[c] != c) c = group[c] = group[group[c]];
+      return c;
+    };
+    const std::vector<Eigen::Vector3d> centres = cell_geometry(dual).centres;
+    for (int f = 0; f < dual.internal_faces(); ++f) {
+      const int o = dual.owner[f], n = dual.neighbour[f];
+      if (!(is_bad[o] || is_bad[n]) || !(judged.empty() || (judged[o] && judged[n]))) continue;
+      if (!face_figures(dual.points, dual.faces[f], centres[o], &centres[n]).fails(gate)) continue;
+      const int ro = root(o), rn = root(n);
+      if (ro != rn) group[std::max(ro, rn)] = std::min(ro, rn), ++merged;
+    }
+    if (merged > 0) {
+      const int old_cells = dual.cells;
+      std::vector<int> new_cell(old_cells, -1), first(old_cells, -1);
+      int cells = 0;
+      for (int c = 0; c < old_cells; ++c) {
+        const int r = root(c);
+        if (first[r] < 0) first[r] = cells++;
+        new_cell[c] = first[r];
+      }
+      dual = merged_cells(dual, new_cell, cells);
+      std::vector<bool> kept(cells, judged.empty());
+      std::vector<int> points(cell_points ? cells : 0);
+      for (int c = old_cells - 1; c >= 0; --c) {  // each group keeps its first cell's point
+        if (!judged.empty()) kept[new_cell[c]] = judged[c];
+        if (cell_points) points[new_cell[c]] = (*cell_points)[c];
+      }
+      if (!judged.empty()) judged = std::move(kept);
+      if (cell_points) *cell_points = std::move(points);
+      q = cell_quality(dual);
+      bad = judged_bad(q);
+    }
+  }
   JudgedQuality worst;
+  worst.merged_cells = merged;
   worst.min_volume = worst.min_face_pyramid = std::numeric_limits<double>::max();
-  std::vector<int> bad;
-  for (int c : q.bad_cells(gate, d_ref))
-    if (judged.empty() || judged[c]) bad.push_back(c);
   for (int c = 0; c < dual.cells; ++c)
     if (judged.empty() || judged[c]) {
       ++worst.cells;
@@ -311,16 +409,19 @@ JudgedQuality gate_polyhedra(const PolyhedralMesh& dual, const std::vector<bool>
   throw ConvergenceError(fmt::format(
       "{}: {} of {} cells fail checkMesh's limits (max non-orthogonality {:.1f} deg, limit {}; max skewness {:.2f}, "
       "limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}; smallest face pyramid "
-      "{:.2e} d^3, limit 0), most near {}; cells written to {}. The tetrahedra passed the quality gate; case.cells = "
+      "{:.2e} d^3, limit 0){}, most near {}; cells written to {}. The tetrahedra passed the quality gate; case.cells = "
       "\"tetrahedra\" runs on them, and other surface edge lengths ([surface]) make other polyhedra",
       what, bad.size(), worst.cells, worst.max_non_orthogonality_deg, gate.max_non_orthogonality_deg,
       worst.max_skewness, gate.max_skewness, worst.max_aspect_ratio, gate.max_aspect_ratio, worst.min_volume / d3,
-      gate.min_volume_d3, worst.min_face_pyramid / d3, where.summary, bad_cells_path.string()));
+      gate.min_volume_d3, worst.min_face_pyramid / d3,
+      merged ? fmt::format(" after {} cells were merged with their neighbours across failing faces", merged) : "",
+      where.summary, bad_cells_path.string()));
 }
 
 nlohmann::json JudgedQuality::to_json(double d_ref) const {
   const double d3 = d_ref * d_ref * d_ref;
   return {{"cells", cells},
+          {"merged_cells", merged_cells},
           {"max_non_orthogonality_deg", max_non_orthogonality_deg},
           {"max_skewness", max_skewness},
           {"max_aspect_ratio", max_aspect_ratio},

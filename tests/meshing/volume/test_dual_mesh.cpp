@@ -221,7 +221,7 @@ TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreRefusedWhereJudged) {
   std::filesystem::create_directories(dir);
   const auto vtk = dir / "bad_polyhedra.vtk";
   try {
-    gate_polyhedra(cube, {}, bed, 1.0, "the cube's polyhedra", vtk);
+    gate_polyhedra(cube, {}, nullptr, bed, 1.0, "the cube's polyhedra", vtk);
     ADD_FAILURE() << "a cell with an inverted face pyramid passed";
   } catch (const ConvergenceError& e) {
     const std::string msg = e.what();
@@ -231,8 +231,62 @@ TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreRefusedWhereJudged) {
   }
   EXPECT_TRUE(std::filesystem::exists(vtk));
   // A cell not judged (a neighbour's, around a piece) does not fail the piece; the stale file goes.
-  EXPECT_EQ(gate_polyhedra(cube, {false}, bed, 1.0, "the cube's polyhedra", vtk).cells, 0);
+  EXPECT_EQ(gate_polyhedra(cube, {false}, nullptr, bed, 1.0, "the cube's polyhedra", vtk).cells, 0);
   EXPECT_FALSE(std::filesystem::exists(vtk));
+}
+
+TEST(DualMesh, TwoCellsAcrossAFailingFaceAreMergedIntoOneThatPasses) {
+  // Two unit cubes side by side whose shared face (x = 1) points from the second into the first:
+  // seen from the wrong side by both (non-orthogonality 180 deg, both pyramids inverted). Merged,
+  // they are the 2 x 1 x 1 box, which passes; not judged, the second may not merge, and the face
+  // fails the gate.
+  auto two_cubes = [] {
+    PolyhedralMesh m;
+    for (int z = 0; z < 2; ++z)
+      for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 3; ++x) m.points.emplace_back(x, y, z);
+    const auto p = [](int x, int y, int z) { return (z * 2 + y) * 3 + x; };
+    m.faces.push_back(std::vector<int>{p(1, 0, 0), p(1, 0, 1), p(1, 1, 1), p(1, 1, 0)});  // normal -x: turned
+    m.owner = {0};
+    m.neighbour = {1};
+    for (int c = 0; c < 2; ++c) {  // each cube's five outer faces, pointing out
+      const std::vector<std::vector<int>> outer{
+          {p(c, 0, 0), p(c, 1, 0), p(c + 1, 1, 0), p(c + 1, 0, 0)},   // z = 0
+          {p(c, 0, 1), p(c + 1, 0, 1), p(c + 1, 1, 1), p(c, 1, 1)},   // z = 1
+          {p(c, 0, 0), p(c + 1, 0, 0), p(c + 1, 0, 1), p(c, 0, 1)},   // y = 0
+          {p(c, 1, 0), p(c, 1, 1), p(c + 1, 1, 1), p(c + 1, 1, 0)}};  // y = 1
+      for (const auto& f : outer) m.faces.push_back(f), m.owner.push_back(c);
+      const int x = 2 * c;  // the cube's end: x = 0 for the first, x = 2 for the second
+      m.faces.push_back(c == 0 ? std::vector<int>{p(x, 0, 0), p(x, 0, 1), p(x, 1, 1), p(x, 1, 0)}
+                               : std::vector<int>{p(x, 0, 0), p(x, 1, 0), p(x, 1, 1), p(x, 0, 1)});
+      m.owner.push_back(c);
+    }
+    PolyMesh::Patch walls;
+    walls.name = "walls", walls.type = "wall", walls.start = 1, walls.size = 10;
+    m.patches = {walls};
+    m.cells = 2;
+    return m;
+  };
+  Bed bed;
+  bed.centres = {Eigen::Vector3d(1.0, 0.5, 2.0)};
+  bed.diameters = {1.0};
+  const auto dir = cli_test::fresh_dir("dual_merge");
+  std::filesystem::create_directories(dir);
+  PolyhedralMesh merged = two_cubes();
+  std::vector<int> cell_points{7, 9};
+  const JudgedQuality q = gate_polyhedra(merged, {}, &cell_points, bed, 1.0, "two cubes", dir / "bad.vtk");
+  EXPECT_EQ(q.merged_cells, 1);
+  EXPECT_EQ(q.cells, 1);
+  EXPECT_EQ(merged.cells, 1);
+  EXPECT_EQ(merged.internal_faces(), 0);
+  EXPECT_EQ(merged.faces.size(), 10u);
+  EXPECT_EQ(merged.points.size(), 12u);  // the removed face's points are all on the others
+  EXPECT_EQ(cell_points, std::vector<int>{7});
+  EXPECT_NEAR(cell_geometry(merged).volumes[0], 2.0, 1e-12);
+  EXPECT_GT(q.min_face_pyramid, 0.0);
+  PolyhedralMesh kept = two_cubes();
+  EXPECT_THROW(gate_polyhedra(kept, {true, false}, nullptr, bed, 1.0, "two cubes", dir / "bad.vtk"), ConvergenceError);
+  EXPECT_EQ(kept.cells, 2);
 }
 
 TEST(DualMesh, IsTheOnePolyDualMeshMakes) {
