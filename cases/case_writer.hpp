@@ -83,7 +83,7 @@ struct CaseInfo {
   // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
   // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
   std::optional<double> mean_velocity_m_s = std::nullopt;
-  // On polyhedra written here: their worst figures, as the gate judged them (gate_polyhedra).
+  // On polyhedra written here: their worst figures, as checked (check_polyhedra).
   std::optional<meshing::JudgedQuality> polyhedra_quality = std::nullopt;
   nlohmann::json to_json() const;        // its report.json entry
 };

@@ -78,6 +78,10 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
     line += fmt::format(", bed section eps {:.4f}", out.info.section.void_fraction_bed);
     if (out.info.section.void_fraction) line += fmt::format(" (meshed {:.4f})", *out.info.section.void_fraction);
   }
+  // Polyhedra that Allrun's checkMesh will fail are said here, before the run (not refused: see
+  // meshing::check_polyhedra).
+  if (out.info.polyhedra_quality && out.info.polyhedra_quality->failing_cells > 0)
+    line += "; checkMesh will fail " + out.info.polyhedra_quality->failure;
   if (p.run) run_flow(out, line, console);
   finish_stage(out.report, meter, line, console);
   return out;

@@ -4,8 +4,10 @@
 #include <fmt/ranges.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <thread>
@@ -158,12 +160,12 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     const std::vector<int> side = std::move(whole.side);
     whole = meshing::SlabWithLayers();
     release_free_memory();
-    // The piece's own polyhedra, held to checkMesh's limits with its neighbours' cells around
-    // them, whose centres the faces across the planes see (as `checkMesh -parallel` does).
+    // The piece's own polyhedra, checked against checkMesh's limits with its neighbours' cells
+    // around them, whose centres the faces across the planes see (as `checkMesh -parallel` does).
     std::vector<bool> own(dual.cells);
     for (int c = 0; c < dual.cells; ++c) own[c] = side[cell_points[c]] == 0;
     report["polyhedra_quality"] =
-        meshing::gate_polyhedra(dual, std::move(own), &cell_points, bed, d,
+        meshing::check_polyhedra(dual, std::move(own), &cell_points, bed, d,
                                 fmt::format("piece {} of {}'s polyhedra", piece + 1, pieces),
                                 case_dir / fmt::format("bad_polyhedra_piece{}.vtk", piece))
             .to_json(d);
@@ -256,6 +258,22 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
       cells += r["cells"].get<long>();
       fluid += r["fluid_volume_m3"].get<double>();
       void_fraction += r["section_void_fraction_share"].get<double>();
+      // The pieces' polyhedra against checkMesh's limits, as one mesh's (meshing::check_polyhedra).
+      if (const auto q = r.find("polyhedra_quality"); q != r.end()) {
+        meshing::JudgedQuality& all = info.polyhedra_quality ? *info.polyhedra_quality : info.polyhedra_quality.emplace();
+        const double d3 = std::pow(info.d_ref_m, 3);
+        if (all.cells == 0) all.min_volume = all.min_face_pyramid = std::numeric_limits<double>::max();
+        all.cells += (*q)["cells"].get<long>();
+        all.merged_cells += (*q)["merged_cells"].get<long>();
+        all.failing_cells += (*q)["failing_cells"].get<long>();
+        all.max_non_orthogonality_deg = std::max(all.max_non_orthogonality_deg, (*q)["max_non_orthogonality_deg"].get<double>());
+        all.max_skewness = std::max(all.max_skewness, (*q)["max_skewness"].get<double>());
+        all.max_aspect_ratio = std::max(all.max_aspect_ratio, (*q)["max_aspect_ratio"].get<double>());
+        all.min_volume = std::min(all.min_volume, (*q)["min_volume_d3"].get<double>() * d3);
+        all.min_face_pyramid = std::min(all.min_face_pyramid, (*q)["min_face_pyramid_d3"].get<double>() * d3);
+        const std::string failure = (*q)["failure"].get<std::string>();
+        if (!failure.empty()) all.failure += (all.failure.empty() ? "" : "; ") + failure;
+      }
     }
     info.cells = cells;
     info.fluid_volume_m3 = fluid;

@@ -231,9 +231,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"case.cells",
        {"the cells solved on: the dual polyhedra of gmsh's tetrahedra (as `polyDualMesh 80` makes them, about a fifth "
         "as many cells), on which the empty tube's pressure drop converges to the exact one; or gmsh's tetrahedra, "
-        "where it settles about 16 % high however fine the mesh; the polyhedra are held to checkMesh's limits "
+        "where it settles about 16 % high however fine the mesh; the polyhedra are checked against checkMesh's limits "
         "(non-orthogonality below 90 deg, skewness 4, positive volumes and face pyramids) before the case is written, "
-        "failures written to `bad_polyhedra.vtk`",
+        "two cells across a failing face merged, and those that still fail said and written to `bad_polyhedra.vtk`",
         "", kWhyCells}},
       {"case.section_exclude_d",
        {"the bed section of the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this"}},

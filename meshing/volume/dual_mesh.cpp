@@ -14,7 +14,6 @@
 #include <unordered_map>
 
 #include "core/edge_key.hpp"
-#include "core/error.hpp"
 #include "core/point_key.hpp"
 
 namespace bedforge::meshing {
@@ -335,7 +334,7 @@ PolyhedralMesh merged_cells(const PolyhedralMesh& m, const std::vector<int>& new
 
 }  // namespace
 
-JudgedQuality gate_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, std::vector<int>* cell_points,
+JudgedQuality check_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, std::vector<int>* cell_points,
                              const Bed& bed, double d_ref, const std::string& what,
                              const std::filesystem::path& bad_cells_path) {
   const QualityGate& gate = kCheckMeshLimits;
@@ -400,28 +399,31 @@ JudgedQuality gate_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, std
       worst.min_volume = std::min(worst.min_volume, q.volume[c]);
       worst.min_face_pyramid = std::min(worst.min_face_pyramid, q.min_face_pyramid[c]);
     }
+  worst.failing_cells = static_cast<long>(bad.size());
   if (bad.empty()) {
     std::filesystem::remove(bad_cells_path);  // an earlier run's, which no longer describes the mesh
     return worst;
   }
   const DefectLocations where = locate_bad_cells(bed, dual, q, bad, bad_cells_path);
   const double d3 = d_ref * d_ref * d_ref;
-  throw ConvergenceError(fmt::format(
+  worst.failure = fmt::format(
       "{}: {} of {} cells fail checkMesh's limits (max non-orthogonality {:.1f} deg, limit {}; max skewness {:.2f}, "
       "limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}; smallest face pyramid "
-      "{:.2e} d^3, limit 0){}, most near {}; cells written to {}. The tetrahedra passed the quality gate; case.cells = "
-      "\"tetrahedra\" runs on them, and other surface edge lengths ([surface]) make other polyhedra",
+      "{:.2e} d^3, limit 0){}, most near {}; cells written to {}",
       what, bad.size(), worst.cells, worst.max_non_orthogonality_deg, gate.max_non_orthogonality_deg,
       worst.max_skewness, gate.max_skewness, worst.max_aspect_ratio, gate.max_aspect_ratio, worst.min_volume / d3,
       gate.min_volume_d3, worst.min_face_pyramid / d3,
       merged ? fmt::format(" after {} cells were merged with their neighbours across failing faces", merged) : "",
-      where.summary, bad_cells_path.string()));
+      where.summary, bad_cells_path.string());
+  return worst;
 }
 
 nlohmann::json JudgedQuality::to_json(double d_ref) const {
   const double d3 = d_ref * d_ref * d_ref;
   return {{"cells", cells},
           {"merged_cells", merged_cells},
+          {"failing_cells", failing_cells},
+          {"failure", failure},
           {"max_non_orthogonality_deg", max_non_orthogonality_deg},
           {"max_skewness", max_skewness},
           {"max_aspect_ratio", max_aspect_ratio},

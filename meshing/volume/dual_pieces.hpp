@@ -23,7 +23,7 @@ namespace bedforge::meshing {
 // the whole mesh would, so the piece's own cells are the whole mesh's; the third keeps the
 // layer's edge (whose meeting with a wall the dual takes for a feature) away from the points
 // next to those, so that the neighbour's cells across the plane are the whole mesh's too, and
-// the faces between them are judged as checkMesh judges them (gate_polyhedra).
+// the faces between them are judged as checkMesh judges them (check_polyhedra).
 struct PlaneLayer {
   std::vector<Eigen::Vector3d> points;  // m
   std::vector<VolumeCell> cells;        // tetrahedra, into points
