@@ -36,6 +36,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"cell_size_m", l.cell_size_m},
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged},
+                {"cells_failing_check_mesh", l.cells_failing_check_mesh},
                 {"wall_share_of_drag", l.wall_share_of_drag},
                 {"force_balance_relative_error", l.force_balance_relative_error},
                 {"own_time_s", l.own_time_s}});
@@ -73,6 +74,7 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   l.cell_size_m = j.at("cell_size_m").get<double>();
   l.pressure_gradient_pa_m = j.at("pressure_gradient_bed_pa_m").get<double>();
   l.converged = j.at("converged").get<bool>();
+  l.cells_failing_check_mesh = j.value("cells_failing_check_mesh", 0L);  // reports before 2026-11-29 lack it
   l.wall_share_of_drag = j.at("wall_share_of_drag").get<double>();
   l.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
   l.own_time_s = j.at("own_time_s").get<double>();
@@ -98,6 +100,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3.value() / static_cast<double>(l.cells));  // gmsh cells: known
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
+  if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
   l.wall_share_of_drag = solved.flow->wall_share_of_drag;
   l.force_balance_relative_error = solved.flow->force_balance_relative_error;
   l.exact_pa_m = solved.flow->exact_pa_m;

@@ -22,6 +22,7 @@ struct StudyLevel {
   double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
+  long cells_failing_check_mesh = 0;  // polyhedra that fail checkMesh's limits (meshing::check_polyhedra)
   double wall_share_of_drag = 0.0;            // the walls' share of the drag (cases::FlowResult)
   double force_balance_relative_error = 0.0;  // drag against the push through inlet and outlet, - 1
   double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one

@@ -40,6 +40,8 @@ struct PressureDropAnswer {
   std::optional<double> void_fraction_bed;           // where the correlation was taken
   // Without a best estimate: why not, and what to change, with its cost by this run's own levels.
   std::string why_no_estimate;
+  // The levels given a value whose polyhedra fail checkMesh's limits: (level, cells failing).
+  std::vector<std::pair<int, long>> failing_check_mesh;
   std::string advice;
   // The lines printed at the end of a run and kept in summary.txt.
   std::vector<std::string> lines() const;

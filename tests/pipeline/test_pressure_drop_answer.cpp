@@ -96,6 +96,18 @@ TEST(PressureDropAnswer, AStudyInTheAsymptoticRangeGivesTheExtrapolationAndTheFi
   EXPECT_FALSE(j.contains("advice"));
 }
 
+// Levels whose polyhedra fail checkMesh's limits are named beside the answer that rests on them;
+// a study whose levels all pass says nothing of it.
+TEST(PressureDropAnswer, LevelsWhosePolyhedraFailCheckMeshAreSaidBesideTheAnswer) {
+  ConvergenceStudy study = study_of(30.0, -10.0, 2.0);
+  EXPECT_FALSE(has(pressure_drop_answer(scene_with(), case_entry(20.0), &study)->lines(), "checkMesh"));
+  study.levels[1].cells_failing_check_mesh = 58;
+  study.levels[2].cells_failing_check_mesh = 695;
+  const std::vector<std::string> lines = pressure_drop_answer(scene_with(), case_entry(20.0), &study)->lines();
+  EXPECT_TRUE(has(lines, "checkMesh: polyhedra fail its limits on the meshes solved (level 2: 58, level 3: 695"));
+  EXPECT_TRUE(has(lines, "best estimate: 30 Pa/m"));  // said, not refused
+}
+
 // Order 0.23 (the first study of the default bed at 0.1 d): outside 1-3, so no estimate and no
 // band; the advice refines every length by the ratio and costs it from the levels: cells x 1.3^3,
 // time in proportion to the cells (as the levels were made), the whole study the new finest plus
