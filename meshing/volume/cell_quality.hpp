@@ -22,10 +22,10 @@ struct QualityGate {
   double min_volume_d3 = 1e-12;  // smallest cell volume, in reference diameters cubed
 };
 
-// checkMesh's own limits, the gate of a case's polyhedra (the dual of tetrahedra that passed
-// QualityGate): a case that fails them fails Allrun's checkMesh. The dual is not held to the
-// tetrahedra's 85 deg: where its faces meet the walls it exceeds that on meshes that pass
-// checkMesh and whose flow converges (docs/findings.md). The volume limit is the tetrahedra's.
+// checkMesh's own limits, which a case's polyhedra (the dual of tetrahedra that passed
+// QualityGate) are checked against: a case that fails them fails Allrun's checkMesh. The dual is
+// not held to the tetrahedra's 85 deg: it exceeds that on meshes that pass checkMesh and whose
+// flow converges (docs/findings.md, session 44). The volume limit is the tetrahedra's.
 inline constexpr QualityGate kCheckMeshLimits{90.0, 4.0, 1000.0, 1e-12};
 
 // Per-cell and summary quality of a PolyMesh, with OpenFOAM's definitions
