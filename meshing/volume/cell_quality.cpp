@@ -148,12 +148,13 @@ FaceFigures face_figures(const std::vector<Eigen::Vector3d>& points, std::span<c
     const Eigen::Vector3d n = area / (area.norm() + kRootVSmall);
     d = n * n.dot(cpf);
   }
-  // Skewness as primitiveMeshTools::faceSkewness / boundaryFaceSkewness.
+  // Skewness as primitiveMeshTools::faceSkewness / boundaryFaceSkewness; a boundary face's d
+  // reaches only from the cell to the face, half an internal face's, hence 0.4 for 0.2.
   const Eigen::Vector3d sv = neighbour_centre
                                  ? Eigen::Vector3d(cpf - (area.dot(cpf) / (area.dot(d) + kRootVSmall)) * d)
                                  : Eigen::Vector3d(cpf - d);
   const Eigen::Vector3d sv_hat = sv / (sv.norm() + kRootVSmall);
-  double fd = 0.2 * d.norm() + kRootVSmall;
+  double fd = (neighbour_centre ? 0.2 : 0.4) * d.norm() + kRootVSmall;
   for (int v : face) fd = std::max(fd, std::abs(sv_hat.dot(points[v] - fc)));
   out.skewness = sv.norm() / fd;
   return out;

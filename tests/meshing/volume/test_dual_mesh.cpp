@@ -200,19 +200,42 @@ TEST(DualMesh, ItsQualityIsTheOneCheckMeshMeasures) {
   EXPECT_GT(q.max_skewness, 0.1);  // the shaken box's dual is far from regular
 }
 
+// One hexahedral cell on the points given (0-3 the bottom, 4-7 above them), its six faces one
+// wall patch; `top` its top face, pointing out of the cell unless given turned.
+PolyhedralMesh one_hexahedron(std::vector<Eigen::Vector3d> points, const std::vector<int>& top = {4, 5, 6, 7}) {
+  PolyhedralMesh cell;
+  cell.points = std::move(points);
+  for (const std::vector<int>& f : std::vector<std::vector<int>>{
+           {0, 3, 2, 1}, top, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}})
+    cell.faces.push_back(f);
+  cell.owner.assign(6, 0);
+  PolyMesh::Patch walls;
+  walls.name = "walls", walls.type = "wall", walls.size = 6;
+  cell.patches = {walls};
+  cell.cells = 1;
+  return cell;
+}
+
+TEST(DualMesh, ABoundaryFacesSkewnessIsTheOneCheckMeshMeasures) {
+  // A 1 x 1 x 10 box whose top is shifted by 1 in x: its end faces' centres sit 0.5 beside the
+  // normal through the cell's centre (1, 0.5, 5), 5 away. checkMesh normalises a boundary face's
+  // offset by 0.4 of that distance (an internal face's by 0.2 of the two cells' distance):
+  // 0.5 / max(0.4 x 5, the face's half-width 0.5) = 0.25.
+  const PolyhedralMesh cell = one_hexahedron({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                              {1, 0, 10}, {2, 0, 10}, {2, 1, 10}, {1, 1, 10}});
+  EXPECT_NEAR(cell_quality(cell).max_skewness, 0.25, 1e-12);
+  if (cli_test::shell("command -v checkMesh").status != 0) GTEST_SKIP() << "OpenFOAM (checkMesh) not on PATH";
+  const auto dir = cli_test::fresh_dir("boundary_skewness");
+  write_case(dir);
+  cases::write_poly_mesh(dir / "constant/polyMesh", cell, true, "test");
+  EXPECT_NEAR(check_mesh_figure(dir, "Max skewness = "), 0.25, 1e-6);
+}
+
 TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreSaidWhereJudged) {
   // One cube with a face turned into it (an inverted face pyramid, as checkMesh reports it; its
   // size, -11/48, is derived in test_poly_mesh.cpp).
-  PolyhedralMesh cube;
-  cube.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  for (const std::vector<int>& f : std::vector<std::vector<int>>{
-           {0, 3, 2, 1}, {7, 6, 5, 4}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}})
-    cube.faces.push_back(f);
-  cube.owner.assign(6, 0);
-  PolyMesh::Patch walls;
-  walls.name = "walls", walls.type = "wall", walls.size = 6;
-  cube.patches = {walls};
-  cube.cells = 1;
+  PolyhedralMesh cube = one_hexahedron(
+      {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}, {7, 6, 5, 4});
   Bed bed;
   bed.centres = {Eigen::Vector3d(0.5, 0.5, 2.0)};
   bed.diameters = {1.0};
