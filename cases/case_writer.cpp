@@ -589,7 +589,8 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     if (mesh && p.polyhedra && !p.snappy_cells) {
       meshing::PolyhedralMesh dual = meshing::dual_mesh(*mesh, geometry->centres, kDualFeatureAngleDeg);
       polyhedra_quality = meshing::check_polyhedra(dual, {}, nullptr, bed, g.d_ref, "the case's polyhedra",
-                                                  case_dir.parent_path() / "bad_polyhedra.vtk");
+                                                  case_dir.parent_path() /
+                                                      fmt::format("bad_polyhedra_{}.vtk", case_dir.filename().string()));
       if (g.periodic) meshing::match_cyclic_patches(dual, "inlet", "outlet");
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;

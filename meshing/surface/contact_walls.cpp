@@ -70,22 +70,31 @@ void ContactTreatment::wall(std::size_t i, const Wall& w, const NeighbourList& n
                                  "allowed: below 0.9 x the smallest sphere diameter",
                                  p_.bridge_diameter_d, i, 2.0 * r / d_));
   const double h = std::sqrt(r * r - bridge_radius * bridge_radius);
-  const int n = ring_points(bridge_radius, edge_c_);
-  const Frame f = plane_cut(i, a, h, bridge_radius, n, kBreakCocircular, "bridge to the " + w.name);
-  const GeneratorLength length = [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
+  const auto length_in = [&w](const Frame& f) -> GeneratorLength {
+    return [f, w](double x, double y) { return w.hit(f.to_world(Eigen::Vector3d(x, y, 0.0)), f.w); };
+  };
+  const GeneratorLength axial = length_in(Frame::along(c + h * a, a));
   double shortest = std::numeric_limits<double>::infinity();
   for (int j = 0; j < 64; ++j) {
-    const double l = length(bridge_radius * std::cos(2 * kPi * j / 64), bridge_radius * std::sin(2 * kPi * j / 64));
+    const double l = axial(bridge_radius * std::cos(2 * kPi * j / 64), bridge_radius * std::sin(2 * kPi * j / 64));
     shortest = std::min(shortest, std::isnan(l) ? -1.0 : l);
   }
   if (!(shortest > 0.0))
     throw InputError(fmt::format("{}: no room for a bridge (the sphere crosses the wall or the bridge misses it)", who));
+  // The tube to a wall is half as long as one between two touching spheres, or less at a concave
+  // wall; its edge is shortened in proportion, so that its triangles keep the shape they have
+  // between spheres: long thin ones gave dual cells whose centres fell outside their faces, which
+  // checkMesh failed (docs/findings.md, 2026-11-29).
+  const double edge = edge_c_ * std::min(1.0, shortest / (2.0 * (r - h)));
+  const int n = ring_points(bridge_radius, edge);
+  const Frame f = plane_cut(i, a, h, bridge_radius, n, kBreakCocircular, "bridge to the " + w.name);
+  const GeneratorLength length = length_in(f);
   const Eigen::Vector3d from = f.origin, to = f.origin + length(0.0, 0.0) * a;
   for (int k : nl.of(i))
     if (segment_distance(bed_.centres[k], from, to) < out_.radius[k] + bridge_radius)
       throw InputError(fmt::format("the bridge between {} would cross sphere {}", who, k));
-  holes.push_back({tube_end_loop(f, bridge_radius, n, length, edge_c_), 2.0 * kPi * bridge_radius / n, static_cast<int>(i)});
-  out_.parts.push_back(tube_mesh(f, bridge_radius, n, length, edge_c_, true, "particles"));
+  holes.push_back({tube_end_loop(f, bridge_radius, n, length, edge), 2.0 * kPi * bridge_radius / n, static_cast<int>(i)});
+  out_.parts.push_back(tube_mesh(f, bridge_radius, n, length, edge, true, "particles"));
   // Volume and lateral area of the bridge: polar quadrature over its cross-section (smooth
   // integrand: Gauss-Legendre in radius, trapezoid in angle, both spectrally accurate).
   constexpr int kAngles = 128;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "meshing/surface/contacts.hpp"
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/stl_io.hpp"
 #include "meshing/surface/surface_checks.hpp"
@@ -405,6 +406,29 @@ TEST(FluidSurface, BoxWallsTakeEveryTreatment) {
   const FluidSurface fs = build_fluid_surface(b, {});
   EXPECT_NEAR(fs.report["fluid_volume_exact_m3"].get<double>(),
               4.0 * (2.0 + 2.0) - 8 * 4.0 / 3.0 * std::numbers::pi * std::pow(0.495, 3), 1e-12);
+}
+
+TEST(FluidSurface, ABridgeToAWallHasTheTrianglesOfABridgeBetweenSpheres) {
+  // Spheres touching each other and flat walls: a bridge of radius rho leaves the sphere where it
+  // is r - h = r - sqrt(r^2 - rho^2) from the contact, so a bridge between two spheres is twice
+  // as long as one to a flat wall; the wall's ring takes half the edge, so that its tube's
+  // triangles keep the shape they have between spheres (long thin ones there gave dual cells
+  // checkMesh fails, docs/findings.md, 2026-11-29).
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::bridge;
+  const Bed b = box_stack(1);
+  const TreatedBed tb = treat_contacts(b, p, DomainPlanes{-1.0, 2.0, false});
+  const double rho = 0.5 * p.bridge_diameter_d, edge = p.contact_edge_length_d;
+  int walls = 0, pairs = 0;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    for (std::size_t k = 0; k < tb.cuts[i].size(); ++k) {
+      const bool to_wall = tb.cut_names[i][k].find("wall") != std::string::npos;
+      const double expected = 2.0 * std::numbers::pi * rho / ring_points(rho, to_wall ? 0.5 * edge : edge);
+      EXPECT_NEAR(tb.cuts[i][k].spacing, expected, 1e-12) << tb.cut_names[i][k];
+      ++(to_wall ? walls : pairs);
+    }
+  EXPECT_EQ(walls, 8);  // each sphere touches two walls
+  EXPECT_EQ(pairs, 8);  // and two neighbours
 }
 
 // The flat faces (inlet, outlet, the box's sides) are Delaunay with no four sites on a circle,
