@@ -260,19 +260,9 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
       void_fraction += r["section_void_fraction_share"].get<double>();
       // The pieces' polyhedra against checkMesh's limits, as one mesh's (meshing::check_polyhedra).
       if (const auto q = r.find("polyhedra_quality"); q != r.end()) {
-        meshing::JudgedQuality& all = info.polyhedra_quality ? *info.polyhedra_quality : info.polyhedra_quality.emplace();
-        const double d3 = std::pow(info.d_ref_m, 3);
-        if (all.cells == 0) all.min_volume = all.min_face_pyramid = std::numeric_limits<double>::max();
-        all.cells += (*q)["cells"].get<long>();
-        all.merged_cells += (*q)["merged_cells"].get<long>();
-        all.failing_cells += (*q)["failing_cells"].get<long>();
-        all.max_non_orthogonality_deg = std::max(all.max_non_orthogonality_deg, (*q)["max_non_orthogonality_deg"].get<double>());
-        all.max_skewness = std::max(all.max_skewness, (*q)["max_skewness"].get<double>());
-        all.max_aspect_ratio = std::max(all.max_aspect_ratio, (*q)["max_aspect_ratio"].get<double>());
-        all.min_volume = std::min(all.min_volume, (*q)["min_volume_d3"].get<double>() * d3);
-        all.min_face_pyramid = std::min(all.min_face_pyramid, (*q)["min_face_pyramid_d3"].get<double>() * d3);
-        const std::string failure = (*q)["failure"].get<std::string>();
-        if (!failure.empty()) all.failure += (all.failure.empty() ? "" : "; ") + failure;
+        const auto piece = meshing::JudgedQuality::from_json(*q, info.d_ref_m);
+        if (info.polyhedra_quality) info.polyhedra_quality->add(piece);
+        else info.polyhedra_quality = piece;
       }
     }
     info.cells = cells;

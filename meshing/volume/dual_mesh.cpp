@@ -431,4 +431,31 @@ nlohmann::json JudgedQuality::to_json(double d_ref) const {
           {"min_face_pyramid_d3", min_face_pyramid / d3}};
 }
 
+JudgedQuality JudgedQuality::from_json(const nlohmann::json& j, double d_ref) {
+  const double d3 = d_ref * d_ref * d_ref;
+  JudgedQuality q;
+  q.cells = j.at("cells").get<long>();
+  q.merged_cells = j.at("merged_cells").get<long>();
+  q.failing_cells = j.at("failing_cells").get<long>();
+  q.failure = j.at("failure").get<std::string>();
+  q.max_non_orthogonality_deg = j.at("max_non_orthogonality_deg").get<double>();
+  q.max_skewness = j.at("max_skewness").get<double>();
+  q.max_aspect_ratio = j.at("max_aspect_ratio").get<double>();
+  q.min_volume = j.at("min_volume_d3").get<double>() * d3;
+  q.min_face_pyramid = j.at("min_face_pyramid_d3").get<double>() * d3;
+  return q;
+}
+
+void JudgedQuality::add(const JudgedQuality& part) {
+  cells += part.cells;
+  merged_cells += part.merged_cells;
+  failing_cells += part.failing_cells;
+  max_non_orthogonality_deg = std::max(max_non_orthogonality_deg, part.max_non_orthogonality_deg);
+  max_skewness = std::max(max_skewness, part.max_skewness);
+  max_aspect_ratio = std::max(max_aspect_ratio, part.max_aspect_ratio);
+  min_volume = std::min(min_volume, part.min_volume);
+  min_face_pyramid = std::min(min_face_pyramid, part.min_face_pyramid);
+  if (!part.failure.empty()) failure += (failure.empty() ? "" : "; ") + part.failure;
+}
+
 }  // namespace bedforge::meshing

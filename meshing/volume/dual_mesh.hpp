@@ -58,6 +58,10 @@ struct JudgedQuality {
   double min_volume = 0.0, min_face_pyramid = 0.0;  // m^3
   std::string failure;
   nlohmann::json to_json(double d_ref) const;
+  static JudgedQuality from_json(const nlohmann::json& j, double d_ref);  // to_json's inverse
+  // Adds another part of the same mesh (a piece's): counts summed, worst figures kept, failures
+  // joined, as check_polyhedra would judge both parts as one mesh.
+  void add(const JudgedQuality& part);
 };
 JudgedQuality check_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, std::vector<int>* cell_points,
                               const Bed& bed, double d_ref, const std::string& what,
