@@ -233,7 +233,8 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "as many cells), on which the empty tube's pressure drop converges to the exact one; or gmsh's tetrahedra, "
         "where it settles about 16 % high however fine the mesh; the polyhedra are checked against checkMesh's limits "
         "(non-orthogonality below 90 deg, skewness 4, positive volumes and face pyramids) before the case is written, "
-        "two cells across a failing face merged, and those that still fail said and written to `bad_polyhedra.vtk`",
+        "two cells across a failing face merged, and those that still fail said and written beside the case to "
+        "`bad_polyhedra_<case>.vtk`",
         "", kWhyCells}},
       {"case.section_exclude_d",
        {"the bed section of the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this"}},
