@@ -869,6 +869,8 @@ def pieces_lines(rows):
              "|---|---|---|---|---|---|---|---|"]
     # The peaks are held against the fewest ranks run: one rank, or where one rank's piece would not fit, two.
     fewest = min((r for r in rows if r["pieces"] >= 1), key=lambda r: r["pieces"], default=None)
+    # The largest rank's peak over the fewest ranks' scaled by their count: 1 where it falls as 1/P.
+    peak_ratio = lambda r: largest_peak(r) / (largest_peak(fewest) * fewest["pieces"] / r["pieces"])
     if one:
         lines.append(f"| one piece | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0.0):.0f} (mesh stage), "
                      f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | | | {one['wall_s']:.0f} | | "
@@ -876,8 +878,8 @@ def pieces_lines(rows):
     for r in rows:
         if r["pieces"] < 1:
             continue
-        peak = max(k["peak_mb"] for k in r["ranks"])
-        scaled = f"{peak / (largest_peak(fewest) * fewest['pieces'] / r['pieces']):.2f}"
+        peak = largest_peak(r)
+        scaled = f"{peak_ratio(r):.2f}"
         times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
         check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
         dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if "dp_pa_m" in r else ""
@@ -894,8 +896,7 @@ def pieces_lines(rows):
                      "gmsh's threads make other tetrahedra on each run; the pieces themselves add none).")
     if fewest:
         p0 = fewest["pieces"]
-        ratios = [(r["pieces"], largest_peak(r) / (largest_peak(fewest) * p0 / r["pieces"]))
-                  for r in rows if p0 < r["pieces"] <= 8]
+        ratios = [(r["pieces"], peak_ratio(r)) for r in rows if p0 < r["pieces"] <= 8]
         if ratios:
             against = "1/P of one rank's, 2" if p0 == 1 else f"{p0}/P of {p0} ranks', {p0 * 2}"
             lines.append(f"- The largest rank's peak within 20 % of {against} to 8 ranks: " +
