@@ -154,7 +154,11 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "is refused before packing, naming the edge that would fit; once the bed is packed the estimate is made again "
         "with its narrow gaps, printed as `mesh estimate` and kept in the report's `stages.mesh.estimate`",
         "", kWhySurface}},
-      {"surface.contact_edge_length_d", {"edge on the loops of treated contacts", "", kWhySurface}},
+      {"surface.contact_edge_length_d",
+       {"edge on the loops of treated contacts; on a bridge to a wall, times the bridge's length over that of a "
+        "bridge between two touching spheres (half at a flat wall, less at a concave one), so that its triangles "
+        "keep their shape",
+        "", kWhySurface}},
       {"surface.growth", {"growth of the edge per ring away from a contact", "1"}},
       {"surface.cells_per_gap",
        {"cells across narrow gaps: where a sphere or wall faces another surface closer than this times "
