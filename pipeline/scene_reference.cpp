@@ -187,10 +187,16 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"largest cell edge; elsewhere cells follow the surface's triangles (`surface.edge_length_d`, "
         "`contact_edge_length_d`, `cells_per_gap`)",
         "", kWhyMeshSizes}},
-      {"mesh.optimize", {"gmsh's tetrahedral optimiser: one pass, more while cells fail the gate", "", kWhyMeshSizes}},
+      {"mesh.optimize",
+       {"gmsh's tetrahedral optimiser: one pass, more while cells fail the gate or a sliver remains", "",
+        kWhyMeshSizes}},
       {"mesh.max_optimize_passes",
        {"optimiser passes at most; if cells still fail, HXT meshes again with its own optimiser (slower, one thread, "
         "several times the memory; skipped when that will not fit)"}},
+      {"mesh.sliver_aspect_ratio",
+       {"optimiser passes go on (up to `max_optimize_passes`) while a cell's aspect ratio exceeds this: such a sliver "
+        "passes the gate, but the polyhedra of the dual around it fail checkMesh",
+        "", kWhyMeshSizes}},
       {"mesh.threads", {"threads, 0 for every core"}},
       {"mesh.slabs",
        {"axial slabs meshed one after the other by gmsh and joined into one conforming mesh, so gmsh's memory follows "
