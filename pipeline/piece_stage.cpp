@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -22,6 +23,7 @@
 #include "core/stage_meter.hpp"
 #include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/dual_pieces.hpp"
+#include "meshing/volume/flat_ears.hpp"
 #include "meshing/volume/processor_patches.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 
@@ -154,6 +156,16 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     slab = meshing::VolumeMesh();
     below.reset(), above.reset();
     release_free_memory();  // the tetrahedra
+    // Flat ears cut as the one-piece route cuts them (a plane between pieces is internal to
+    // `whole` on both sides of it, so both decide alike); counted by each piece with a point of it.
+    const std::vector<int> ears = meshing::flat_ears(whole.mesh);
+    std::vector<char> counted(ears.size(), 0);
+    for (const auto& patch : whole.mesh.patches)
+      for (int f = patch.start; f < patch.start + patch.size; ++f)
+        if (const auto e = std::lower_bound(ears.begin(), ears.end(), whole.mesh.owner[f]);
+            e != ears.end() && *e == whole.mesh.owner[f])
+          for (int v : whole.mesh.faces[f]) counted[e - ears.begin()] |= whole.side[v] == 0;
+    meshing::cut_ears(whole.mesh, ears);
     std::vector<int> cell_points;
     meshing::PolyhedralMesh dual = meshing::dual_mesh(whole.mesh, meshing::tetrahedron_centroids(whole.mesh),
                                                       cases::kDualFeatureAngleDeg, &cell_points);
@@ -164,11 +176,12 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     // around them, whose centres the faces across the planes see (as `checkMesh -parallel` does).
     std::vector<bool> own(dual.cells);
     for (int c = 0; c < dual.cells; ++c) own[c] = side[cell_points[c]] == 0;
-    report["polyhedra_quality"] =
+    meshing::JudgedQuality quality =
         meshing::check_polyhedra(dual, std::move(own), &cell_points, bed, d,
                                 fmt::format("piece {} of {}'s polyhedra", piece + 1, pieces),
-                                case_dir / fmt::format("bad_polyhedra_piece{}.vtk", piece))
-            .to_json(d);
+                                case_dir / fmt::format("bad_polyhedra_piece{}.vtk", piece));
+    quality.ears_cut = std::count(counted.begin(), counted.end(), 1);
+    report["polyhedra_quality"] = quality.to_json(d);
     dual = meshing::dual_piece(dual, cell_points, side, piece, pieces);
     report["cells"] = dual.cells;
     meter.record(report);

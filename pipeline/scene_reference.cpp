@@ -187,16 +187,10 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"largest cell edge; elsewhere cells follow the surface's triangles (`surface.edge_length_d`, "
         "`contact_edge_length_d`, `cells_per_gap`)",
         "", kWhyMeshSizes}},
-      {"mesh.optimize",
-       {"gmsh's tetrahedral optimiser: one pass, more while cells fail the gate or a sliver remains", "",
-        kWhyMeshSizes}},
+      {"mesh.optimize", {"gmsh's tetrahedral optimiser: one pass, more while cells fail the gate", "", kWhyMeshSizes}},
       {"mesh.max_optimize_passes",
        {"optimiser passes at most; if cells still fail, HXT meshes again with its own optimiser (slower, one thread, "
         "several times the memory; skipped when that will not fit)"}},
-      {"mesh.sliver_aspect_ratio",
-       {"optimiser passes go on (up to `max_optimize_passes`) while a cell's aspect ratio exceeds this: such a sliver "
-        "passes the gate, but the polyhedra of the dual around it fail checkMesh",
-        "", kWhyMeshSizes}},
       {"mesh.threads", {"threads, 0 for every core"}},
       {"mesh.slabs",
        {"axial slabs meshed one after the other by gmsh and joined into one conforming mesh, so gmsh's memory follows "
@@ -241,7 +235,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"case.cells",
        {"the cells solved on: the dual polyhedra of gmsh's tetrahedra (as `polyDualMesh 80` makes them, about a fifth "
         "as many cells), on which the empty tube's pressure drop converges to the exact one; or gmsh's tetrahedra, "
-        "where it settles about 16 % high however fine the mesh; the polyhedra are checked against checkMesh's limits "
+        "where it settles about 16 % high however fine the mesh; slivers with two faces on a wall that turns by less "
+        "than 30 deg across them are cut off the tetrahedra first (the dual around one fails checkMesh); the "
+        "polyhedra are checked against checkMesh's limits "
         "(non-orthogonality below 90 deg, skewness 4, positive volumes and face pyramids) before the case is written, "
         "two cells across a failing face merged, and those that still fail said and written beside the case to "
         "`bad_polyhedra_<case>.vtk`",

@@ -422,6 +422,7 @@ nlohmann::json JudgedQuality::to_json(double d_ref) const {
   const double d3 = d_ref * d_ref * d_ref;
   return {{"cells", cells},
           {"merged_cells", merged_cells},
+          {"ears_cut", ears_cut},
           {"failing_cells", failing_cells},
           {"failure", failure},
           {"max_non_orthogonality_deg", max_non_orthogonality_deg},
@@ -436,6 +437,7 @@ JudgedQuality JudgedQuality::from_json(const nlohmann::json& j, double d_ref) {
   JudgedQuality q;
   q.cells = j.at("cells").get<long>();
   q.merged_cells = j.at("merged_cells").get<long>();
+  q.ears_cut = j.value("ears_cut", 0L);  // reports before 2026-11-29 (session 46) lack it
   q.failing_cells = j.at("failing_cells").get<long>();
   q.failure = j.at("failure").get<std::string>();
   q.max_non_orthogonality_deg = j.at("max_non_orthogonality_deg").get<double>();
@@ -449,6 +451,7 @@ JudgedQuality JudgedQuality::from_json(const nlohmann::json& j, double d_ref) {
 void JudgedQuality::add(const JudgedQuality& part) {
   cells += part.cells;
   merged_cells += part.merged_cells;
+  ears_cut += part.ears_cut;
   failing_cells += part.failing_cells;
   max_non_orthogonality_deg = std::max(max_non_orthogonality_deg, part.max_non_orthogonality_deg);
   max_skewness = std::max(max_skewness, part.max_skewness);

@@ -57,6 +57,7 @@ struct JudgedQuality {
   double max_non_orthogonality_deg = 0.0, max_skewness = 0.0, max_aspect_ratio = 0.0;
   double min_volume = 0.0, min_face_pyramid = 0.0;  // m^3
   std::string failure;
+  long ears_cut = 0;  // flat ears cut off the tetrahedra before the dual was made (flat_ears.hpp)
   nlohmann::json to_json(double d_ref) const;
   static JudgedQuality from_json(const nlohmann::json& j, double d_ref);  // to_json's inverse
   // Adds another part of the same mesh (a piece's): counts summed, worst figures kept, failures

@@ -35,7 +35,6 @@ VolumeMeshParams read_volume_mesh_params(SceneSection& s) {
   p.max_size_d = s.number("max_size_d", p.max_size_d, Range::closed(0.01, 10.0));
   p.optimize = s.boolean("optimize", p.optimize);
   p.max_optimize_passes = static_cast<int>(s.integer("max_optimize_passes", p.max_optimize_passes, 1, 20));
-  p.sliver_aspect_ratio = s.number("sliver_aspect_ratio", p.sliver_aspect_ratio, Range{1.0, 1e12, false, false});
   p.threads = static_cast<int>(s.integer("threads", p.threads, 0, 1024));
   p.slabs = static_cast<int>(s.integer("slabs", p.slabs, 0, 64));
   p.pieces = static_cast<int>(s.integer("pieces", p.pieces, 0, 4096));
@@ -57,7 +56,6 @@ nlohmann::json to_json(const VolumeMeshParams& p) {
           {"max_size_d", p.max_size_d},
           {"optimize", p.optimize},
           {"max_optimize_passes", p.max_optimize_passes},
-          {"sliver_aspect_ratio", p.sliver_aspect_ratio},
           {"threads", p.threads},
           {"slabs", p.slabs},
           {"pieces", p.pieces},
@@ -370,18 +368,15 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       out.quality = cell_quality(out.mesh);
       release();
       bad = out.quality.bad_cells(p.gate, d_ref);
-      const auto slivers = std::count_if(out.quality.aspect_ratio.begin(), out.quality.aspect_ratio.end(),
-                                         [&](double a) { return a > p.sliver_aspect_ratio; });
       history.push_back({{"pass", pass},
                          {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()},
                          {"max_non_orthogonality_deg", out.quality.max_non_orthogonality_deg},
                          {"max_skewness", out.quality.max_skewness},
                          {"max_aspect_ratio", out.quality.max_aspect_ratio},
-                         {"cells_failing_gate", bad.size()},
-                         {"slivers", slivers}});
+                         {"cells_failing_gate", bad.size()}});
       const int passes = p.optimize ? p.max_optimize_passes : 0;
       // After HXT's own optimisation gmsh's pass is needed only for what it left.
-      if (pass >= passes || (bad.empty() && slivers == 0 && (pass >= 1 || hxt_optimiser))) break;
+      if (pass >= passes || (bad.empty() && (pass >= 1 || hxt_optimiser))) break;
     }
     if (!broken.empty()) {
       record("error", broken);

@@ -31,9 +31,6 @@ struct VolumeMeshParams {
   // (skipped when its memory, estimated from the cells before it, exceeds what is available).
   bool optimize = true;
   int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
-  // More passes (up to max_optimize_passes) also while a cell's aspect ratio exceeds this: such a
-  // sliver passes the gate, but the polyhedra of the dual around it fail checkMesh.
-  double sliver_aspect_ratio = 50.0;
   int threads = 0;                       // 0: every core
   // Axial slabs meshed one at a time and joined (meshing/volume/slab_mesh.hpp), so that gmsh's memory
   // follows a slab, not the bed: 0 chooses (slab_count), 1 meshes in one piece.

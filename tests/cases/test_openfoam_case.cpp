@@ -79,9 +79,9 @@ TEST(OpenFoamCase, TheDefaultScenesPathEndsInThePressureDropWithItsBand) {
   const auto& stages = report["stages"];
   // The coarser meshes the band rests on pass checkMesh's limits too. Before the bridges to the
   // wall took a shorter edge, levels 2 and 3 failed 5 and 63 cells here, all at those bridges;
-  // after it, a sliver that gmsh's first optimiser pass leaves on some runs (gmsh's meshes differ
-  // from run to run) failed 5 cells of level 2 in CI, until the optimiser went on while slivers
-  // remain (docs/findings.md, 2026-11-29 and session 46: 0 failing on 24 runs of levels 2 and 3).
+  // after it, a sliver that gmsh leaves on the wall on some runs (its meshes differ from run to
+  // run), a tetrahedron with two faces on the wall, failed 5 cells of level 2 in CI, until the
+  // case cut such ears off (docs/findings.md, 2026-11-29, sessions 45 and 46).
   for (const auto& level : stages["case"]["convergence"]["levels"])
     EXPECT_EQ(level.at("cells_failing_check_mesh").get<long>(), 0) << stages["case"]["convergence"].dump(1);
   // The answer is the run's last word, and summary.txt's.

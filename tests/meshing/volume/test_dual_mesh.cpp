@@ -257,13 +257,14 @@ TEST(DualMesh, PiecesJudgedApartAddUpToOneMeshsFigures) {
   // Two pieces' figures, as each rank writes them to its bedforge_piece.json and the case reads
   // them back (d = 2 mm, so volumes go through d^3): counts add, the worst of each figure stays.
   const double d = 0.002, d3 = d * d * d;
-  const JudgedQuality one{100, 2, 1, 95.0, 3.0, 20.0, 1e-3 * d3, -1e-6 * d3, "piece 1 of 2's polyhedra: ..."};
-  const JudgedQuality two{50, 0, 0, 60.0, 4.5, 10.0, 1e-4 * d3, 1e-5 * d3, ""};
+  const JudgedQuality one{100, 2, 1, 95.0, 3.0, 20.0, 1e-3 * d3, -1e-6 * d3, "piece 1 of 2's polyhedra: ...", 1};
+  const JudgedQuality two{50, 0, 0, 60.0, 4.5, 10.0, 1e-4 * d3, 1e-5 * d3, "", 2};
   JudgedQuality both = JudgedQuality::from_json(one.to_json(d), d);
   EXPECT_EQ(both.to_json(d), one.to_json(d));
   both.add(JudgedQuality::from_json(two.to_json(d), d));
   EXPECT_EQ(both.cells, 150);
   EXPECT_EQ(both.merged_cells, 2);
+  EXPECT_EQ(both.ears_cut, 3);
   EXPECT_EQ(both.failing_cells, 1);
   EXPECT_EQ(both.max_non_orthogonality_deg, 95.0);
   EXPECT_EQ(both.max_skewness, 4.5);
