@@ -8,11 +8,10 @@ namespace bedforge::meshing {
 
 namespace {
 
-bool is_ear(const std::vector<int>& ears, int cell) { return std::binary_search(ears.begin(), ears.end(), cell); }
-
-Eigen::Vector3d area_vector(const PolyMesh& m, int f) {
-  const Face& t = m.faces[f];
-  return 0.5 * (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]);
+// Where `cell` is in `sorted` (cells in increasing order), or -1.
+int position(const std::vector<int>& sorted, int cell) {
+  const auto it = std::lower_bound(sorted.begin(), sorted.end(), cell);
+  return it != sorted.end() && *it == cell ? static_cast<int>(it - sorted.begin()) : -1;
 }
 
 }  // namespace
@@ -43,7 +42,8 @@ std::vector<int> flat_ears(const PolyMesh& m, double max_turn_deg) {
       const Owned &a = boundary[i], &b = boundary[i + 1];
       const auto& patch = m.patches[a.patch];
       if (a.patch == b.patch && patch.type == "wall" && m.faces[a.face].size() == 3 && m.faces[b.face].size() == 3) {
-        const Eigen::Vector3d na = area_vector(m, a.face), nb = area_vector(m, b.face);
+        const Eigen::Vector3d na = face_geometry(m.points, m.faces[a.face]).area,
+                              nb = face_geometry(m.points, m.faces[b.face]).area;
         const bool free = std::none_of(m.faces[a.face].begin(), m.faces[a.face].end(), [&](int v) { return fixed[v]; }) &&
                           std::none_of(m.faces[b.face].begin(), m.faces[b.face].end(), [&](int v) { return fixed[v]; });
         if (free && na.dot(nb) > min_cos * na.norm() * nb.norm()) candidates.push_back(a.cell);
@@ -54,12 +54,8 @@ std::vector<int> flat_ears(const PolyMesh& m, double max_turn_deg) {
   // A tetrahedron: besides its two boundary triangles, exactly two internal triangles.
   std::vector<int> internal(candidates.size(), 0);
   std::vector<char> neighbour_ear(candidates.size(), 0), not_triangle(candidates.size(), 0);
-  auto index = [&](int cell) {
-    const auto it = std::lower_bound(candidates.begin(), candidates.end(), cell);
-    return it != candidates.end() && *it == cell ? static_cast<int>(it - candidates.begin()) : -1;
-  };
   for (int f = 0; f < m.internal_faces(); ++f) {
-    const int o = index(m.owner[f]), n = index(m.neighbour[f]);
+    const int o = position(candidates, m.owner[f]), n = position(candidates, m.neighbour[f]);
     for (int k : {o, n})
       if (k >= 0) ++internal[k], not_triangle[k] |= m.faces[f].size() != 3;
     if (o >= 0 && n >= 0) neighbour_ear[n] = 1;  // the owner, numbered first, is kept
@@ -72,15 +68,15 @@ std::vector<int> flat_ears(const PolyMesh& m, double max_turn_deg) {
 
 double cut_ears(PolyMesh& m, const std::vector<int>& ears) {
   if (ears.empty()) return 0.0;
+  // A kept cell's number less the ears before it.
   auto renumbered = [&](int cell) {
     return cell - static_cast<int>(std::lower_bound(ears.begin(), ears.end(), cell) - ears.begin());
   };
-  auto ear_index = [&](int cell) { return std::lower_bound(ears.begin(), ears.end(), cell) - ears.begin(); };
   // Each ear's wall patch, from its wall faces.
   std::vector<int> ear_patch(ears.size(), -1);
   for (int k = 0; k < static_cast<int>(m.patches.size()); ++k)
     for (int f = m.patches[k].start; f < m.patches[k].start + m.patches[k].size; ++f)
-      if (is_ear(ears, m.owner[f])) ear_patch[ear_index(m.owner[f])] = k;
+      if (const int e = position(ears, m.owner[f]); e >= 0) ear_patch[e] = k;
   // The internal faces: kept (renumbered, their order unchanged) or moved to the ear's wall.
   std::vector<Face> faces;
   std::vector<int> owner, neighbour;
@@ -88,10 +84,10 @@ double cut_ears(PolyMesh& m, const std::vector<int>& ears) {
   std::vector<std::vector<int>> ear_points(ears.size());
   for (int f = 0; f < m.internal_faces(); ++f) {
     const int o = m.owner[f], n = m.neighbour[f];
-    if (is_ear(ears, o) || is_ear(ears, n)) {
-      const bool ear_owns = is_ear(ears, o);
-      const int ear = ear_owns ? o : n, other = ear_owns ? n : o;
-      const auto e = ear_index(ear);
+    const int eo = position(ears, o), en = position(ears, n);
+    if (eo >= 0 || en >= 0) {
+      const bool ear_owns = eo >= 0;
+      const int e = ear_owns ? eo : en, other = ear_owns ? n : o;
       Face face = m.faces[f];
       if (ear_owns) std::reverse(face.begin(), face.end());  // it pointed into `other`
       joining[ear_patch[e]].push_back({face, renumbered(other)});
@@ -114,7 +110,7 @@ double cut_ears(PolyMesh& m, const std::vector<int>& ears) {
     patches[k].start = static_cast<int>(faces.size());
     const auto& p = m.patches[k];
     for (int f = p.start; f < p.start + p.size; ++f)
-      if (!is_ear(ears, m.owner[f])) faces.push_back(m.faces[f]), owner.push_back(renumbered(m.owner[f]));
+      if (position(ears, m.owner[f]) < 0) faces.push_back(m.faces[f]), owner.push_back(renumbered(m.owner[f]));
     for (const auto& [face, cell] : joining[k]) faces.push_back(face), owner.push_back(cell);
     patches[k].size = static_cast<int>(faces.size()) - patches[k].start;
   }
