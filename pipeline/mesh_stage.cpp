@@ -20,8 +20,8 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   Progress progress("mesh", console.progress);
   const int slabs = meshing::slab_count(surface.triangles.size(), surface_params, p);
   auto vm = std::make_shared<meshing::VolumeMesh>(
-      slabs > 1 ? meshing::build_slabbed_volume_mesh(bed, surface_params, slabs, reference_diameter(bed), p, msh_path,
-                                                     bad_cells_path, progress)
+      slabs > 1 ? meshing::build_slabbed_volume_mesh(bed, surface_params, &surface, slabs, reference_diameter(bed), p,
+                                                     msh_path, bad_cells_path, progress)
                 : meshing::build_volume_mesh(surface, bed, reference_diameter(bed), p, msh_path, bad_cells_path, progress));
   progress.finish();
   MeshStage out{vm, std::move(vm->report)};
@@ -60,7 +60,9 @@ constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra 
 
 MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                         const cases::CaseParams& c, double fluid_volume_m3, double gap_cells, double d) {
-  const double mesh_bytes = meshing::slabs_possible(surface, mesh) && mesh.slabs != 1 ? 300.0 : 460.0;
+  const bool in_slabs = meshing::slabs_possible(mesh) &&
+                        (mesh.slabs > 1 || (mesh.slabs == 0 && meshing::slabs_from_clip_windows(surface)));
+  const double mesh_bytes = in_slabs ? 300.0 : 460.0;
   const bool solver = c.run && !c.snappy_cells;
   const double h = std::min(surface.edge_length_d, mesh.max_size_d) * d;  // the edge away from the surfaces
   MeshEstimate e;

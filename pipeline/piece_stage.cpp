@@ -77,7 +77,7 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     throw InputError(fmt::format("{}: no case to write a piece into (no 0/ fields); write the case first, e.g. "
                                  "`bedforge run` with case.run = false",
                                  case_dir.string()));
-  if (!meshing::slabs_possible(surface, mesh))
+  if (!meshing::slabs_possible(mesh) || !meshing::slabs_from_clip_windows(surface))
     throw InputError(fmt::format("contacts.treatment = \"{}\", contacts.wall_treatment = \"{}\", mesh.layers.count = "
                                  "{}: a piece's planes would cut treated contacts or prism layers open; allowed for "
                                  "pieces: contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\", "

@@ -86,7 +86,7 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
 // and no whole surface or mesh anywhere.
 void check_pieces(const Scene& sc) {
   const int n = sc.mesh.pieces;
-  if (!meshing::slabs_possible(sc.surface, sc.mesh))
+  if (!meshing::slabs_possible(sc.mesh) || !meshing::slabs_from_clip_windows(sc.surface))
     throw InputError(fmt::format("mesh.pieces = {}: the planes between pieces cut through the bed, and through treated "
                                  "contacts or prism layers they would open them; allowed: 0 or 1, or mesh.pieces > 1 "
                                  "with contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\" (now "
@@ -227,12 +227,10 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection mesh = root.sub("mesh"), case_section = root.sub("case");
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   sc.mesh = meshing::read_volume_mesh_params(mesh);
-  if (sc.mesh.slabs > 1 && !meshing::slabs_possible(sc.surface, sc.mesh))
-    throw InputError(fmt::format("mesh.slabs = {}: the planes between slabs cut through the bed, and through treated "
-                                 "contacts they would open them; allowed: 0 or 1, or mesh.slabs > 1 with "
-                                 "contacts.treatment \"shrink\" or \"none\" (now \"{}\") and no prism layers "
-                                 "(mesh.layers.count = {})",
-                                 sc.mesh.slabs, meshing::treatment_name(sc.surface.treatment), sc.mesh.layers.count));
+  if (sc.mesh.slabs > 1 && !meshing::slabs_possible(sc.mesh))
+    throw InputError(fmt::format("mesh.slabs = {}: the planes between slabs would cut the prism layers open; allowed: "
+                                 "0 or 1, or mesh.slabs > 1 with no prism layers (mesh.layers.count = {}, allowed 0)",
+                                 sc.mesh.slabs, sc.mesh.layers.count));
 #else
   if (sc.needs_mesh() || table.contains("mesh"))
     throw InputError("this bedforge was built without gmsh or CGAL, so it has no volume mesh stage ([mesh], "

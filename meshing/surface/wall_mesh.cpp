@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "core/random.hpp"
@@ -266,11 +267,32 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
         [&](const Eigen::Vector2d& q) { return f.to_world(Eigen::Vector3d(q.x(), q.y(), 0.0)); }, try_add);
   staggered(edge, [&](const Eigen::Vector2d& q) { try_add(q, edge); });
 
-  // 4. Constrained Delaunay triangulation; faces inside a hole go to `inside`.
+  // 4. Constrained Delaunay triangulation. A face is in the region when one constraint lies
+  // between it and the outside (counted by a flood fill that stops at constraints, not by where
+  // its centroid falls: a sliver between three nearly collinear loop vertices outside a
+  // non-convex boundary has its centroid on the boundary); behind a second one it is in a hole
+  // (to `inside`) or beyond an inner boundary.
   Cdt cdt;
   const std::vector<Cdt::Vertex_handle> handle = insert_in_rows(cdt, uv, edge);
   for (const auto& loop : loops)
     for (std::size_t k = 0; k < loop.size(); ++k) cdt.insert_constraint(handle[loop[k]], handle[loop[(k + 1) % loop.size()]]);
+  std::map<Cdt::Face_handle, int> depth;
+  std::vector<Cdt::Edge> border;
+  auto flood = [&](Cdt::Face_handle start, int level) {
+    std::vector<Cdt::Face_handle> stack{start};
+    while (!stack.empty()) {
+      const Cdt::Face_handle fh = stack.back();
+      stack.pop_back();
+      if (!depth.emplace(fh, level).second) continue;
+      for (int i = 0; i < 3; ++i)
+        if (!depth.count(fh->neighbor(i))) (cdt.is_constrained({fh, i}) ? border.push_back({fh, i}) : stack.push_back(fh->neighbor(i)));
+    }
+  };
+  flood(cdt.infinite_face(), 0);
+  for (std::size_t b = 0; b < border.size(); ++b) {
+    const Cdt::Face_handle behind = border[b].first->neighbor(border[b].second);
+    if (!depth.count(behind)) flood(behind, depth.at(border[b].first) + 1);
+  }
   WallMesh out;
   out.outside.points = out.inside.points = points;
   for (auto fh : cdt.finite_face_handles()) {
@@ -280,8 +302,9 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
       t[k] = fh->vertex(k)->info();
       centroid += uv[t[k]] / 3.0;
     }
-    if (!in_region(centroid)) continue;
-    (hole_index.contains(centroid) ? out.inside : out.outside).triangles.push_back(t);
+    const int level = depth.at(fh);
+    if (level == 1) out.outside.triangles.push_back(t);
+    else if (level == 2 && hole_index.contains(centroid)) out.inside.triangles.push_back(t);
   }
   for (TriangleMesh* m : {&out.outside, &out.inside}) {
     m->patch.assign(m->triangles.size(), 0);

@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -14,6 +15,8 @@
 #include "core/error.hpp"
 #include "core/point_key.hpp"
 #include "core/stage_meter.hpp"
+#include "meshing/surface/plane_cut.hpp"
+#include "meshing/surface/primitives.hpp"
 
 namespace bedforge::meshing {
 
@@ -173,22 +176,44 @@ double widest_interval_middle(const std::vector<double>& ends, double asked, dou
   return best;
 }
 
+// Slab `k` of `slabs` from its closed surface, quietly, its failure naming it by `heights_d`
+// (asked, d above the floor); the report adds those heights, the surface's triangles and the cells.
+VolumeMesh mesh_slab_surface(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
+                             const std::filesystem::path& bad_cells_path, bool release_memory, int k, int slabs,
+                             const std::array<double, 2>& heights_d) {
+  Progress quiet("mesh", false);
+  VolumeMesh slab;
+  try {
+    slab = build_volume_mesh(surface, bed, d_ref, p, {}, bad_cells_path, quiet, release_memory);
+  } catch (const ConvergenceError& e) {
+    throw ConvergenceError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor): {}", k + 1, slabs,
+                                       heights_d[0], heights_d[1], e.what()));
+  }
+  slab.report["heights_d"] = heights_d;
+  slab.report["surface_triangles"] = surface.triangles.size();
+  slab.report["cells"] = slab.mesh.cells;
+  return slab;
+}
+
 // The slabbed mesh between `planes` (d): each slab meshed and joined, the joined mesh checked.
-VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
-                               double d_ref, const VolumeMeshParams& p, const std::filesystem::path& msh_path,
-                               const std::filesystem::path& bad_cells_path, Progress& progress);
+VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const TriangleMesh* whole,
+                               const std::vector<double>& planes, double d_ref, const VolumeMeshParams& p,
+                               const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
+                               Progress& progress);
 
 }  // namespace
 
-bool slabs_possible(const SurfaceParams& s, const VolumeMeshParams& p) {
+bool slabs_possible(const VolumeMeshParams& p) { return p.layers.count == 0; }
+
+bool slabs_from_clip_windows(const SurfaceParams& s) {
   using T = SurfaceParams::Treatment;
   const auto alone = [](T t) { return t == T::shrink || t == T::none; };
-  return alone(s.treatment) && alone(s.wall_treatment) && p.layers.count == 0;
+  return alone(s.treatment) && alone(s.wall_treatment);
 }
 
 int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const VolumeMeshParams& p) {
   if (p.slabs > 0) return p.slabs;
-  if (!slabs_possible(s, p)) return 1;
+  if (!slabs_possible(p) || !slabs_from_clip_windows(s)) return 1;
   return std::max(1, static_cast<int>(std::ceil(static_cast<double>(surface_triangles) / kSurfaceTrianglesPerSlab)));
 }
 
@@ -271,33 +296,27 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
                                    k + 1, slabs, q.clip_bottom_d, q.clip_top_d, e.what()));
     }
   }();
-  Progress quiet("mesh", false);
-  VolumeMesh slab;
-  try {
-    slab = build_volume_mesh(fs.fluid, bed, d_ref, p, {}, bad_cells_path, quiet, release_memory);
-  } catch (const ConvergenceError& e) {
-    throw ConvergenceError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor): {}", k + 1, slabs,
-                                       q.clip_bottom_d, q.clip_top_d, e.what()));
-  }
-  slab.report["heights_d"] = {q.clip_bottom_d, q.clip_top_d};  // asked
+  VolumeMesh slab = mesh_slab_surface(fs.fluid, bed, d_ref, p, bad_cells_path, release_memory, k, slabs,
+                                      {q.clip_bottom_d, q.clip_top_d});
   slab.report["planes_d"] = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
-  slab.report["surface_triangles"] = fs.fluid.triangles.size();
-  slab.report["cells"] = slab.mesh.cells;
   return slab;
 }
 
-VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
-                                     const VolumeMeshParams& p, const std::filesystem::path& msh_path,
+VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, const TriangleMesh* whole,
+                                     int slabs, double d_ref, const VolumeMeshParams& p,
+                                     const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
+  if (!slabs_from_clip_windows(surface) && whole == nullptr)
+    throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts need the whole surface to cut slabs from");
   const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
   try {
-    return mesh_and_join_slabs(bed, surface, planes, d_ref, p, msh_path, bad_cells_path, progress);
+    return mesh_and_join_slabs(bed, surface, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
   } catch (const ConvergenceError& first) {
     // The planes are where the slabs differ from one mesh of the whole domain: tried once more
     // with each moved to another interval between the spheres' ends.
     const std::vector<double> moved = moved_slab_planes_d(bed, surface, planes);
     try {
-      VolumeMesh out = mesh_and_join_slabs(bed, surface, moved, d_ref, p, msh_path, bad_cells_path, progress);
+      VolumeMesh out = mesh_and_join_slabs(bed, surface, whole, moved, d_ref, p, msh_path, bad_cells_path, progress);
       out.report["planes_moved"] = {{"from_d", planes}, {"to_d", moved}, {"because", first.what()}};
       return out;
     } catch (const ConvergenceError& second) {
@@ -310,18 +329,44 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
 
 namespace {
 
-VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
-                               double d_ref, const VolumeMeshParams& p, const std::filesystem::path& msh_path,
-                               const std::filesystem::path& bad_cells_path, Progress& progress) {
+VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, const TriangleMesh* whole,
+                               const std::vector<double>& planes, double d_ref, const VolumeMeshParams& p,
+                               const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
+                               Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const int slabs = static_cast<int>(planes.size()) + 1;
+  const bool cut = !slabs_from_clip_windows(surface);
+  const double d = reference_diameter(bed);
+  TriangleMesh above;  // cut slabs: the whole surface above the planes cut so far
+  if (cut) above = *whole;
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
   for (int k = 0; k < slabs; ++k) {
     progress.update(fmt::format("slab {} of {}: surface and cells", k + 1, slabs));
     // Memory a slab frees stays with the allocator for the next slab and the join: handing it
     // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
-    VolumeMesh slab = mesh_slab(bed, surface, planes, k, d_ref, p, bad_cells_path, false);
+    VolumeMesh slab;
+    if (!cut) {
+      slab = mesh_slab(bed, surface, planes, k, d_ref, p, bad_cells_path, false);
+    } else {
+      const SurfaceParams q = slab_surface(bed, surface, planes, k);
+      TriangleMesh own = std::move(above);
+      nlohmann::json cut_report;
+      if (k + 1 < slabs) {
+        try {
+          PlaneCut c = cut_by_plane(own, planes[k] * d, {surface.edge_length_d * d, surface.growth, "outlet", "inlet"});
+          cut_report = {{"loops", c.loops}, {"vertices_snapped", c.vertices_snapped}, {"plane_triangles", c.plane_triangles}};
+          own = std::move(c.below), above = std::move(c.above);
+        } catch (const CutConflict& e) {
+          throw InputError(fmt::format("mesh.slabs: the plane at {:.3f} d above the floor cannot be cut from the bed's "
+                                       "surface: {}; allowed: another number of slabs, or mesh.slabs = 1",
+                                       planes[k], e.what()));
+        }
+      }
+      slab = mesh_slab_surface(own, bed, d_ref, p, bad_cells_path, false, k, slabs, {q.clip_bottom_d, q.clip_top_d});
+      slab.report["planes_d"] = slab.report["heights_d"];
+      if (!cut_report.is_null()) slab.report["plane_cut"] = std::move(cut_report);
+    }
     progress.update(fmt::format("slab {} of {}: {} cells joined", k + 1, slabs, slab.mesh.cells), (k + 1.0) / slabs);
     joined.add(slab.mesh, k == 0, k + 1 == slabs, k);
     reports.push_back(std::move(slab.report));

@@ -15,16 +15,22 @@ namespace bedforge::meshing {
 // largest slab instead of the whole bed. Each slab is the surface stage's domain clipped to its
 // heights (build_fluid_surface with a clip window): the planes between slabs cut the spheres
 // crossing them, and both slabs triangulate a shared plane alike, so the joined cells are
-// conforming and the planes' triangles become internal faces. A plane through a treated contact
-// (bridge, cap, union) would open it, so slabs serve the shrink and none treatments only.
+// conforming and the planes' triangles become internal faces. A clip plane through a treated
+// contact (bridge, cap, union) would open it, so under those treatments the slabs are cut from
+// the whole domain's surface instead (cut_by_plane, which cuts any contact and gives each plane's
+// triangles to both its slabs): one process holds that surface, so pieces on ranks of their own
+// (pipeline/piece_stage) keep to the clip windows.
 
-// Whether a bed under `surface` can be meshed in slabs with `params`: contacts shrunk or left
-// alone (and walls too), and no prism layers (they would meet the planes between slabs).
-bool slabs_possible(const SurfaceParams& surface, const VolumeMeshParams& params);
+// Whether a bed can be meshed in slabs with `params`: no prism layers (they would meet the
+// planes between slabs).
+bool slabs_possible(const VolumeMeshParams& params);
+// Whether each slab's surface is built on its own from a clip window (contacts and walls shrunk
+// or left alone), needing no whole surface; otherwise slabs are cut from the whole one.
+bool slabs_from_clip_windows(const SurfaceParams& surface);
 
-// How many slabs: params.slabs when set; else, when slabs_possible, one per
-// kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles makes
-// about 2.7 M cells; a = 10, N = 4000 at 0.1 d: 3.2 M triangles, 4 slabs); else 1.
+// How many slabs: params.slabs when set; else, when slabs_possible and slabs_from_clip_windows,
+// one per kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles
+// makes about 2.7 M cells; a = 10, N = 4000 at 0.1 d: 3.2 M triangles, 4 slabs); else 1.
 constexpr double kSurfaceTrianglesPerSlab = 1.0e6;
 int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, const VolumeMeshParams& params);
 
@@ -56,7 +62,8 @@ FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, in
 // spheres, alike for the slabs on either side.
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k);
 
-// Slab `k` between `planes` meshed on its own: its surface (slab_surface) and build_volume_mesh with
+// Slab `k` between `planes` meshed on its own from its clip window (slabs_from_clip_windows): its
+// surface (slab_surface) and build_volume_mesh with
 // `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
 // in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
 // (where the surface stage put them), "surface_triangles" and "cells". InputError naming
@@ -68,16 +75,20 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 
 // The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;
-// `params.layers` must be off) and joined. `d_ref` (m) scales the parameters; the report holds
-// each slab's report under "slabs". Writes the joined mesh (MSH 2.2: physical groups per patch
-// and `fluid`) to `msh_path` when not empty. std::runtime_error when two slabs' shared plane is
-// not triangulated alike (a defect of ours); ConvergenceError naming the slab when one fails
-// the gate, or naming the cells at the joins when the joined mesh does, after writing them to
-// `bad_cells_path`. On such a failure the slabs are meshed once more between planes moved by
-// moved_slab_planes_d (the report then says so under "planes_moved": from_d, to_d and the first
-// failure); the error names both attempts.
-VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, int slabs, double d_ref,
-                                     const VolumeMeshParams& params, const std::filesystem::path& msh_path,
+// `params.layers` must be off) and joined. Unless slabs_from_clip_windows, the slabs are cut
+// from `whole` (the surface stage's fluid surface of the same bed under `surface`; m), which may
+// be null otherwise. `d_ref` (m) scales the parameters; the report holds each slab's report
+// under "slabs" (a cut slab's with "plane_cut": its loops, snapped vertices, plane triangles).
+// Writes the joined mesh (MSH 2.2: physical groups per patch and `fluid`) to `msh_path` when
+// not empty. std::runtime_error when two slabs' shared plane is not triangulated alike (a
+// defect of ours); InputError naming mesh.slabs when a slab cannot be cut from the bed;
+// ConvergenceError naming the slab when one fails the gate, or naming the cells at the joins
+// when the joined mesh does, after writing them to `bad_cells_path`. On such a failure the
+// slabs are meshed once more between planes moved by moved_slab_planes_d (the report then says
+// so under "planes_moved": from_d, to_d and the first failure); the error names both attempts.
+VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, const TriangleMesh* whole,
+                                     int slabs, double d_ref, const VolumeMeshParams& params,
+                                     const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress);
 
 }  // namespace bedforge::meshing

@@ -1,0 +1,284 @@
+#include "meshing/surface/plane_cut.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iterator>
+#include <stdexcept>
+#include <tuple>
+#include <unordered_map>
+
+#include "meshing/surface/planar_cdt.hpp"
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/wall_mesh.hpp"
+
+namespace bedforge::meshing {
+
+namespace {
+
+std::uint64_t edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return static_cast<std::uint64_t>(a) << 32 | static_cast<std::uint32_t>(b);
+}
+
+Eigen::Vector3d normal(const std::vector<Eigen::Vector3d>& x, const std::array<int, 3>& t) {
+  return (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+}
+
+std::string where(const Eigen::Vector3d& q) { return fmt::format("({:.4g}, {:.4g}, {:.4g}) m", q.x(), q.y(), q.z()); }
+
+}  // namespace
+
+PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) {
+  PlaneCut out;
+  std::vector<Eigen::Vector3d> x = m.points;
+  const int nv = static_cast<int>(x.size());
+  std::vector<double> s(nv);
+  for (int v = 0; v < nv; ++v) s[v] = x[v].z() - z;
+  std::vector<std::vector<int>> incident(nv);
+  for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    for (int v : m.triangles[t]) incident[v].push_back(static_cast<int>(t));
+
+  // Where the edge (a, b) crosses the plane, computed from its end below (so the same doubles
+  // whichever way round or however numbered it comes).
+  auto from_below = [&](int a, int b) { return s[a] < s[b] ? std::pair{a, b} : std::pair{b, a}; };
+  auto crossing = [&](int a, int b) {
+    std::tie(a, b) = from_below(a, b);
+    Eigen::Vector3d q = x[a] + s[a] / (s[a] - s[b]) * (x[b] - x[a]);
+    q.z() = z;
+    return q;
+  };
+
+  // 1. Vertices near the plane along a crossing edge move onto it there, nearest first.
+  struct Snap {
+    double distance;
+    int v, other;
+    Eigen::Vector3d to;
+  };
+  std::vector<Snap> snaps;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const auto [a, b] = from_below(t[k], t[(k + 1) % 3]);
+      if (!(s[a] * s[b] < 0.0)) continue;
+      const Eigen::Vector3d at = crossing(a, b);
+      const double f = s[a] / (s[a] - s[b]), length = (x[b] - x[a]).norm();
+      if (f < kPlaneCutSnap) snaps.push_back({f * length, a, b, at});
+      if (f > 1.0 - kPlaneCutSnap) snaps.push_back({(1.0 - f) * length, b, a, at});
+    }
+  std::sort(snaps.begin(), snaps.end(), [&x](const Snap& a, const Snap& b) {
+    auto key = [&x](const Snap& q) {
+      return std::tuple{q.distance, x[q.v].x(), x[q.v].y(), x[q.v].z(), x[q.other].x(), x[q.other].y()};
+    };
+    return key(a) < key(b);
+  });
+  std::vector<char> moved(nv, 0);
+  for (const Snap& snap : snaps) {
+    if (s[snap.v] == 0.0 || moved[snap.other]) continue;
+    // Only where the plane would then pass through the vertex once: its neighbours, in order
+    // around it, on one arc above and one below (at a saddle, the necks of bridges and unions,
+    // two loops would touch there), any neighbour on the plane between the two (below); and no
+    // triangle turned by more than about 75 degrees.
+    bool ok = true;
+    const Eigen::Vector3d from = x[snap.v];
+    std::unordered_map<int, int> after_in_link;  // neighbour -> the next one around the vertex
+    for (int t : incident[snap.v]) {
+      const auto& tri = m.triangles[t];
+      const int k = static_cast<int>(std::find(tri.begin(), tri.end(), snap.v) - tri.begin());
+      after_in_link[tri[(k + 1) % 3]] = tri[(k + 2) % 3];
+      const Eigen::Vector3d before = normal(x, tri);
+      x[snap.v] = snap.to;
+      const Eigen::Vector3d after = normal(x, tri);
+      x[snap.v] = from;
+      if (!(after.dot(before) > 0.25 * after.norm() * before.norm())) ok = false;
+    }
+    std::vector<int> signs;  // around the vertex
+    for (int u = after_in_link.begin()->first; ok && signs.size() <= after_in_link.size();) {
+      signs.push_back((s[u] > 0.0) - (s[u] < 0.0));
+      const auto it = after_in_link.find(u);
+      if (it == after_in_link.end()) ok = false;
+      else if ((u = it->second) == after_in_link.begin()->first) break;
+    }
+    if (!ok || signs.size() != after_in_link.size()) continue;
+    int changes = 0, last = 0;
+    const std::size_t n = signs.size();
+    for (std::size_t k = 0; k < 2 * n; ++k) {  // twice round, counting from the first nonzero
+      const int g = signs[k % n];
+      // A neighbour on the plane: the edge to it must be where the surface crosses, between a
+      // triangle below and one above (where both are on one side, the solid would touch the
+      // plane's face along it).
+      if (g == 0 && signs[(k + 1) % n] * signs[(k + n - 1) % n] >= 0) ok = false;
+      if (g != 0 && last != 0 && g != last && k >= n) ++changes;
+      if (g != 0) last = g;
+    }
+    if (!ok || changes != 2) continue;
+    x[snap.v] = snap.to, s[snap.v] = 0.0, moved[snap.v] = 1;
+    ++out.vertices_snapped;
+  }
+
+  // 2. Each edge still crossing gets one point on the plane, shared by its two triangles.
+  std::unordered_map<std::uint64_t, int> cut_point;
+  auto cut = [&](int a, int b) {
+    const auto [it, added] = cut_point.try_emplace(edge_key(a, b), static_cast<int>(x.size()));
+    if (added) x.push_back(crossing(a, b)), s.push_back(0.0);
+    return it->second;
+  };
+
+  // 3. Triangles to their side, split where they cross (orientation kept).
+  std::vector<std::array<int, 3>> below, above;
+  std::vector<int> below_patch, above_patch;
+  auto keep = [&](const std::array<int, 3>& t, int side, int patch) {
+    (side < 0 ? below : above).push_back(t);
+    (side < 0 ? below_patch : above_patch).push_back(patch);
+  };
+  auto sign = [&](int v) { return (s[v] > 0.0) - (s[v] < 0.0); };
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto& v = m.triangles[t];
+    const int patch = m.patch[t];
+    const std::array<int, 3> g{sign(v[0]), sign(v[1]), sign(v[2])};
+    const int lo = std::min({g[0], g[1], g[2]}), hi = std::max({g[0], g[1], g[2]});
+    if (lo == 0 && hi == 0)
+      throw std::runtime_error(fmt::format("plane cut at z = {} m: a surface triangle lies in the plane, at {}", z,
+                                           where(x[v[0]])));
+    if (hi <= 0 || lo >= 0) {
+      keep(v, hi <= 0 ? -1 : 1, patch);
+      continue;
+    }
+    // Rotate so that v[k] is the vertex alone on its side (or on the plane).
+    int k = static_cast<int>(std::find(g.begin(), g.end(), 0) - g.begin());
+    if (k == 3)
+      for (int j = 0; j < 3; ++j)
+        if (g[j] != g[(j + 1) % 3] && g[j] != g[(j + 2) % 3]) k = j;
+    const int l = v[k], a = v[(k + 1) % 3], b = v[(k + 2) % 3];
+    if (g[k] == 0) {  // through a vertex: two triangles
+      const int c = cut(a, b);
+      keep({l, a, c}, sign(a), patch);
+      keep({l, c, b}, sign(b), patch);
+      continue;
+    }
+    const int ca = cut(l, a), cb = cut(l, b);
+    keep({l, ca, cb}, g[k], patch);
+    // The quad (ca, a, b, cb) by its shorter diagonal.
+    if ((x[b] - x[ca]).squaredNorm() <= (x[a] - x[cb]).squaredNorm())
+      keep({ca, a, b}, -g[k], patch), keep({ca, b, cb}, -g[k], patch);
+    else
+      keep({ca, a, cb}, -g[k], patch), keep({a, b, cb}, -g[k], patch);
+  }
+
+  // 4. The loops on the plane: the edges of the part below that no second triangle below shares,
+  // directed as the part below has them; the part above must have the same edges.
+  auto open_edges = [](const std::vector<std::array<int, 3>>& tris) {
+    std::unordered_map<std::uint64_t, std::pair<int, int>> seen;  // key -> (count, directed edge's start)
+    for (const auto& t : tris)
+      for (int k = 0; k < 3; ++k) {
+        auto& e = seen[edge_key(t[k], t[(k + 1) % 3])];
+        ++e.first;
+        e.second = t[k];
+      }
+    std::vector<std::pair<int, int>> open;
+    for (const auto& [key, e] : seen)
+      if (e.first == 1) {
+        const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
+        open.push_back(e.second == a ? std::pair{a, b} : std::pair{b, a});
+      }
+    std::sort(open.begin(), open.end());
+    return open;
+  };
+  const std::vector<std::pair<int, int>> open = open_edges(below);
+  {
+    std::vector<std::pair<int, int>> reversed;
+    for (const auto& [a, b] : open_edges(above)) reversed.push_back({b, a});
+    std::sort(reversed.begin(), reversed.end());
+    if (reversed != open || open.empty()) {
+      std::vector<std::pair<int, int>> odd;
+      std::set_symmetric_difference(open.begin(), open.end(), reversed.begin(), reversed.end(), std::back_inserter(odd));
+      throw std::runtime_error(fmt::format("plane cut at z = {} m: the surface is not closed along the plane ({} and {} "
+                                           "open edges below and above, the first unmatched at {})",
+                                           z, open.size(), reversed.size(), odd.empty() ? "none" : where(x[odd[0].first])));
+    }
+  }
+  std::unordered_map<int, int> next;
+  for (const auto& [a, b] : open) {
+    if (s[a] != 0.0 || s[b] != 0.0)
+      throw std::runtime_error(fmt::format("plane cut at z = {} m: the surface is open at {}", z, where(x[a])));
+    if (!next.emplace(a, b).second)
+      throw CutConflict(fmt::format("the plane at z = {} m meets the surface where two loops touch, at {}", z, where(x[a])));
+  }
+  std::vector<std::vector<int>> loops;
+  std::unordered_map<int, char> done;
+  for (const auto& [start, unused] : open) {
+    if (done[start]) continue;
+    loops.emplace_back();
+    for (int v = start; !done[v]; v = next.at(v)) done[v] = 1, loops.back().push_back(v);
+  }
+  // In an order of their points alone, not of the vertices' numbers: each loop from its least
+  // point (x, then y), the loops by that point; so the face is a function of the section.
+  auto less = [&](int a, int b) { return std::pair{x[a].x(), x[a].y()} < std::pair{x[b].x(), x[b].y()}; };
+  for (auto& loop : loops) std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end(), less), loop.end());
+  std::sort(loops.begin(), loops.end(), [&](const auto& a, const auto& b) { return less(a[0], b[0]); });
+
+  // 5. The faces: each loop clockwise from above (the walls, or fluid that solid rings in on the
+  // plane) less the anticlockwise loops it is the nearest to hold.
+  struct Loop {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector2d> xy;
+    double area = 0.0, spacing = 0.0;
+  };
+  std::vector<Loop> outer, inner;
+  for (const auto& loop : loops) {
+    Loop l;
+    double perimeter = 0.0;
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const Eigen::Vector3d& a = x[loop[k]];
+      const Eigen::Vector3d& b = x[loop[(k + 1) % loop.size()]];
+      l.area += 0.5 * (a.x() * b.y() - b.x() * a.y());
+      perimeter += (b - a).norm();
+      l.points.push_back(a), l.xy.emplace_back(a.x(), a.y());
+    }
+    l.spacing = perimeter / static_cast<double>(loop.size());
+    (l.area < 0.0 ? outer : inner).push_back(std::move(l));
+  }
+  std::vector<std::vector<WallHole>> holes(outer.size());
+  for (const Loop& h : inner) {
+    int holder = -1;
+    for (std::size_t o = 0; o < outer.size(); ++o)
+      if (inside_polygon(outer[o].xy, h.xy[0]) && (holder < 0 || outer[o].area > outer[holder].area))
+        holder = static_cast<int>(o);
+    if (holder < 0)
+      throw CutConflict(fmt::format("the plane at z = {} m cuts the solid in a loop outside every face of the fluid, at {}",
+                                    z, where(h.points[0])));
+    holes[holder].push_back({h.points, h.spacing, -1});
+  }
+  TriangleMesh face;
+  for (std::size_t o = 0; o < outer.size(); ++o)
+    face.append(plane_mesh(Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ()), {outer[o].points}, p.edge, holes[o],
+                           p.growth, true, p.below_patch)
+                    .outside);
+  out.loops = static_cast<long>(loops.size());
+  out.faces = static_cast<long>(outer.size());
+  out.plane_triangles = static_cast<long>(face.triangles.size());
+
+  // 6. Each side with the face, which shares the loops' points bit for bit (welded to them).
+  auto side = [&](std::vector<std::array<int, 3>>& tris, std::vector<int>& patches, bool up) {
+    TriangleMesh part;
+    part.points = x;
+    part.triangles = std::move(tris);
+    part.patch = std::move(patches);
+    part.patches = m.patches;
+    TriangleMesh f = face;
+    if (up) {
+      for (auto& t : f.triangles) std::swap(t[1], t[2]);
+      f.patches = {p.above_patch};
+    }
+    part.append(f);
+    part.weld();
+    drop_unused_points(part);
+    return part;
+  };
+  out.below = side(below, below_patch, false);
+  out.above = side(above, above_patch, true);
+  return out;
+}
+
+}  // namespace bedforge::meshing

@@ -1,0 +1,48 @@
+#pragma once
+#include <string>
+
+#include "meshing/surface/triangle_mesh.hpp"
+
+namespace bedforge::meshing {
+
+// A closed surface cut in two by a horizontal plane, whatever it bounds: a bed's fluid surface
+// with bridges, caps or unions, which a clip window (build_fluid_surface) would open where its
+// plane crosses them. The plane's face is triangulated once and given to both sides, so the
+// two parts share it point for point (by construction: the same doubles), facing opposite ways.
+
+struct PlaneCutParams {
+  double edge = 0.0;  // m: the plane face's target edge away from the cut (the surface's edge)
+  double growth = 1.5;  // edge growth per ring away from the cut's loops
+  std::string below_patch = "outlet", above_patch = "inlet";  // the plane face's patch on each side
+};
+
+struct PlaneCut {
+  TriangleMesh below, above;  // closed, normals out of the region each bounds (m)
+  long plane_triangles = 0;   // of the shared face
+  long loops = 0;             // where the plane meets the surface
+  long faces = 0;             // of the plane's section: the walls' and any fluid that solid rings in there
+  long vertices_snapped = 0;  // surface vertices moved onto the plane along an edge (see cut_by_plane)
+};
+
+// `surface` (closed, welded, normals out of the region it bounds; m) cut by the plane z = `z`
+// (m). The nearer end of each edge crossing the plane (within kPlaneCutSnap of the edge's length
+// of it) is moved along that edge onto the plane, nearest first, so that the cut's loops are
+// mostly the surface's own vertices, spaced as its edges, with no needles beside them; not
+// where the plane would then pass through that vertex twice (a saddle: the necks of bridges
+// and unions), touch the surface along an edge, or turn a triangle over. Each edge still
+// crossing is split where it meets the plane, and the triangles on either side are kept whole
+// or split in two or three. The
+// region's section by the plane is one face or more (bridged spheres and the wall can ring in a
+// pocket of fluid there), each an outer loop (clockwise seen from above on the part below) less
+// the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with
+// `p`'s edge and growth, normals +z on the part below and -z above.
+// CutConflict (primitives.hpp) naming the height and place when the plane meets the surface at
+// a point where loops touch, or when plane_mesh cannot place a hole; std::runtime_error when
+// `surface` is not closed along the plane.
+// 0.5: every crossing edge, moving a vertex by up to half an edge along it. On the default bed
+// in 3 slabs (2026-11-30, docs/findings.md) 0.2 left 9 and 23 plane triangles under 5 deg and
+// 11 dual cells failing checkMesh, 0.4 none under 5 deg and 4 failing, 0.5 none and 2.
+inline constexpr double kPlaneCutSnap = 0.5;
+PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
+
+}  // namespace bedforge::meshing
