@@ -171,8 +171,9 @@ TEST(SlabMesh, ASlabFailingTheGateIsTriedAgainWithThePlanesMovedAndTheErrorNames
 // through the bridges their planes cross (meshing/surface/plane_cut.hpp). The joined mesh passes
 // the gate and fills exactly what the cut parts enclose, with no boundary face left on a plane;
 // the particles' faces keep the whole surface's area within 1e-3 (the cut only moves vertices
-// onto the planes along the surface: measured -7.3e-5 here on 2026-11-30; one sphere left out,
-// or the contacts near a plane opened by shrinking its spheres, would take 1e-2 or more).
+// onto the planes along the surface: measured -3.4e-4 here on 2026-11-30, the volume +3.5e-4;
+// one sphere left out, or the contacts near a plane opened by shrinking its spheres, would take
+// 1e-2 or more).
 TEST(SlabMesh, BridgedBedsAreCutIntoSlabsThroughTheirBridges) {
   Progress quiet("mesh", false);
   const Bed b = test_support::packed_bed(80, 4.0, 1);
