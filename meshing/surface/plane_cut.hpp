@@ -41,7 +41,7 @@ struct PlaneCut {
 // `surface` is not closed along the plane.
 // 0.5: every crossing edge, moving a vertex by up to half an edge along it. On the default bed
 // in 3 slabs (2026-11-30, docs/findings.md) 0.2 left 9 and 23 plane triangles under 5 deg and
-// 11 dual cells failing checkMesh, 0.4 none under 5 deg and 4 failing, 0.5 none and 2.
+// 11 dual cells failing checkMesh, 0.4 none under 5 deg and 4 failing, 0.5 none and 2 or 3.
 inline constexpr double kPlaneCutSnap = 0.5;
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
 
