@@ -77,11 +77,11 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     throw InputError(fmt::format("{}: no case to write a piece into (no 0/ fields); write the case first, e.g. "
                                  "`bedforge run` with case.run = false",
                                  case_dir.string()));
-  if (!meshing::slabs_possible(mesh) || !meshing::slabs_from_clip_windows(surface))
+  if (!meshing::slabs_possible(mesh) || !meshing::pieces_possible(surface, *bed.container))
     throw InputError(fmt::format("contacts.treatment = \"{}\", contacts.wall_treatment = \"{}\", mesh.layers.count = "
-                                 "{}: a piece's planes would cut treated contacts or prism layers open; allowed for "
-                                 "pieces: contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\", "
-                                 "mesh.layers.count = 0",
+                                 "{}: a piece's planes would cut prism layers open, or a box's sides unlike its "
+                                 "neighbour's; allowed for pieces: mesh.layers.count = 0, and in a box "
+                                 "contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\"",
                                  meshing::treatment_name(surface.treatment),
                                  meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
   // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them.

@@ -30,8 +30,8 @@ namespace bedforge::pipeline {
 // volume of its slab's tetrahedra (m^3) and their share of the bed section's void fraction as
 // meshed (cases::bed_section; the pieces' shares add up to it), the slab's report, time and peak
 // memory.
-// InputError, before any work, when case_dir/0 is not there, the treatments cannot be cut by a
-// plane (meshing::slabs_possible), or a piece on polyhedra made alone finds no neighbour's layer;
+// InputError, before any work, when case_dir/0 is not there, prism layers are asked for or the
+// treatments cannot be cut in pieces (meshing::slabs_possible, pieces_possible), or a piece on polyhedra made alone finds no neighbour's layer;
 // the errors of mesh_slab otherwise, naming the piece.
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
                            const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,

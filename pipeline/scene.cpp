@@ -82,17 +82,21 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
 }
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
-// What a case in pieces can be given today: planes that cut only shrunk or untreated spheres,
-// and no whole surface or mesh anywhere.
+// What a case in pieces can be given today: planes that cut no prism layers, treated contacts
+// only where the walls can be ringed, and no whole surface or mesh anywhere.
 void check_pieces(const Scene& sc) {
   const int n = sc.mesh.pieces;
-  if (!meshing::slabs_possible(sc.mesh) || !meshing::slabs_from_clip_windows(sc.surface))
-    throw InputError(fmt::format("mesh.pieces = {}: the planes between pieces cut through the bed, and through treated "
-                                 "contacts or prism layers they would open them; allowed: 0 or 1, or mesh.pieces > 1 "
-                                 "with contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\" (now "
-                                 "\"{}\" and \"{}\") and mesh.layers.count = 0 (now {})",
+  if (!meshing::slabs_possible(sc.mesh))
+    throw InputError(fmt::format("mesh.pieces = {} with mesh.layers.count = {}: the planes between pieces would cut "
+                                 "the prism layers open; allowed: 0 or 1, or mesh.pieces > 1 with mesh.layers.count = 0",
+                                 n, sc.mesh.layers.count));
+  if (!meshing::pieces_possible(sc.surface, *sc.container))
+    throw InputError(fmt::format("mesh.pieces = {} in a box with contacts.treatment \"{}\" and "
+                                 "contacts.wall_treatment \"{}\": a box's sides are not cut alike by its pieces yet; "
+                                 "allowed: 0 or 1, or in a box contacts \"shrink\" or \"none\" (any treatment in a "
+                                 "cylinder or annulus)",
                                  n, meshing::treatment_name(sc.surface.treatment),
-                                 meshing::treatment_name(sc.surface.wall_treatment), sc.mesh.layers.count));
+                                 meshing::treatment_name(sc.surface.wall_treatment)));
   if (sc.container->axial_period() > 0.0)
     throw InputError(fmt::format("mesh.pieces = {} on a periodic section; allowed: 0 or 1", n));
   if (sc.wants("stl") || sc.wants("mesh"))

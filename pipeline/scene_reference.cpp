@@ -204,8 +204,10 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
         "piece`, started by the run) as `case/processorK` with processor patches, and solved on as many processes "
         "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise; pieces that "
-        "fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Shrink or none, no prism layers, no snappyHexMesh, no `stl` or `mesh` output (there is no whole "
-        "surface or mesh)"}},
+        "fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Every "
+        "contact treatment in a cylinder or annulus (bridges, caps and unions cut by the planes from each rank's "
+        "widened window, its walls ringed there), shrink or none in a box; no prism layers, no snappyHexMesh, no "
+        "`stl` or `mesh` output (there is no whole surface or mesh)"}},
       // [mesh.gate]
       {"mesh.gate.max_non_orthogonality_deg", {"quality gate: largest face non-orthogonality (checkMesh's definition)"}},
       {"mesh.gate.max_skewness", {"quality gate: largest skewness (checkMesh's definition)", "1"}},

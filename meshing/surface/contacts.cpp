@@ -56,8 +56,14 @@ TreatedBed ContactTreatment::run() {
   NeighbourList nl(std::max(tolerance, 0.0) + resized * d_max + join + 1e-3 * d_);
   nl.build(bed_.centres, out_.radius, *bed_.container);
   const double wall_pad = 0.6 * p_.edge_length_d * d_;  // the wall mesh keeps its holes this clear of its ends
+  std::vector<int> partners;
   for (std::size_t i = 0; i < n; ++i) {
-    for (int j : nl.of(i))
+    // By index, not in the list's order (its grid follows the skin, which a window's opened
+    // contacts widen): a sphere's cuts then come in one order in every window of a bed, and the
+    // sphere is meshed alike in each (pieces cut from widened windows rely on it).
+    partners.assign(nl.of(i).begin(), nl.of(i).end());
+    std::sort(partners.begin(), partners.end());
+    for (int j : partners)
       if (static_cast<std::size_t>(j) > i) {
         const Marks m = mark(i, j);
         pair(i, j, nl);
@@ -73,7 +79,7 @@ TreatedBed ContactTreatment::run() {
   for (std::size_t i = 0; i < n; ++i) check_cuts(i);
   if (!(min_gap_ > 0.0)) throw InputError(gap_error_);
   out_.solid_volume = volume_;
-  out_.min_concave_wall_gap = min_concave_wall_gap_;
+  out_.min_concave_wall_gap = out_.bed_min_concave_wall_gap = min_concave_wall_gap_;
   auto angle = [](double a) { return std::isfinite(a) ? nlohmann::json(a * 180.0 / kPi) : nlohmann::json(nullptr); };
   out_.report = {
       {"contacts_treated",
@@ -266,6 +272,7 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   // The curved walls' edge follows their narrowest gap: taken over the whole bed, every window
   // of one bed (the slabs of one mesh) rims a plane they share with the same vertices.
   out.min_concave_wall_gap = std::min(out.min_concave_wall_gap, whole.min_concave_wall_gap);
+  out.bed_min_concave_wall_gap = whole.min_concave_wall_gap;
   out.report["clip"] = placed.report;
   return out;
 }

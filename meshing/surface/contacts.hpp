@@ -35,6 +35,7 @@ struct TreatedBed {
   // facets lie inside it, towards the spheres (an annulus's inner wall's lie away from them).
   // With clip planes, the narrower of the window's and the whole bed's.
   double min_concave_wall_gap = 0.0;
+  double bed_min_concave_wall_gap = 0.0;          // the whole bed's, without the window's opened contacts
   nlohmann::json report;                          // contacts treated, volume and area change, gaps, angles
 };
 

@@ -103,7 +103,7 @@ constexpr double kSmallestNewAngleDeg = 10.0;
 }  // namespace
 
 WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vector<SurfacePiece>& pieces, double band,
-                                                     int max_rounds) {
+                                                     const std::vector<double>& rings, int max_rounds) {
   WallDelaunaySplits out;
   std::vector<std::size_t> walls;
   for (std::size_t k = 0; k < pieces.size(); ++k)
@@ -167,7 +167,9 @@ WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vecto
       for (int e : order) {
         const int a = tri[e], b = tri[(e + 1) % 3];
         const auto& shared = edge_triangles.at(edge_key(a, b));
-        if (shared.size() != 2 || touched.count(shared[0]) || touched.count(shared[1])) continue;
+        const bool on_ring = f.points[a].z() == f.points[b].z() &&
+                             std::find(rings.begin(), rings.end(), f.points[a].z()) != rings.end();
+        if (on_ring || shared.size() != 2 || touched.count(shared[0]) || touched.count(shared[1])) continue;
         const Eigen::Vector3d m = midpoint_on_wall(pieces[wall_of(t)], f.points[a], f.points[b]);
         double smallest = 180.0;
         for (std::size_t s : shared) {

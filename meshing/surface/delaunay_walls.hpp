@@ -39,9 +39,11 @@ struct WallDelaunaySplits {
 //
 // Inputs: `f`, a welded surface (m); `pieces`, f's triangle ranges as build_fluid_surface makes
 // them (those of Shape::cylinder are the walls); `band` (m), larger than the wall triangles'
-// circumradii. Output: f with new points at its end and each wall's triangles still one range;
-// `pieces`' ranges moved to match; or both as they were (`kept` false).
+// circumradii; `rings` (m): heights of the walls' rings (wall_mesh), whose edges are not split
+// (their points are what two windows of one bed must agree on). Output: f with new points at
+// its end and each wall's triangles still one range; `pieces`' ranges moved to match; or both as
+// they were (`kept` false).
 WallDelaunaySplits split_wall_triangles_off_delaunay(TriangleMesh& f, std::vector<SurfacePiece>& pieces, double band,
-                                                     int max_rounds = 2);
+                                                     const std::vector<double>& rings = {}, int max_rounds = 2);
 
 }  // namespace bedforge::meshing

@@ -12,10 +12,12 @@
 #include <numbers>
 #include <optional>
 #include <tuple>
+#include <unordered_map>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/intersection_volumes.hpp"
+#include "core/point_key.hpp"
 #include "core/version.hpp"
 #include "meshing/surface/defect_locations.hpp"
 #include "meshing/surface/clip_planes.hpp"
@@ -85,7 +87,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
 }
 
 nlohmann::json to_json(const SurfaceParams& p) {
-  return {{"treatment", treatment_name(p.treatment)},
+  nlohmann::json j = {{"treatment", treatment_name(p.treatment)},
           {"wall_treatment", treatment_name(p.wall_treatment)},
           {"shrink_factor", p.shrink_factor},
           {"enlarge_factor", p.enlarge_factor},
@@ -103,6 +105,8 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"clip_shift_d", p.clip_shift_d},
           {"clip_clearance_d", p.clip_clearance_d},
           {"min_angle_deg", p.min_angle_deg}};
+  if (!p.wall_rings_d.empty()) j["wall_rings_d"] = p.wall_rings_d;
+  return j;
 }
 
 namespace {
@@ -232,18 +236,43 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // sphere. Where the spheres' edge is too long for that, the curved walls (a few thousand
   // triangles; an annulus's two share the end rings' meshes) take the longest edge whose
   // sagitta is 0.4 of the gap, down to the contact edge.
+  // With rings, the whole bed's gap: every window of the bed then rings its walls alike (the
+  // window's opened contacts lie beyond its pieces' planes, cut away).
+  const double wall_gap = p.wall_rings_d.empty() ? tb.min_concave_wall_gap : tb.bed_min_concave_wall_gap;
   double wall_edge = edge;
-  if (!box && ring_sagitta(R, edge) >= 0.5 * tb.min_concave_wall_gap) {
-    wall_edge = tb.min_concave_wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * tb.min_concave_wall_gap) : 0.0;
+  if (!box && ring_sagitta(R, edge) >= 0.5 * wall_gap) {
+    wall_edge = wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * wall_gap) : 0.0;
     if (!(wall_edge >= p.contact_edge_length_d * d))
       throw InputError(fmt::format(
           "surface.edge_length_d = {}: the wall facets would lie up to {:.3g} d inside the wall, more than half the "
           "narrowest gap left at the wall ({:.3g} d), and a wall edge short enough ({:.3g} d) is below "
           "surface.contact_edge_length_d = {}; allowed: a treatment that leaves a wider gap at the wall",
-          p.edge_length_d, ring_sagitta(R, edge) / d, tb.min_concave_wall_gap / d, wall_edge / d,
+          p.edge_length_d, ring_sagitta(R, edge) / d, wall_gap / d, wall_edge / d,
           p.contact_edge_length_d));
   }
   const double wall_sag = box ? 0.0 : ring_sagitta(R, wall_edge);
+
+  // Rings on the curved walls at the heights asked (those inside the window), each a height the
+  // STL's rounding keeps: the holes' loops meet them at vertices, moved there alike in the loops'
+  // other owners (a bridge's end, a sphere's cut).
+  std::vector<double> rings;
+  if (!p.wall_rings_d.empty() && (box || laid.periodic()))
+    throw std::invalid_argument("build_fluid_surface: wall rings need a cylinder or annulus, not periodic");
+  for (double h : p.wall_rings_d)
+    if (const double z = round_to_ascii_stl(h * d); z > z0 + wall_edge && z < z1 - wall_edge) rings.push_back(z);
+  if (!rings.empty()) {
+    std::unordered_map<PointKey, Eigen::Vector3d, PointKeyHash> moved;
+    for (auto& holes : tb.wall_holes)
+      for (const auto& [from, to] : snap_holes_to_rings(holes, rings)) moved.insert_or_assign(PointKey(from), to);
+    auto follow = [&moved](Eigen::Vector3d& q) {
+      if (const auto it = moved.find(PointKey(q)); it != moved.end()) q = it->second;
+    };
+    for (TriangleMesh& m : tb.parts)
+      for (Eigen::Vector3d& q : m.points) follow(q);
+    for (auto& cuts : tb.cuts)
+      for (SphereCut& cut : cuts)
+        for (Eigen::Vector3d& q : cut.loop) follow(q);
+  }
 
   // Edges shortened where the surface faces another across a narrow gap.
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
@@ -318,10 +347,12 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
     }
   } else {
     add("wall", Shape::cylinder, R,
-        [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1)); });
+        [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1), rings); });
     if (ann)
       add("inner_wall", Shape::cylinder, r_in,
-          [&] { return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1)); });
+          [&] {
+            return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1), rings);
+          });
   }
   // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
   using Loops = std::vector<std::vector<Eigen::Vector3d>>;
@@ -380,7 +411,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
     piece(Shape::plane);
   }
   f.weld();
-  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 4.0 * wall_edge);
+  const WallDelaunaySplits splits = split_wall_triangles_off_delaunay(f, out.pieces, 4.0 * wall_edge, rings);
   round_to_ascii_stl(f);
   out.bed.weld();
 

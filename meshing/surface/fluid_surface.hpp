@@ -41,6 +41,9 @@ struct SurfaceParams {
   double clip_bottom_d = 0.0, clip_top_d = 0.0;
   double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
+  // Heights above the floor (d) where the curved walls get rings (wall_mesh), not from a scene:
+  // the planes a bed's pieces are cut at, so that each piece's window cuts the wall there alike.
+  std::vector<double> wall_rings_d;
   // Quality gate: a surface with a smaller angle fails, its triangles written to
   // bad_triangles.vtp (0 turns the gate off).
   double min_angle_deg = 2.0;

@@ -73,9 +73,20 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
     };
     return key(a) < key(b);
   });
-  std::vector<char> moved(nv, 0);
+  // A vertex where patches meet (a bridge's end on the wall) stays: its link holds the other
+  // patch's triangles, which two windows of one bed need not mesh alike, and it would move the
+  // patches' common edge.
+  std::vector<char> moved(nv, 0), between_patches(nv, 0);
+  {
+    std::vector<int> patch_of(nv, -1);
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      for (int v : m.triangles[t]) {
+        if (patch_of[v] >= 0 && patch_of[v] != m.patch[t]) between_patches[v] = 1;
+        patch_of[v] = m.patch[t];
+      }
+  }
   for (const Snap& snap : snaps) {
-    if (s[snap.v] == 0.0 || moved[snap.other]) continue;
+    if (s[snap.v] == 0.0 || moved[snap.other] || between_patches[snap.v]) continue;
     // Only where the plane would then pass through the vertex once: its neighbours, in order
     // around it, on one arc above and one below (at a saddle, the necks of bridges and unions,
     // two loops would touch there), any neighbour on the plane between the two (below); and no

@@ -29,7 +29,8 @@ struct PlaneCut {
 // of it) is moved along that edge onto the plane, nearest first, so that the cut's loops are
 // mostly the surface's own vertices, spaced as its edges, with no needles beside them; not
 // where the plane would then pass through that vertex twice (a saddle: the necks of bridges
-// and unions), touch the surface along an edge, or turn a triangle over. Each edge still
+// and unions), touch the surface along an edge, or turn a triangle over; nor a vertex where
+// patches meet. Each edge still
 // crossing is split where it meets the plane, and the triangles on either side are kept whole
 // or split in two or three. The
 // region's section by the plane is one face or more (bridged spheres and the wall can ring in a

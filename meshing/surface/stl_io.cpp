@@ -33,14 +33,17 @@ std::vector<std::size_t> triangles_of(const TriangleMesh& m, int patch) {
 
 }  // namespace
 
+double round_to_ascii_stl(double x) {
+  char text[32];
+  const char* end = fmt::format_to_n(text, sizeof text, "{:.{}g}", x, kDigits).out;
+  std::from_chars(text, end, x);
+  return x;
+}
+
 void round_to_ascii_stl(TriangleMesh& m) {
 #pragma omp parallel for schedule(static)
   for (std::size_t v = 0; v < m.points.size(); ++v)
-    for (int k = 0; k < 3; ++k) {
-      char text[32];
-      const char* end = fmt::format_to_n(text, sizeof text, "{:.{}g}", m.points[v][k], kDigits).out;
-      std::from_chars(text, end, m.points[v][k]);
-    }
+    for (int k = 0; k < 3; ++k) m.points[v][k] = round_to_ascii_stl(m.points[v][k]);
 }
 
 void write_stl_ascii_by_patch(std::ostream& out, const TriangleMesh& m) {

@@ -12,6 +12,8 @@ namespace bedforge::meshing {
 // keeps gmsh's Delaunay fast: at full precision a sphere's points are cospherical to rounding and
 // its predicates fall back to exact arithmetic on nearly every test.
 void round_to_ascii_stl(TriangleMesh& mesh);
+// One coordinate so rounded (a value it leaves as it is: a height planes and rings share).
+double round_to_ascii_stl(double x);
 
 // ASCII STL with one named solid per patch (`solid inlet ... endsolid inlet`), the layout
 // snappyHexMesh and surfaceFeatureExtract read as separate regions. Coordinates in metres.

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 #include <numbers>
 
 #include "core/random.hpp"
@@ -26,8 +27,35 @@ double wrap_pi(double a) { return wrap_2pi(a + std::numbers::pi) - std::numbers:
 
 }  // namespace
 
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std::vector<WallHole>& holes,
+                                                                             const std::vector<double>& rings) {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> moves;
+  for (WallHole& hole : holes)
+    for (double z : rings) {
+      std::vector<Eigen::Vector3d>& loop = hole.loop;
+      const std::size_t n = loop.size();
+      auto move = [&](std::size_t k, Eigen::Vector3d to) {
+        to.z() = z;
+        moves.emplace_back(loop[k], to);
+        loop[k] = to;
+      };
+      // Vertices near the ring onto it (straight down or up), then the nearer end of each edge
+      // still crossing it along that edge.
+      for (std::size_t k = 0; k < n; ++k)
+        if (loop[k].z() != z && std::abs(loop[k].z() - z) < kRingSnap * hole.spacing) move(k, loop[k]);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t l = (k + 1) % n;
+        const double a = loop[k].z() - z, b = loop[l].z() - z;
+        if (!(a * b < 0.0)) continue;
+        const Eigen::Vector3d at = loop[k] + a / (a - b) * (loop[l] - loop[k]);
+        move(std::abs(a) <= std::abs(b) ? k : l, at);
+      }
+    }
+  return moves;
+}
+
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
-                   bool outward, const std::string& patch, const SpacingField& field) {
+                   bool outward, const std::string& patch, const SpacingField& field, const std::vector<double>& rings) {
   const int n = ring_points(R, edge);
   // Sites lie on a dyadic grid in s whose step divides the period, so a site's copy one period
   // on is its exact translate: the exact predicates then see the two ends of the strip alike
@@ -92,6 +120,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   std::vector<std::vector<Eigen::Vector2d>> polygons;
   std::vector<std::vector<int>> loop_sites;
   std::vector<std::size_t> original;  // per hole, its polygon at offset 0
+  std::vector<double> polygon_spacing;  // per polygon, its hole's
   for (const auto& hole : holes) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (const auto& p : hole.loop) mean += Eigen::Vector2d(p.x(), p.y()).normalized();
@@ -112,7 +141,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
     for (double offset : {0.0, -period, period}) {
       if (offset != 0.0 && hi + offset < -margin) continue;
       if (offset != 0.0 && lo + offset > period + margin) continue;
-      polygons.emplace_back(), loop_sites.emplace_back();
+      polygons.emplace_back(), loop_sites.emplace_back(), polygon_spacing.push_back(std::min(hole.spacing, step));
       for (std::size_t k = 0; k < poly.size(); ++k) {
         polygons.back().push_back(poly[k] + Eigen::Vector2d(offset, 0.0));
         loop_sites.back().push_back(static_cast<int>(uv.size()));
@@ -122,6 +151,87 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   }
   const PolygonIndex hole_index(polygons);
   auto in_hole = [&](const Eigen::Vector2d& q) { return hole_index.contains(q); };
+  // 1b. Rings: a row of end-row vertices at each height, less those in or beside a hole, joined
+  // by constraints to each other and to the holes' vertices on the ring (snap_holes_to_rings).
+  // The wall's triangles then end on the ring from both sides, whatever else is meshed there.
+  std::vector<std::array<int, 2>> ring_constraints;
+  std::unordered_map<int, std::vector<int>> sites_of;  // vertex -> its sites, for those on a ring
+  for (double z : rings) {
+    if (!(z > z0 + 0.5 * step && z < z1 - 0.5 * step))
+      throw std::invalid_argument(fmt::format("wall_mesh: ring at z = {} m outside ({}, {})", z, z0, z1));
+    // The ring's vertices as sites in [0, period), in order along it.
+    std::vector<std::pair<double, int>> along;
+    std::vector<Eigen::Vector2d> on_ring;  // the holes' vertices on it
+    for (std::size_t h = 0; h < holes.size(); ++h)
+      for (std::size_t k = 0; k < holes[h].loop.size(); ++k) {
+        if (holes[h].loop[k].z() != z) continue;
+        const int v = vertex[loop_sites[original[h]][k]];
+        if (sites_of.count(v)) continue;
+        for (std::size_t site = 0; site < uv.size(); ++site)
+          if (vertex[site] == v) sites_of[v].push_back(static_cast<int>(site));
+        const Eigen::Vector2d q = uv[loop_sites[original[h]][k]];
+        on_ring.push_back(q);
+        along.emplace_back(R * wrap_2pi(q.x() / R), v);
+      }
+    // The holes' vertices near the ring, with their loops' spacing: the ring's points are
+    // graded towards them as the rings around a hole are (a loop vertex just off the ring would
+    // otherwise make a needle with two ring points an edge apart).
+    std::vector<std::pair<Eigen::Vector2d, double>> near;
+    for (std::size_t k = 0; k < polygons.size(); ++k)
+      for (const auto& q : polygons[k])
+        if (std::abs(q.y() - z) < step) near.emplace_back(q, polygon_spacing[k]);
+    for (int j = 0; j < n; ++j) {
+      // The interval from ring point j to j + 1 in m equal parts, m from the spacing wanted
+      // at its middle: alike in every window, whose holes near the ring are the same.
+      const double s_mid = R * (2.0 * std::numbers::pi * (j + 0.5) / n - seam);
+      double wanted = step;
+      for (const auto& [q, spacing] : near) {
+        const double ds = std::abs(wrap_pi((q.x() - s_mid) / R)) * R, dz = q.y() - z;
+        wanted = std::min(wanted, spacing + (growth - 1.0) * std::max(0.0, std::hypot(ds, dz) - 0.5 * step));
+      }
+      const int m = std::max(1, static_cast<int>(std::ceil(step / wanted - 0.25)));
+      for (int i = 0; i < m; ++i) {
+        const double t = static_cast<double>(i) / m, angle = 2.0 * std::numbers::pi * (j + t) / n;
+        const Eigen::Vector2d q = on_grid({R * wrap_2pi(angle - seam), z});
+        bool clear = !in_hole(q) && !in_hole(q + Eigen::Vector2d(period, 0.0)) && !in_hole(q - Eigen::Vector2d(period, 0.0));
+        for (const Eigen::Vector2d& h : on_ring)
+          clear = clear && std::abs(wrap_pi((q.x() - h.x()) / R)) * R >= 0.5 * step / m;
+        if (!clear) continue;
+        const std::size_t first = uv.size();
+        add_vertex(Eigen::Vector3d(R * std::cos(angle), R * std::sin(angle), z), q, step / m, true);
+        const int v = vertex[first];
+        for (std::size_t site = first; site < uv.size(); ++site) sites_of[v].push_back(static_cast<int>(site));
+        along.emplace_back(q.x(), v);
+      }
+    }
+    std::sort(along.begin(), along.end());
+    // Vertex v's site at about s = x (its own, or its copy a period on or back); -1 if none.
+    auto site_at = [&](int v, double x) {
+      for (int site : sites_of.at(v))
+        if (std::abs(uv[site].x() - x) < 0.25 * period) return site;
+      return -1;
+    };
+    for (std::size_t k = 0; k < along.size(); ++k) {
+      const bool wrap = k + 1 == along.size();
+      const auto [sa, a] = along[k];
+      const double sb = wrap ? along[0].first + period : along[k + 1].first;
+      const int b = along[wrap ? 0 : k + 1].second;
+      const Eigen::Vector2d mid(0.5 * (sa + sb), z);
+      if (in_hole(mid) || in_hole(mid - Eigen::Vector2d(period, 0.0)) || in_hole(mid + Eigen::Vector2d(period, 0.0)))
+        continue;  // across a hole
+      // The segment and its copies a period on and back, where both its ends have one.
+      for (double shift : {-period, 0.0, period}) {
+        const int from = site_at(a, sa + shift), to = site_at(b, sb + shift);
+        if (from >= 0 && to >= 0) ring_constraints.push_back({from, to});
+        else if (shift == 0.0)
+          throw CutConflict(fmt::format("the wall's ring at z = {} m cannot be joined across the strip's seam", z));
+      }
+      // Free vertices keep off the constraint as off the ring's points.
+      const double length = sb - sa;
+      for (double t : {0.25, 0.5, 0.75})
+        spaced.add(Eigen::Vector3d(R * wrap_2pi((sa + t * length) / R), z, 0.0), std::min(step, length));
+    }
+  }
   auto on_wall = [&](const Eigen::Vector2d& q) {
     const double theta = seam + q.x() / R;
     return Eigen::Vector3d(R * std::cos(theta), R * std::sin(theta), q.y());
@@ -163,6 +273,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   for (const auto& sites : loop_sites)
     for (std::size_t k = 0; k < sites.size(); ++k)
       cdt.insert_constraint(handle[sites[k]], handle[sites[(k + 1) % sites.size()]]);
+  for (const auto& [a, b] : ring_constraints) cdt.insert_constraint(handle[a], handle[b]);
   WallMesh out;
   out.outside.points = out.inside.points = points;
   for (auto f : cdt.finite_face_handles()) {

@@ -2,6 +2,7 @@
 #include <Eigen/Core>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "meshing/surface/primitives.hpp"
@@ -22,6 +23,18 @@ struct WallMesh {
   TriangleMesh inside;   // what the holes cut out (closes the bed solid there)
 };
 
+// A hole loop's vertex within this fraction of the loop's spacing of a ring moves onto it
+// (snap_holes_to_rings): nearer, the wall's triangles between it and the ring would be needles.
+inline constexpr double kRingSnap = 0.25;
+
+// Moves the vertices of `holes`' loops so that each ring height in `rings` (m) meets a loop only
+// at its vertices, as wall_mesh's rings need: a vertex within kRingSnap of the loop's spacing of
+// a ring onto it (in z only), then the nearer end of each loop edge still crossing it along that
+// edge (by at most half the edge). Returns each move as (from, to): the parts that share the
+// loops (a bridge's end, a sphere's cut) must move the same points alike.
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std::vector<WallHole>& holes,
+                                                                             const std::vector<double>& rings);
+
 // Lateral wall of the cylinder of radius R about the z axis, z0 <= z <= z1, with holes.
 // Meshed unrolled (s = R theta, z): a staggered lattice of spacing about `edge` (its end rows
 // are circle_loop(Frame at z0 or z1, R, ring_points(R, edge)), the edges of ring_mesh), the
@@ -30,8 +43,14 @@ struct WallMesh {
 // unrolled strip is cut along a lattice generator clear of every hole; its two sides share
 // their vertices. `outward` = normals away from the axis. CutConflict when a hole crosses the
 // strip's ends or no generator is clear of the holes. With a `field`, spacing as in sphere_mesh.
+// `rings` (m, inside (z0, z1) by half an edge): heights where the wall has a row of vertices
+// like its end rows, joined by edges to each other and to the holes' vertices on the ring (the
+// holes must meet a ring only at vertices: snap_holes_to_rings), which no triangle crosses: the
+// wall's section at a ring is then those points whatever else the strip holds, so two windows
+// of one bed that share a ring cut the wall there alike (pieces on ranks of their own).
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
-                   bool outward, const std::string& patch, const SpacingField& field = {});
+                   bool outward, const std::string& patch, const SpacingField& field = {},
+                   const std::vector<double>& rings = {});
 
 // Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
 // the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the

@@ -17,6 +17,7 @@
 #include "core/stage_meter.hpp"
 #include "meshing/surface/plane_cut.hpp"
 #include "meshing/surface/primitives.hpp"
+#include "meshing/surface/stl_io.hpp"
 
 namespace bedforge::meshing {
 
@@ -211,6 +212,10 @@ bool slabs_from_clip_windows(const SurfaceParams& s) {
   return alone(s.treatment) && alone(s.wall_treatment);
 }
 
+bool pieces_possible(const SurfaceParams& s, const Container& container) {
+  return slabs_from_clip_windows(s) || dynamic_cast<const Box*>(&container) == nullptr;
+}
+
 int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const VolumeMeshParams& p) {
   if (p.slabs > 0) return p.slabs;
   if (!slabs_possible(p) || !slabs_from_clip_windows(s)) return 1;
@@ -280,25 +285,64 @@ SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const s
   return q;
 }
 
+double piece_margin_d(const Bed& bed, const SurfaceParams& surface) {
+  const double d = reference_diameter(bed);
+  const double largest = bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) / d : 0.0;
+  return 3.0 * largest + surface.cells_per_gap * surface.edge_length_d + surface.clip_shift_d;
+}
+
 VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k,
                      double d_ref, const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path,
                      bool release_memory) {
   const int slabs = static_cast<int>(planes.size()) + 1;
-  const SurfaceParams q = slab_surface(bed, surface, planes, k);
+  const SurfaceParams asked = slab_surface(bed, surface, planes, k);
+  // Treated contacts: the window widened by piece_margin_d on each side and ringed at every
+  // plane, its surface then cut at the slab's own planes.
+  const bool cut = !slabs_from_clip_windows(surface);
+  SurfaceParams q = asked;
+  if (cut) {
+    const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
+    const double margin = piece_margin_d(bed, surface);
+    if (k > 0) q.clip_bottom_d = std::max(whole.clip_bottom_d, planes[k - 1] - margin);
+    if (k + 1 < slabs) q.clip_top_d = std::min(whole.clip_top_d, planes[k] + margin);
+    q.wall_rings_d = planes;
+  }
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
-  const FluidSurface fs = [&] {
+  auto cannot = [&](const std::string& what) {
+    return InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut from the "
+                                  "bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
+                                  k + 1, slabs, asked.clip_bottom_d, asked.clip_top_d, what));
+  };
+  FluidSurface fs = [&] {
     try {
       return build_fluid_surface(bed, q);
     } catch (const InputError& e) {
-      throw InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut "
-                                   "from the bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
-                                   k + 1, slabs, q.clip_bottom_d, q.clip_top_d, e.what()));
+      throw cannot(e.what());
     }
   }();
+  nlohmann::json planes_used = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
+  nlohmann::json cut_report = nlohmann::json::array();
+  if (cut) {
+    const double d = reference_diameter(bed);
+    for (const auto& [j, keep_above] : {std::pair{k - 1, true}, std::pair{k, false}}) {
+      if (j < 0 || j + 1 >= slabs) continue;
+      try {
+        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d),
+                                  {surface.edge_length_d * d, surface.growth, "outlet", "inlet"});
+        cut_report.push_back({{"plane_d", planes[j]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
+                              {"plane_triangles", c.plane_triangles}});
+        fs.fluid = std::move(keep_above ? c.above : c.below);
+      } catch (const CutConflict& e) {
+        throw cannot(e.what());
+      }
+      planes_used[keep_above ? 0 : 1] = planes[j];
+    }
+  }
   VolumeMesh slab = mesh_slab_surface(fs.fluid, bed, d_ref, p, bad_cells_path, release_memory, k, slabs,
-                                      {q.clip_bottom_d, q.clip_top_d});
-  slab.report["planes_d"] = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
+                                      {asked.clip_bottom_d, asked.clip_top_d});
+  slab.report["planes_d"] = std::move(planes_used);
+  if (cut) slab.report["plane_cut"] = std::move(cut_report);
   return slab;
 }
 

@@ -16,17 +16,23 @@ namespace bedforge::meshing {
 // heights (build_fluid_surface with a clip window): the planes between slabs cut the spheres
 // crossing them, and both slabs triangulate a shared plane alike, so the joined cells are
 // conforming and the planes' triangles become internal faces. A clip plane through a treated
-// contact (bridge, cap, union) would open it, so under those treatments the slabs are cut from
-// the whole domain's surface instead (cut_by_plane, which cuts any contact and gives each plane's
-// triangles to both its slabs): one process holds that surface, so pieces on ranks of their own
-// (pipeline/piece_stage) keep to the clip windows.
+// contact (bridge, cap, union) would open it, so under those treatments the slabs are cut by
+// cut_by_plane, which cuts any contact and triangulates a plane from its section alone: in one
+// process from the whole domain's surface; on ranks of their own (mesh_slab, pipeline/
+// piece_stage) each from the surface of its window widened by piece_margin_d, whose walls are
+// ringed at every plane (wall_mesh), so that two neighbours' surfaces cross their shared plane
+// in the same triangles and their cuts triangulate it alike.
 
 // Whether a bed can be meshed in slabs with `params`: no prism layers (they would meet the
 // planes between slabs).
 bool slabs_possible(const VolumeMeshParams& params);
 // Whether each slab's surface is built on its own from a clip window (contacts and walls shrunk
-// or left alone), needing no whole surface; otherwise slabs are cut from the whole one.
+// or left alone); otherwise slabs are cut by planes from a surface.
 bool slabs_from_clip_windows(const SurfaceParams& surface);
+// Whether a bed in `container` under `surface` can be meshed in pieces that need no whole
+// surface (mesh_slab): from clip windows in any container; cut from widened windows only where
+// the walls can be ringed (a cylinder or annulus; a box's flat sides are not).
+bool pieces_possible(const SurfaceParams& surface, const Container& container);
 
 // How many slabs: params.slabs when set; else, when slabs_possible and slabs_from_clip_windows,
 // one per kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles
@@ -62,8 +68,17 @@ FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, in
 // spheres, alike for the slabs on either side.
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k);
 
-// Slab `k` between `planes` meshed on its own from its clip window (slabs_from_clip_windows): its
-// surface (slab_surface) and build_volume_mesh with
+// How far (d) a slab's window is widened before its surface is cut at its planes (treated
+// contacts): a sphere crossing a plane, its neighbours (whose contacts shape its cuts) and theirs
+// (which the window's own clip planes may open, moved by up to surface.clip_shift_d), and the
+// surfaces its narrow-gap spacing sees (surface.cells_per_gap edges): 3 largest diameters plus
+// those two lengths. Within it both windows of a plane hold the same spheres, contacts and cuts.
+double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
+
+// Slab `k` between `planes` meshed on its own, needing no other slab's surface: from its clip
+// window (slabs_from_clip_windows), or under treated contacts from its window widened by
+// piece_margin_d, ringed at every plane and cut at its own (cut_by_plane; the report's
+// "plane_cut" lists each cut); its surface and build_volume_mesh with
 // `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
 // in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
 // (where the surface stage put them), "surface_triangles" and "cells". InputError naming

@@ -30,14 +30,15 @@ const char* kScene =
     "[case]\nprocessors = 2\n";
 
 // `bedforge run` of kScene, the case solved or only written, on `cells`, with `mesh` the [mesh]
-// section (slabs joined by default) and a convergence study of `levels`, into a fresh directory
-// `name`.
+// section (slabs joined by default), a convergence study of `levels` and the contacts
+// `treatment`, into a fresh directory `name`.
 fs::path run(const std::string& name, bool solve, const std::string& cells = "polyhedra",
-             const std::string& mesh = "[mesh]\nslabs = 2\n", int levels = 0) {
+             const std::string& mesh = "[mesh]\nslabs = 2\n", int levels = 0, const std::string& treatment = "shrink") {
   const fs::path dir = fresh_dir(name), scene = fresh_dir(name + "_scene");
   fs::create_directories(scene);
   std::string text = kScene;
   text.replace(text.find("levels = 0"), 10, "levels = " + std::to_string(levels));
+  text.replace(text.find("\"shrink\""), 8, "\"" + treatment + "\"");
   std::ofstream(scene / "s.toml") << text << (solve ? "run = true\n" : "run = false\n") << "cells = \"" << cells
                                   << "\"\n" << mesh;
   const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
@@ -146,6 +147,29 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabsAndItsStudyI
       EXPECT_NEAR(h / wanted, 1.0, 0.03) << "level " << k + 1;
     }
   }
+}
+
+// Bridged contacts in pieces: each rank cuts its slab, bridges and all, from its own widened
+// window (meshing/volume/slab_mesh.hpp); the ranks' planes match, checkMesh passes across them
+// and on the gathered mesh, and the pressure drop is the joined slabs' (cut from the whole
+// surface in one process) within issue 58's 0.5 %: the two differ only in the walls' triangles
+// near the planes.
+TEST(PieceStage, BridgedPiecesGiveThePressureDropOfTheJoinedSlabs) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam, mpirun) not on PATH";
+  const fs::path joined = run("piece_bridged_joined", true, "polyhedra", "[mesh]\nslabs = 2\n", 0, "bridge");
+  const double joined_gradient = nlohmann::json::parse(read(joined / "report.json"))["stages"]["case"]["flow"]
+                                     ["pressure_gradient_bed_pa_m"].get<double>();
+  const fs::path dir = run("piece_bridged", true, "polyhedra", "[mesh]\npieces = 2\n", 0, "bridge");
+  const auto& c = nlohmann::json::parse(read(dir / "report.json"))["stages"]["case"];
+  const auto piece = nlohmann::json::parse(read(dir / "case/processor1/bedforge_piece.json"));
+  EXPECT_EQ(piece["slab"]["plane_cut"].size(), 1u) << piece["slab"].dump();
+  EXPECT_GT(piece["slab"]["plane_cut"][0]["loops"].get<long>(), 1);
+  const std::string check = read(dir / "case/log.checkMesh");
+  EXPECT_NE(check.find("Mesh OK."), std::string::npos) << check;
+  EXPECT_TRUE(c["flow"]["converged"].get<bool>()) << c["flow"].dump();
+  const double gradient = c["flow"]["pressure_gradient_bed_pa_m"].get<double>();
+  EXPECT_NEAR(gradient, joined_gradient, 0.005 * joined_gradient);
+  expect_gathered(dir, c["cells"].get<long>());
 }
 
 TEST(PieceStage, OnTetrahedraThePiecesPassCheckMeshAndGatherIntoOneMesh) {
@@ -273,23 +297,21 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
                           "made together"),
             std::string::npos)
       << r.output;
-  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --contacts bridge");
+  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --layers 2");
   EXPECT_EQ(r.status, 2) << r.output;
-  EXPECT_NE(r.output.find("contacts.treatment = \"bridge\""), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("allowed for pieces: contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\""),
-            std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("mesh.layers.count = 2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("allowed for pieces: mesh.layers.count = 0"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
   // A scene asking for pieces the route cannot make is refused when read, naming mesh.pieces:
-  // the default scene's bridges.
+  // the default scene with prism layers.
   std::string scene = read(fs::path(BEDFORGE_SOURCE_DIR) / "scenes/default.toml");
-  scene.replace(scene.find("algorithm = \"hxt\""), 17, "algorithm = \"hxt\"\npieces = 2");
+  scene.replace(scene.find("algorithm = \"hxt\""), 17, "algorithm = \"hxt\"\npieces = 2\nlayers.count = 2");
   const fs::path out = fresh_dir("piece_refused_run"), file = fresh_dir("piece_refused_scene");
   fs::create_directories(file);
   std::ofstream(file / "s.toml") << scene;
   r = bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("mesh.pieces = 2"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("contacts.treatment and contacts.wall_treatment"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("mesh.layers.count = 2"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out / "bed.csv"));
 }

@@ -125,17 +125,22 @@ TEST(Scene, ContactTreatmentsAndTheirErrors) {
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 // A plane between slabs cuts through the bed: every contact treatment is cut there (bridges,
 // caps and unions from the whole surface), but prism layers would meet it, so slabs are refused
-// with them, naming the key; pieces on ranks of their own build their surfaces from clip
-// windows, which would open treated contacts, so pieces are refused with those.
+// with them, naming the key; pieces on ranks of their own are cut from widened windows whose
+// curved walls are ringed at the planes, so treated contacts are refused in pieces only in a
+// box, whose flat sides are not ringed.
 TEST(Scene, SlabsAndPiecesAreRefusedWhereTheirPlanesWouldChangeTheBed) {
   const std::string bed = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
   EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"shrink\"\n[mesh]\nslabs = 3\n").mesh.slabs, 3);
   EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"bridge\"\n[mesh]\nslabs = 3\n").mesh.slabs, 3);
   EXPECT_EQ(read(bed + "[contacts]\ntreatment = \"cap\"\n[mesh]\nslabs = 2\n").mesh.slabs, 2);
+  EXPECT_EQ(read(bed + "[mesh]\npieces = 2\n").mesh.pieces, 2);  // bridged by default
+  const std::string box = "[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\n[particles]\ncount = 10\n";
+  EXPECT_EQ(read(box + "[contacts]\ntreatment = \"shrink\"\n[mesh]\npieces = 2\n").mesh.pieces, 2);
   for (const auto& [extra, key] : std::vector<std::pair<std::string, std::string>>{
-           {"[contacts]\ntreatment = \"shrink\"\n[mesh]\nslabs = 2\n[mesh.layers]\ncount = 2\n", "mesh.slabs = 2"},
-           {"[mesh]\npieces = 2\n", "mesh.pieces = 2"}}) {  // bridged by default
-    const std::string m = message(bed + extra);
+           {bed + "[contacts]\ntreatment = \"shrink\"\n[mesh]\nslabs = 2\n[mesh.layers]\ncount = 2\n", "mesh.slabs = 2"},
+           {bed + "[mesh]\npieces = 2\n[mesh.layers]\ncount = 2\n", "mesh.pieces = 2 with mesh.layers.count = 2"},
+           {box + "[mesh]\npieces = 2\n", "mesh.pieces = 2 in a box with contacts.treatment \"bridge\""}}) {
+    const std::string m = message(extra);
     EXPECT_NE(m.find(key), std::string::npos) << m;
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
   }

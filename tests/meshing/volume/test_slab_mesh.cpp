@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "core/point_key.hpp"
 #include "meshing/volume/gmsh_model.hpp"
 #include "meshing/surface/plane_cut.hpp"
 #include "meshing/surface/surface_checks.hpp"
@@ -225,4 +227,69 @@ TEST(SlabMesh, BridgedBedsAreCutIntoSlabsThroughTheirBridges) {
       particles_whole += 0.5 * (w.points[q[1]] - w.points[q[0]]).cross(w.points[q[2]] - w.points[q[0]]).norm();
     }
   EXPECT_NEAR(particles, particles_whole, 1e-3 * particles_whole);
+}
+
+// Pieces of a bridged bed meshed each on its own (as ranks do, mesh_slab), with no surface of
+// the whole: one plane through a bridge to the wall and one through the middle of a bridge
+// between two spheres. Neighbours triangulate their shared plane with the same points and
+// triangles, and the pieces fill the whole surface's volume but for the cuts' snaps.
+TEST(SlabMesh, BridgedPiecesMeshedAloneTriangulateTheirSharedPlanesAlike) {
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  SurfaceParams sp;
+  sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::bridge;
+  sp.edge_length_d = 0.15;
+  const double R = dynamic_cast<const Cylinder&>(*b.container).radius();
+  // The lowest sphere bridged to the wall, and the highest pair bridged to each other above it.
+  double wall_z = NAN, pair_z = NAN;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (R - b.centres[i].head<2>().norm() - 0.5 < sp.bridge_gap_d && b.centres[i].z() > 1.5 &&
+        !(b.centres[i].z() >= wall_z))
+      wall_z = b.centres[i].z();
+  ASSERT_FALSE(std::isnan(wall_z));
+  for (std::size_t i = 0; i < b.size(); ++i)
+    for (std::size_t j = i + 1; j < b.size(); ++j) {
+      const double z = 0.5 * (b.centres[i].z() + b.centres[j].z());
+      if ((b.centres[i] - b.centres[j]).norm() - 1.0 < sp.bridge_gap_d && z > wall_z + 1.5 && !(z <= pair_z)) pair_z = z;
+    }
+  ASSERT_FALSE(std::isnan(pair_z));
+  const std::vector<double> planes{wall_z, pair_z};
+  const FluidSurface whole = build_fluid_surface(b, sp);
+  VolumeMeshParams p;
+  const fs::path dir = test_support::fresh_dir("pieces_bridged", true);
+  std::vector<VolumeMesh> pieces;
+  double volume = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    pieces.push_back(mesh_slab(b, sp, planes, k, 1.0, p, dir / "bad_cells.vtk", false));
+    EXPECT_TRUE(pieces.back().quality.bad_cells(p.gate, 1.0).empty()) << "piece " << k;
+    volume += pieces.back().quality.total_volume;
+  }
+  // A plane's triangles as sorted corner coordinates, from the piece below (its outlet) or above.
+  auto plane_triangles = [](const VolumeMesh& m, const std::string& patch) {
+    std::vector<std::array<Eigen::Vector3d, 3>> out;
+    const PolyMesh& g = m.mesh;
+    for (const auto& q : g.patches)
+      if (q.name == patch)
+        for (int f = q.start; f < q.start + q.size; ++f) {
+          std::array<Eigen::Vector3d, 3> t{g.points[g.faces[f][0]], g.points[g.faces[f][1]], g.points[g.faces[f][2]]};
+          std::sort(t.begin(), t.end(), coordinates_less);
+          out.push_back(t);
+        }
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& c) {
+      for (int k = 0; k < 3; ++k)
+        if (a[k] != c[k]) return coordinates_less(a[k], c[k]);
+      return false;
+    });
+    return out;
+  };
+  for (int k = 0; k < 2; ++k) {
+    const auto below = plane_triangles(pieces[k], "outlet"), above = plane_triangles(pieces[k + 1], "inlet");
+    ASSERT_GT(below.size(), 100u) << "plane " << k;
+    EXPECT_TRUE(below == above) << "plane " << k << ": " << below.size() << " and " << above.size() << " triangles";
+    EXPECT_EQ(pieces[k].report["plane_cut"].size(), k == 0 ? 1u : 2u);
+  }
+  // The pieces fill the whole surface's volume but for the cuts' snaps and their walls'
+  // triangulations, which differ between windows: within 1e-3 of it (measured 2.8e-4 on
+  // 2026-11-30; one sphere is 8e-3 of it, so a sphere lost or doubled at a plane fails).
+  const double exact = check_surface(whole.fluid, SelfIntersectionTest::skip).volume;
+  EXPECT_NEAR(volume, exact, 1e-3 * exact);
 }
