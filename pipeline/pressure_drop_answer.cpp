@@ -97,10 +97,8 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.why_no_estimate = "the flow was solved on one mesh only, so its discretisation error is not known (on the beds "
                         "measured it was 20-45 %: docs/mesh_case_benchmark.md)";
     const double r3 = std::pow(scene.case_params.convergence.ratio, 3);
-    // A study's levels are not made in pieces yet (scene.cpp refuses the two together).
-    a.advice = fmt::format("set [case.convergence] levels = 3{}: two coarser meshes, about {} more by this run's time "
+    a.advice = fmt::format("set [case.convergence] levels = 3: two coarser meshes, about {} more by this run's time "
                            "(their cells 1 / {:.3g} and 1 / {:.3g} of this one's)",
-                           scene.mesh.pieces > 1 ? " and mesh.pieces = 0 (a study is not made in pieces yet)" : "",
                            minutes(flow["time_s"].get<double>() * (1.0 / r3 + 1.0 / (r3 * r3))), r3, r3 * r3);
     return a;
   }
