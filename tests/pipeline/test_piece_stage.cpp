@@ -56,11 +56,15 @@ const std::string kOpenFoam =
     "export WM_PROJECT_DIR=${WM_PROJECT_DIR:-/usr/share/openfoam}; "
     "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; ";
 
-// The pieces of dir/case gathered into one mesh (reconstructParMesh) pass checkMesh with `cells`.
+// The pieces of dir/case gathered into one mesh (reconstructParMesh), then checkMesh on it.
+Result gather(const fs::path& dir) {
+  return shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh "
+               "-constant > log.reconstructParMesh 2>&1 && checkMesh");
+}
+
+// The pieces of dir/case gathered into one mesh pass checkMesh with `cells`.
 void expect_gathered(const fs::path& dir, long cells) {
-  const Result gathered =
-      shell(kOpenFoam + "cd " + (dir / "case").string() + " && rm -rf constant/polyMesh && reconstructParMesh -constant "
-            "> log.reconstructParMesh 2>&1 && checkMesh");
+  const Result gathered = gather(dir);
   ASSERT_EQ(gathered.status, 0) << read(dir / "case/log.reconstructParMesh");
   EXPECT_NE(gathered.output.find("Mesh OK."), std::string::npos) << gathered.output;
   EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
@@ -180,9 +184,7 @@ TEST(PieceStage, BridgedPiecesGiveThePressureDropOfTheJoinedSlabs) {
   EXPECT_TRUE(c["flow"]["converged"].get<bool>()) << c["flow"].dump();
   const double gradient = c["flow"]["pressure_gradient_bed_pa_m"].get<double>();
   EXPECT_NEAR(gradient, joined_gradient, 0.005 * joined_gradient);
-  const Result gathered = shell(kOpenFoam + "cd " + (dir / "case").string() +
-                                " && rm -rf constant/polyMesh && reconstructParMesh -constant > log.reconstructParMesh 2>&1"
-                                " && checkMesh");
+  const Result gathered = gather(dir);
   EXPECT_NE(gathered.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << gathered.output;
 }
 
