@@ -12,6 +12,7 @@
 
 #include "meshing/surface/planar_cdt.hpp"
 #include "meshing/surface/primitives.hpp"
+#include "meshing/surface/spaced_points.hpp"
 #include "meshing/surface/wall_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -261,10 +262,44 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
                                     z, where(h.points[0])));
     holes[holder].push_back({h.points, h.spacing, -1});
   }
+  // The face's spacing across narrow gaps, from its loops alone (both windows of a plane have the
+  // same loops): each loop point with its normal into the fluid, which lies on the right of every
+  // loop (outer loops run clockwise, holes anticlockwise).
+  const double reach = p.cells_per_gap * p.edge;
+  std::vector<Eigen::Vector2d> loop_point, fluid_side;
+  PointsByCell near_loop(reach > 0.0 ? reach : p.edge);
+  SpacingField field;
+  if (reach > 0.0) {
+    for (const auto& loop : loops)
+      for (std::size_t k = 0; k < loop.size(); ++k) {
+        const Eigen::Vector3d t = x[loop[(k + 1) % loop.size()]] - x[loop[(k + loop.size() - 1) % loop.size()]];
+        near_loop.add({x[loop[k]].x(), x[loop[k]].y(), 0.0}, static_cast<int>(loop_point.size()));
+        loop_point.emplace_back(x[loop[k]].x(), x[loop[k]].y());
+        fluid_side.push_back(Eigen::Vector2d(t.y(), -t.x()).normalized());
+      }
+    field = {[&](const Eigen::Vector3d& q3) {
+               const Eigen::Vector2d q(q3.x(), q3.y());
+               const Eigen::Vector3d at(q.x(), q.y(), 0.0);
+               int nearest = -1;
+               double d1 = reach, d2 = reach;
+               near_loop.near(at, [&](int i) {
+                 if (const double r = (loop_point[i] - q).norm(); r < d1) d1 = r, nearest = i;
+               });
+               if (nearest < 0) return p.edge;
+               const Eigen::Vector2d away = d1 > 1e-9 * reach ? Eigen::Vector2d((q - loop_point[nearest]) / d1)
+                                                              : fluid_side[nearest];
+               near_loop.near(at, [&](int i) {
+                 const Eigen::Vector2d w = loop_point[i] - q;
+                 if (const double r = w.norm(); r < d2 && w.dot(away) > 0.5 * r) d2 = r;
+               });
+               return std::clamp((d1 + d2) / p.cells_per_gap, p.finest, p.edge);
+             },
+             p.finest};
+  }
   TriangleMesh face;
   for (std::size_t o = 0; o < outer.size(); ++o)
     face.append(plane_mesh(Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ()), {outer[o].points}, p.edge, holes[o],
-                           p.growth, true, p.below_patch)
+                           p.growth, true, p.below_patch, field)
                     .outside);
   out.loops = static_cast<long>(loops.size());
   out.faces = static_cast<long>(outer.size());

@@ -14,6 +14,11 @@ struct PlaneCutParams {
   double edge = 0.0;  // m: the plane face's target edge away from the cut (the surface's edge)
   double growth = 1.5;  // edge growth per ring away from the cut's loops
   std::string below_patch = "outlet", above_patch = "inlet";  // the plane face's patch on each side
+  // Cells across the face's narrow gaps, as [surface] cells_per_gap asks of the surfaces beside
+  // it: where the section's loops face each other across the face nearer than cells_per_gap x
+  // edge, the face's edge there is their distance / cells_per_gap, at least `finest` (m). 0: the
+  // edge everywhere (its triangles then span a narrow gap in one step).
+  double cells_per_gap = 0.0, finest = 0.0;
 };
 
 struct PlaneCut {
@@ -36,7 +41,11 @@ struct PlaneCut {
 // region's section by the plane is one face or more (bridged spheres and the wall can ring in a
 // pocket of fluid there), each an outer loop (clockwise seen from above on the part below) less
 // the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with
-// `p`'s edge and growth, normals +z on the part below and -z above.
+// `p`'s edge and growth, shorter across narrow gaps (PlaneCutParams::cells_per_gap: the gap at
+// a point of the face is its distance to the nearest loop point plus that to the nearest loop
+// point ahead of it, within 60 degrees of the direction away from the first, so two sides of
+// one loop (spheres joined by a bridge the plane cuts) count as a gap too), normals +z on the
+// part below and -z above.
 // CutConflict (primitives.hpp) naming the height and place when the plane meets the surface at
 // a point where loops touch, or when plane_mesh cannot place a hole; std::runtime_error when
 // `surface` is not closed along the plane.

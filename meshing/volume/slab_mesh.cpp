@@ -153,6 +153,13 @@ void write_msh22(const std::filesystem::path& path, const Joined& j) {
   if (!out) throw std::runtime_error(fmt::format("volume mesh: cannot write {}", path.string()));
 }
 
+// The cut of a plane between slabs (d: the reference diameter, m): the surface's edge and its
+// cells across gaps, down to the edge the gaps' spacing allows (gap_spacing).
+PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
+  return {.edge = s.edge_length_d * d, .growth = s.growth, .cells_per_gap = s.cells_per_gap,
+          .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};
+}
+
 // The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, sorted.
 std::vector<double> sphere_ends_d(const Bed& bed, const SurfaceParams& s) {
   const double d = reference_diameter(bed);
@@ -328,8 +335,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     for (const auto& [j, keep_above] : {std::pair{k - 1, true}, std::pair{k, false}}) {
       if (j < 0 || j + 1 >= slabs) continue;
       try {
-        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d),
-                                  {surface.edge_length_d * d, surface.growth, "outlet", "inlet"});
+        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), plane_cut_params(surface, d));
         cut_report.push_back({{"plane_d", planes[j]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
                               {"plane_triangles", c.plane_triangles}});
         fs.fluid = std::move(keep_above ? c.above : c.below);
@@ -398,7 +404,7 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
       nlohmann::json cut_report;
       if (k + 1 < slabs) {
         try {
-          PlaneCut c = cut_by_plane(own, planes[k] * d, {surface.edge_length_d * d, surface.growth, "outlet", "inlet"});
+          PlaneCut c = cut_by_plane(own, planes[k] * d, plane_cut_params(surface, d));
           cut_report = {{"loops", c.loops}, {"vertices_snapped", c.vertices_snapped}, {"plane_triangles", c.plane_triangles}};
           own = std::move(c.below), above = std::move(c.above);
         } catch (const CutConflict& e) {

@@ -154,3 +154,44 @@ TEST(PlaneCut, APackedBedCutAtEveryHeightGivesClosedParts) {
   }
   EXPECT_GT(faces, 30);
 }
+
+// Two spheres 0.15 d apart, with an edge of 0.3 d, cut through their centres: asked for 4 cells
+// across gaps, the plane's face crosses the gap between their sections in as many steps as the
+// spheres' surfaces beside it, where without the field two triangles span it (measured on
+// 2026-11-30: the line of centres crosses 2 triangles in the gap without, 7 with). The bound: a
+// line across a band of 4 rows of triangles crosses at least 4.
+TEST(PlaneCut, TheFaceIsFinerAcrossANarrowGapBetweenSections) {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(2.0);
+  b.centres = {{-0.575, 0.0, 1.0}, {0.575, 0.0, 1.0}};
+  b.diameters = {1.0, 1.0};
+  SurfaceParams sp;
+  sp.edge_length_d = 0.3;
+  sp.cells_per_gap = 4.0;
+  const FluidSurface whole = build_fluid_surface(b, sp);
+  const double gap = 0.15;
+  // Triangles of the face that the line of centres crosses between the two sections.
+  auto across_the_gap = [&](double cells_per_gap) {
+    PlaneCutParams p{sp.edge_length_d, sp.growth, "outlet", "inlet", cells_per_gap, sp.contact_edge_length_d};
+    const PlaneCut c = cut_by_plane(whole.fluid, 1.0, p);
+    std::set<std::pair<int, int>> edges;
+    for (const auto& t : c.below.triangles) {
+      bool on_plane = true;
+      for (int v : t) on_plane = on_plane && c.below.points[v].z() == 1.0;
+      if (on_plane)
+        for (int k = 0; k < 3; ++k) edges.insert(std::minmax(t[k], t[(k + 1) % 3]));
+    }
+    int crossed = 1;
+    for (const auto& [u, v] : edges) {
+      const Eigen::Vector3d& a = c.below.points[u];
+      const Eigen::Vector3d& e = c.below.points[v];
+      if (a.y() * e.y() >= 0.0) continue;
+      const double x = a.x() + a.y() / (a.y() - e.y()) * (e.x() - a.x());
+      if (std::abs(x) < 0.5 * gap) ++crossed;
+    }
+    return crossed;
+  };
+  const int without = across_the_gap(0.0), with = across_the_gap(sp.cells_per_gap);
+  EXPECT_LT(without, 4) << "the control: without the field the gap is crossed in fewer steps; with it: " << with;
+  EXPECT_GE(with, 4) << "asked for " << sp.cells_per_gap;
+}
