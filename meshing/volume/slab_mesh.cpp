@@ -356,8 +356,8 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
                                      int slabs, double d_ref, const VolumeMeshParams& p,
                                      const std::filesystem::path& msh_path,
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
-  if (!slabs_from_clip_windows(surface) && whole == nullptr)
-    throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts need the whole surface to cut slabs from");
+  if (!pieces_possible(surface, *bed.container) && whole == nullptr)
+    throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts in a box need the whole surface to cut slabs from");
   const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
   try {
     return mesh_and_join_slabs(bed, surface, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
@@ -385,10 +385,12 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
                                Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const int slabs = static_cast<int>(planes.size()) + 1;
-  const bool cut = !slabs_from_clip_windows(surface);
+  // Treated contacts in a box: slabs cut from the whole surface, whose flat sides windows would
+  // not cut alike (they are not ringed); elsewhere each slab from its own window, as on ranks.
+  const bool from_whole = !pieces_possible(surface, *bed.container);
   const double d = reference_diameter(bed);
-  TriangleMesh above;  // cut slabs: the whole surface above the planes cut so far
-  if (cut) above = *whole;
+  TriangleMesh above;  // slabs from the whole surface: the part above the planes cut so far
+  if (from_whole) above = *whole;
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
   for (int k = 0; k < slabs; ++k) {
@@ -396,16 +398,17 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
     // Memory a slab frees stays with the allocator for the next slab and the join: handing it
     // back and faulting it in again made the stage 1.7 times slower (a = 10, N = 4000).
     VolumeMesh slab;
-    if (!cut) {
+    if (!from_whole) {
       slab = mesh_slab(bed, surface, planes, k, d_ref, p, bad_cells_path, false);
     } else {
       const SurfaceParams q = slab_surface(bed, surface, planes, k);
       TriangleMesh own = std::move(above);
-      nlohmann::json cut_report;
+      nlohmann::json cut_report = nlohmann::json::array();
       if (k + 1 < slabs) {
         try {
           PlaneCut c = cut_by_plane(own, planes[k] * d, plane_cut_params(surface, d));
-          cut_report = {{"loops", c.loops}, {"vertices_snapped", c.vertices_snapped}, {"plane_triangles", c.plane_triangles}};
+          cut_report.push_back({{"plane_d", planes[k]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
+                                {"plane_triangles", c.plane_triangles}});
           own = std::move(c.below), above = std::move(c.above);
         } catch (const CutConflict& e) {
           throw InputError(fmt::format("mesh.slabs: the plane at {:.3f} d above the floor cannot be cut from the bed's "
@@ -415,7 +418,7 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
       }
       slab = mesh_slab_surface(own, bed, d_ref, p, bad_cells_path, false, k, slabs, {q.clip_bottom_d, q.clip_top_d});
       slab.report["planes_d"] = slab.report["heights_d"];
-      if (!cut_report.is_null()) slab.report["plane_cut"] = std::move(cut_report);
+      slab.report["plane_cut"] = std::move(cut_report);
     }
     progress.update(fmt::format("slab {} of {}: {} cells joined", k + 1, slabs, slab.mesh.cells), (k + 1.0) / slabs);
     joined.add(slab.mesh, k == 0, k + 1 == slabs, k);

@@ -17,11 +17,12 @@ namespace bedforge::meshing {
 // crossing them, and both slabs triangulate a shared plane alike, so the joined cells are
 // conforming and the planes' triangles become internal faces. A clip plane through a treated
 // contact (bridge, cap, union) would open it, so under those treatments the slabs are cut by
-// cut_by_plane, which cuts any contact and triangulates a plane from its section alone: in one
-// process from the whole domain's surface; on ranks of their own (mesh_slab, pipeline/
-// piece_stage) each from the surface of its window widened by piece_margin_d, whose walls are
-// ringed at every plane (wall_mesh), so that two neighbours' surfaces cross their shared plane
-// in the same triangles and their cuts triangulate it alike.
+// cut_by_plane, which cuts any contact and triangulates a plane from its section alone: each
+// from the surface of its window widened by piece_margin_d, whose walls are ringed at every
+// plane (wall_mesh), so that two neighbours' surfaces cross their shared plane in the same
+// triangles and their cuts triangulate it alike (mesh_slab, in one process or on ranks of their
+// own, pipeline/piece_stage); in a box, whose flat sides are not ringed, in one process from the
+// whole domain's surface.
 
 // Whether a bed can be meshed in slabs with `params`: no prism layers (they would meet the
 // planes between slabs).
@@ -90,9 +91,9 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 
 // The volume mesh of the fluid domain of `bed` under `surface`, in slabs meshed one after the
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;
-// `params.layers` must be off) and joined. Unless slabs_from_clip_windows, the slabs are cut
-// from `whole` (the surface stage's fluid surface of the same bed under `surface`; m), which may
-// be null otherwise. `d_ref` (m) scales the parameters; the report holds each slab's report
+// `params.layers` must be off) and joined, each by mesh_slab where pieces_possible (so the slabs
+// are the pieces ranks would make); treated contacts in a box are cut from `whole` (the surface
+// stage's fluid surface of the same bed under `surface`; m), which may be null otherwise. `d_ref` (m) scales the parameters; the report holds each slab's report
 // under "slabs" (a cut slab's with "plane_cut": its loops, snapped vertices, plane triangles).
 // Writes the joined mesh (MSH 2.2: physical groups per patch and `fluid`) to `msh_path` when
 // not empty. std::runtime_error when two slabs' shared plane is not triangulated alike (a

@@ -155,12 +155,13 @@ TEST(PieceStage, ARunInTwoPiecesGivesThePressureDropOfTheJoinedSlabsAndItsStudyI
 
 // Bridged contacts in pieces: each rank cuts its slab, bridges and all, from its own widened
 // window (meshing/volume/slab_mesh.hpp); the ranks' planes match (the case runs in parallel and
-// gathers into one mesh of the pieces' cells), and the pressure drop is the joined slabs' (cut
-// from the whole surface in one process) within issue 58's 0.5 %: the two differ only in the
-// walls' triangles near the planes. Not asserted: checkMesh's "Mesh OK". On this bed 1-3
-// polyhedra beside the plane fail it (face pyramids), as 14 of the joined slabs' do and none of
-// one piece's (2026-11-30, docs/findings.md): issue 58's checkMesh target is not met for cut
-// planes yet; the run says so in its checkMesh line, and that is checked here.
+// gathers into one mesh of the pieces' cells), and the pressure drop is the joined slabs' (the
+// same windows, meshed one after the other in one process) within issue 58's 0.5 %: gmsh's
+// threads make other tetrahedra on each run. Not asserted: checkMesh's "Mesh OK". This bed's
+// pieces passed it once the plane's face took cells across its narrow gaps (2026-11-30, session
+// 49; 1 polyhedron failed before), but the default bed's pieces still fail 5-6 beside their
+// planes (docs/findings.md): issue 58's checkMesh target is not met for cut planes; the run
+// says so in its checkMesh line, and that is checked here.
 TEST(PieceStage, BridgedPiecesGiveThePressureDropOfTheJoinedSlabs) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam, mpirun) not on PATH";
   const fs::path joined = run("piece_bridged_joined", true, "polyhedra", "[mesh]\nslabs = 2\n", 0, "bridge");
