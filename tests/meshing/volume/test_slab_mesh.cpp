@@ -24,6 +24,25 @@ using namespace bedforge;
 using namespace bedforge::meshing;
 namespace fs = std::filesystem;
 
+namespace {
+
+// Neighbouring slabs report the same plane between them, and no boundary face of the joined
+// mesh lies on it: the plane's faces became internal.
+void expect_no_boundary_on_the_planes(const VolumeMesh& vm) {
+  for (std::size_t k = 0; k + 1 < vm.report["slabs"].size(); ++k) {
+    const double h = vm.report["slabs"][k]["planes_d"][1].get<double>();
+    EXPECT_EQ(h, vm.report["slabs"][k + 1]["planes_d"][0].get<double>());
+    for (const auto& patch : vm.mesh.patches)
+      for (int f = patch.start; f < patch.start + patch.size; ++f) {
+        bool on_plane = true;
+        for (int v : vm.mesh.faces[f]) on_plane = on_plane && std::abs(vm.mesh.points[v].z() - h) < 1e-9;
+        EXPECT_FALSE(on_plane) << patch.name << " face on the plane at " << h << " d";
+      }
+  }
+}
+
+}  // namespace
+
 TEST(SlabMesh, SlabsJoinIntoOneConformingMeshFillingTheirSurfaces) {
   Progress quiet("mesh", false);
   const Bed b = test_support::packed_bed(80, 4.0, 1);
@@ -51,16 +70,7 @@ TEST(SlabMesh, SlabsJoinIntoOneConformingMeshFillingTheirSurfaces) {
 
   // No boundary face is left on a plane between slabs (where the clip planes went, each a little
   // off its asked height to keep clear of the spheres' tops and bottoms).
-  for (std::size_t k = 0; k + 1 < vm.report["slabs"].size(); ++k) {
-    const double h = vm.report["slabs"][k]["planes_d"][1].get<double>();
-    EXPECT_EQ(h, vm.report["slabs"][k + 1]["planes_d"][0].get<double>());
-    for (const auto& patch : vm.mesh.patches)
-      for (int f = patch.start; f < patch.start + patch.size; ++f) {
-        bool on_plane = true;
-        for (int v : vm.mesh.faces[f]) on_plane = on_plane && std::abs(vm.mesh.points[v].z() - h) < 1e-9;
-        EXPECT_FALSE(on_plane) << patch.name << " face on the plane at " << h << " d";
-      }
-  }
+  expect_no_boundary_on_the_planes(vm);
   // The inlet and outlet are the whole domain's, one plane each.
   for (const auto& patch : vm.mesh.patches)
     if (patch.name == "inlet" || patch.name == "outlet") {
@@ -199,16 +209,7 @@ TEST(SlabMesh, BridgedBedsAreCutIntoSlabsThroughTheirBridges) {
     for (const auto& slab : vm.report["slabs"]) cells += slab["cells"].get<long>();
     EXPECT_EQ(vm.mesh.cells, cells);
 
-    for (std::size_t k = 0; k + 1 < vm.report["slabs"].size(); ++k) {
-      const double h = vm.report["slabs"][k]["planes_d"][1].get<double>();
-      EXPECT_EQ(h, vm.report["slabs"][k + 1]["planes_d"][0].get<double>());
-      for (const auto& patch : vm.mesh.patches)
-        for (int f = patch.start; f < patch.start + patch.size; ++f) {
-          bool on_plane = true;
-          for (int v : vm.mesh.faces[f]) on_plane = on_plane && std::abs(vm.mesh.points[v].z() - h) < 1e-9;
-          EXPECT_FALSE(on_plane) << patch.name << " face on the plane at " << h << " d";
-        }
-    }
+    expect_no_boundary_on_the_planes(vm);
     // Every cut went through the bed: more loops than the wall's.
     for (const auto& slab : vm.report["slabs"])
       for (const auto& c : slab["plane_cut"]) {
