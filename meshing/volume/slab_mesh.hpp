@@ -18,8 +18,8 @@ namespace bedforge::meshing {
 // conforming and the planes' triangles become internal faces. A clip plane through a treated
 // contact (bridge, cap, union) would open it, so under those treatments the slabs are cut by
 // cut_by_plane, which cuts any contact and triangulates a plane from its section alone: each
-// from the surface of its window widened by piece_margin_d, whose walls are ringed at every
-// plane (wall_mesh), so that two neighbours' surfaces cross their shared plane in the same
+// from the surface of its window widened by at least piece_margin_d, whose walls are ringed at
+// every plane (wall_mesh), so that two neighbours' surfaces cross their shared plane in the same
 // triangles and their cuts triangulate it alike (mesh_slab, in one process or on ranks of their
 // own, pipeline/piece_stage); in a box, whose flat sides are not ringed, in one process from the
 // whole domain's surface.
@@ -78,7 +78,8 @@ double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
 
 // Slab `k` between `planes` meshed on its own, needing no other slab's surface: from its clip
 // window (slabs_from_clip_windows), or under treated contacts from its window widened by
-// piece_margin_d, ringed at every plane and cut at its own (cut_by_plane; the report's
+// piece_margin_d + 1 d (its own clip planes free to move 1 d, so they stay at least
+// piece_margin_d away), ringed at every plane and cut at its own (cut_by_plane; the report's
 // "plane_cut" lists each cut); its surface and build_volume_mesh with
 // `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
 // in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
@@ -93,8 +94,9 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 // other by build_volume_mesh (each slab with `params`: its algorithms, optimiser and gate;
 // `params.layers` must be off) and joined, each by mesh_slab where pieces_possible (so the slabs
 // are the pieces ranks would make); treated contacts in a box are cut from `whole` (the surface
-// stage's fluid surface of the same bed under `surface`; m), which may be null otherwise. `d_ref` (m) scales the parameters; the report holds each slab's report
-// under "slabs" (a cut slab's with "plane_cut": its loops, snapped vertices, plane triangles).
+// stage's fluid surface of the same bed under `surface`; m), which may be null otherwise.
+// `d_ref` (m) scales the parameters; the report holds each slab's report under "slabs" (a cut
+// slab's with "plane_cut": each cut's plane, loops, snapped vertices, plane triangles).
 // Writes the joined mesh (MSH 2.2: physical groups per patch and `fluid`) to `msh_path` when
 // not empty. std::runtime_error when two slabs' shared plane is not triangulated alike (a
 // defect of ours); InputError naming mesh.slabs when a slab cannot be cut from the bed;
