@@ -11,6 +11,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <regex>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -203,13 +204,33 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
   return {whole.clip_bottom_d * d, whole.clip_top_d * d};
 }
 
+RanksLog read_ranks_log(const std::filesystem::path& log) {
+  // Open MPI 4.1's words (Debian 12) for a rank killed, a rank's non-zero exit and too few slots.
+  static const std::regex killed(R"(process rank (\d+) with PID \d+ on node \S+ exited on signal (\d+) \(([^)]*)\))"),
+      first(R"(Process name: \[\[\d+,\d+\],(\d+)\])");
+  RanksLog out;
+  std::ifstream in(log);
+  std::string line;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (line.rfind("bedforge: ", 0) == 0 && out.message.empty()) out.message = line;
+    out.too_few_slots = out.too_few_slots || line.find("not enough slots available") != std::string::npos;
+    if (out.signal == 0 && std::regex_search(line, m, killed)) {
+      out.failed_rank = std::stoi(m[1]), out.signal = std::stoi(m[2]), out.signal_name = m[3];
+    } else if (out.failed_rank < 0 && std::regex_search(line, m, first)) {
+      out.failed_rank = std::stoi(m[1]);
+    }
+  }
+  return out;
+}
+
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
                        const std::filesystem::path& run_dir, const Console& console) {
   CasePieces out;
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
   // The ranks are given `planes` (d; empty: their own, meshing::slab_planes_d's), each try its log.
-  const auto run_ranks = [pieces, run_dir, &console](const fs::path& case_dir, const std::vector<double>& planes) {
+  const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir, const std::vector<double>& planes) {
     const fs::path self = fs::read_symlink("/proc/self/exe"),
                    log = case_dir / (planes.empty() ? "log.pieces" : "log.pieces_planes_moved");
     Progress progress("pieces", console.progress);
@@ -223,27 +244,41 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     const int status = std::system(cmd.c_str());
     progress.finish();
     if (status == 0) return;
-    // A rank's own message says which piece and why; or mpirun's, that it had too few slots.
-    std::ifstream in(log);
-    std::string line, said;
-    bool too_few_slots = false;
-    while (std::getline(in, line)) {
-      if (line.rfind("bedforge: ", 0) == 0 && said.empty()) said = line;
-      too_few_slots = too_few_slots || line.find("not enough slots available") != std::string::npos;
-    }
-    if (too_few_slots)
+    const RanksLog said = read_ranks_log(log);
+    if (said.too_few_slots)
       throw InputError(fmt::format(
           "mesh.pieces = {}: mpirun has fewer slots than {} ranks here (see {}); allowed: mesh.pieces at most the "
           "slots (this machine's cores, or the batch job's tasks), or more ranks than cores with "
           "OMPI_MCA_rmaps_base_oversubscribe=1 in the environment (each rank still holds only its piece; the "
           "ranks share the cores)",
           pieces, pieces, log.string()));
+    // Which piece stopped first, with its heights: a rank's own message may not say.
+    std::string which = "a rank";
+    if (said.failed_rank >= 0 && said.failed_rank < pieces) {
+      const std::vector<double> at = planes.empty() ? meshing::slab_planes_d(bed, surface, pieces) : planes;
+      const meshing::SurfaceParams slab = meshing::slab_surface(bed, surface, at, said.failed_rank);
+      which = fmt::format("piece {} of {} ({:.2f}-{:.2f} d above the floor, rank {})", said.failed_rank + 1, pieces,
+                          slab.clip_bottom_d, slab.clip_top_d, said.failed_rank);
+    }
+    // Killed from outside, with no word of its own: on a machine short of memory, the kernel's
+    // out-of-memory killer, which the ranks' check (an estimate that errs low) did not foresee.
+    if (said.signal == 9)
+      throw InputError(fmt::format(
+          "mesh.pieces = {}: {} was killed by signal 9 ({}), most likely by the kernel for want of memory (each "
+          "rank checks its piece against this machine's memory before it starts, by an estimate that errs low); "
+          "allowed: more pieces (with as many ranks, spread over machines), fewer ranks per machine, or a longer "
+          "surface.edge_length_d; see {}",
+          pieces, which, said.signal_name, log.string()));
+    if (said.signal > 0)
+      throw std::runtime_error(fmt::format("the case's pieces: {} stopped on signal {} ({}); see {}", which,
+                                           said.signal, said.signal_name, log.string()));
     // Stopped as the rank stopped: bad input, a gate not passed, or a defect.
-    const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}); see {}", pieces,
-                                         self.filename().string(), said.empty() ? "no rank said why" : said,
-                                         log.string());
-    if (said.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
-    if (said.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
+    const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}{}); see {}", pieces,
+                                         self.filename().string(), which == "a rank" ? "" : which + ": ",
+                                         said.message.empty() ? "no rank said why" : said.message, log.string());
+    const std::string& message = said.message;
+    if (message.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
+    if (message.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
     throw std::runtime_error(what);
   };
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {

@@ -42,11 +42,26 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
 // window's ends when it has one), as its pieces and the case that holds them take them.
 std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceParams& surface);
 
+// What mpirun's output `log` (case/log.pieces) says of a job whose ranks did not all succeed: the
+// first line a rank wrote starting "bedforge: " (its error; "" when none did), whether mpirun had
+// too few slots, and the rank that stopped first (-1 when not named) with the signal that ended
+// it (0 and "" when it exited on its own).
+struct RanksLog {
+  std::string message;
+  bool too_few_slots = false;
+  int failed_rank = -1;
+  int signal = 0;
+  std::string signal_name;
+};
+RanksLog read_ranks_log(const std::filesystem::path& log);
+
 // The pieces of the case a run writes (case_stage with CasePieces): `pieces` ranks started as
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,
 // the case is run_dir/case), their reports summed into the case's info. mpirun's output goes to
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
-// one (std::runtime_error otherwise). When a rank's piece fails the gate, the ranks run once
+// one (std::runtime_error otherwise), naming the piece that stopped first and its heights; a rank
+// killed by signal 9 as InputError naming mesh.pieces (the kernel's out-of-memory killer, most
+// likely). When a rank's piece fails the gate, the ranks run once
 // more with the planes moved (meshing::moved_slab_planes_d, given as `piece --planes-d`; their
 // output in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files (case/piece_layers) are removed once all
 // have succeeded; a failed run leaves them for the next, which remakes only the failed pieces.

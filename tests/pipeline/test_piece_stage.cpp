@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "pipeline/piece_stage.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
@@ -41,7 +42,7 @@ fs::path run(const std::string& name, bool solve, const std::string& cells = "po
   text.replace(text.find("\"shrink\""), 8, "\"" + treatment + "\"");
   std::ofstream(scene / "s.toml") << text << (solve ? "run = true\n" : "run = false\n") << "cells = \"" << cells
                                   << "\"\n" << mesh;
-  const Result r = bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  const Result r = cli_test::bedforge("--quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
   EXPECT_EQ(r.status, 0) << r.output;
   return dir;
 }
@@ -226,7 +227,7 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
   // its tetrahedra and only piece 1 is meshed.
   const fs::path scene = fs::path(fresh_dir("piece_rerun_scene").string() + "_again.toml");
   std::ofstream(scene) << read(dir / "scene.toml");
-  r = bedforge("--quiet run " + scene.string() + " -o " + dir.string() + " --overwrite --force");
+  r = cli_test::bedforge("--quiet run " + scene.string() + " -o " + dir.string() + " --overwrite --force");
   ASSERT_EQ(r.status, 0) << r.output;
   const auto piece0 = nlohmann::json::parse(read(dir / "case/processor0/bedforge_piece.json"));
   const auto piece1 = nlohmann::json::parse(read(dir / "case/processor1/bedforge_piece.json"));
@@ -255,6 +256,31 @@ TEST(PieceStage, MoreRanksThanMpirunHasSlotsAreRefusedNamingThePieces) {
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
 }
 
+// mpirun's own words when a rank stops: the run reads which rank stopped first, and the signal
+// when one was killed from outside (as the kernel kills a process for want of memory), from the
+// output of this machine's Open MPI, here of ranks that stop on purpose.
+TEST(PieceStage, TheRankThatStoppedAndTheSignalThatKilledItAreReadFromMpirun) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (mpirun) not on PATH";
+  const fs::path dir = fresh_dir("piece_ranks_log");
+  fs::create_directories(dir);
+  const auto job = [&](const std::string& name, const std::string& rank_one) {
+    const fs::path log = dir / name;
+    shell(kOpenFoam + "mpirun -np 2 sh -c 'if [ $OMPI_COMM_WORLD_RANK = 1 ]; then " + rank_one +
+          "; fi; sleep 2' > " + log.string() + " 2>&1");
+    return bedforge::pipeline::read_ranks_log(log);
+  };
+  const auto killed = job("killed.log", "kill -9 $$");
+  EXPECT_EQ(killed.failed_rank, 1);
+  EXPECT_EQ(killed.signal, 9);
+  EXPECT_EQ(killed.signal_name, "Killed");
+  EXPECT_EQ(killed.message, "");
+  const auto failed = job("failed.log", "echo \"bedforge: error: the reason\"; exit 2");
+  EXPECT_EQ(failed.failed_rank, 1);
+  EXPECT_EQ(failed.signal, 0);
+  EXPECT_EQ(failed.message, "bedforge: error: the reason");
+  EXPECT_FALSE(failed.too_few_slots);
+}
+
 // A piece failing the gate where the whole mesh would pass has its planes to blame: the ranks
 // mesh again with the planes moved, and when that fails too the run stops (exit 3) naming both
 // attempts. Here a gate no tetrahedral mesh of a bed passes (10 deg), so both fail (one
@@ -267,7 +293,7 @@ TEST(PieceStage, APieceFailingTheGateIsMeshedAgainWithThePlanesMovedAndTheErrorN
   text.replace(text.find("edge_length_d = 0.2"), 19, "edge_length_d = 0.35");
   std::ofstream(scene / "s.toml") << text << "run = false\n[mesh]\npieces = 2\nfallback = false\nmax_optimize_passes = 1\n"
                                   << "[mesh.gate]\nmax_non_orthogonality_deg = 10\n";
-  const Result r = bedforge("run " + (scene / "s.toml").string() + " -o " + dir.string());
+  const Result r = cli_test::bedforge("run " + (scene / "s.toml").string() + " -o " + dir.string());
   EXPECT_EQ(r.status, 3) << r.output;
   const auto moved = r.output.find("and with the planes moved from ");
   ASSERT_NE(moved, std::string::npos) << r.output;
@@ -284,14 +310,14 @@ TEST(PieceStage, APieceFailingTheGateIsMeshedAgainWithThePlanesMovedAndTheErrorN
 // processor directory is left.
 TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_dir("piece_refused");
-  ASSERT_EQ(bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
-  Result r = bedforge("piece " + dir.string() + " --piece 2 --pieces 2");
+  ASSERT_EQ(cli_test::bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
+  Result r = cli_test::bedforge("piece " + dir.string() + " --piece 2 --pieces 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--piece 2: allowed: 0 to 1"), std::string::npos) << r.output;
   r = shell("env -u OMPI_COMM_WORLD_RANK " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() + " --pieces 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--piece not given and OMPI_COMM_WORLD_RANK not set"), std::string::npos) << r.output;
-  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2");
+  r = cli_test::bedforge("piece " + dir.string() + " --piece 0 --pieces 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("no case to write a piece into"), std::string::npos) << r.output;
   fs::create_directories(dir / "case/0");
@@ -303,7 +329,7 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   EXPECT_NE(r.output.find("mesh.pieces = 2: a piece would take at least"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("allowed: mesh.pieces >= "), std::string::npos) << r.output;
   // Planes given for the pieces: one fewer than the pieces, increasing, inside the domain.
-  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --contacts shrink --planes-d 0.5 1.0");
+  r = cli_test::bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --contacts shrink --planes-d 0.5 1.0");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--planes-d 0.5 1: allowed: 1 height (d above the floor)"), std::string::npos) << r.output;
   // A piece on polyhedra made alone, with no neighbour's layer to take.
@@ -314,7 +340,7 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
                           "made together"),
             std::string::npos)
       << r.output;
-  r = bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --layers 2");
+  r = cli_test::bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --layers 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("mesh.layers.count = 2"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("allowed for pieces: mesh.layers.count = 0"), std::string::npos) << r.output;
@@ -326,7 +352,7 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path out = fresh_dir("piece_refused_run"), file = fresh_dir("piece_refused_scene");
   fs::create_directories(file);
   std::ofstream(file / "s.toml") << scene;
-  r = bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
+  r = cli_test::bedforge("run " + (file / "s.toml").string() + " -o " + out.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("mesh.pieces = 2"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("mesh.layers.count = 2"), std::string::npos) << r.output;
