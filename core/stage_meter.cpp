@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -66,7 +67,11 @@ double available_memory_bytes() {
   std::string limit;
   double used = 0.0;
   if (max >> limit && limit != "max" && current >> used) available = std::min(available, std::stod(limit) - used);
-  return available;
+  // Ranks of one mpirun on this machine share it: each may take its share of what was available
+  // when it first asked (the others, started with it, had taken little then).
+  const char* ranks = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+  static const double share = available / std::max(1, ranks ? std::atoi(ranks) : 1);
+  return std::min(available, share);
 }
 
 void release_free_memory() {

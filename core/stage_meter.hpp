@@ -26,7 +26,9 @@ class StageMeter {
 double children_peak_memory_mb();
 
 // Memory this process may still take, bytes: the kernel's MemAvailable, or what the cgroup's
-// limit leaves if that is less. Infinity when neither can be read.
+// limit leaves if that is less; for one of the ranks Open MPI started on this machine
+// (OMPI_COMM_WORLD_LOCAL_SIZE), at most its share of that as it was at the first call.
+// Infinity when neither can be read.
 double available_memory_bytes();
 
 // Hands memory the allocator keeps after a free back to the system: tcmalloc (when the program

@@ -170,14 +170,14 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
 
 void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes) {
   const double per_piece = e.mesh_peak_bytes / pieces;
-  if (ranks_here * per_piece <= available_bytes) return;
+  if (per_piece <= available_bytes) return;
   throw InputError(fmt::format(
       "mesh.pieces = {}: a piece would take at least {:.1f} GB to mesh ({:.3g} million cells of the whole bed shared "
-      "among the pieces, an estimate that errs low), {:.1f} GB for the {} ranks on this machine, which has {:.1f} GB "
-      "available; allowed: mesh.pieces >= {} (with as many ranks, spread over machines), fewer ranks per machine, or "
-      "a longer surface.edge_length_d",
-      pieces, per_piece / 1e9, e.cells / 1e6, ranks_here * per_piece / 1e9, ranks_here, available_bytes / 1e9,
-      static_cast<int>(std::ceil(e.mesh_peak_bytes * ranks_here / available_bytes))));
+      "among the pieces, an estimate that errs low), and a rank may take {:.1f} GB here ({} rank{} on this "
+      "machine sharing its memory); allowed: mesh.pieces >= {} (with as many ranks, spread over machines), fewer "
+      "ranks per machine, or a longer surface.edge_length_d",
+      pieces, per_piece / 1e9, e.cells / 1e6, available_bytes / 1e9, ranks_here, ranks_here == 1 ? "" : "s",
+      static_cast<int>(std::ceil(e.mesh_peak_bytes / available_bytes))));
 }
 
 }  // namespace bedforge::pipeline

@@ -80,9 +80,10 @@ void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
 MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes);
 
 // One rank's piece of `pieces` (piece_stage), with `ranks_here` ranks on this machine
-// (OMPI_COMM_WORLD_LOCAL_SIZE): InputError naming mesh.pieces and the count that would fit when
-// the ranks here would need more than `available_bytes` to mesh their pieces, each taking a
-// 1/pieces share of e.mesh_peak_bytes (the pieces are cut to about equal estimated cells). Errs
+// (OMPI_COMM_WORLD_LOCAL_SIZE, said in the message): InputError naming mesh.pieces and the count
+// that would fit when its piece, a 1/pieces share of e.mesh_peak_bytes (the pieces are cut to
+// about equal estimated cells), needs more than `available_bytes`, this rank's share of the
+// machine's memory (available_memory_bytes()). Errs
 // towards trying: one rank with the whole default bed peaked at 4329 MB where its mesh stage
 // took 3060 MB (docs/mesh_case_benchmark.md, pieces).
 void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes);

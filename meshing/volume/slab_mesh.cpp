@@ -351,7 +351,11 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
       planes_used[keep_above ? 0 : 1] = planes[j];
     }
   }
-  VolumeMesh slab = mesh_slab_surface(fs.fluid, bed, d_ref, p, bad_cells_path, release_memory, k, slabs,
+  // Only the fluid surface goes on: the window's solid and pieces would sit beside gmsh's cells.
+  const TriangleMesh fluid = std::move(fs.fluid);
+  fs = FluidSurface();
+  if (release_memory) release_free_memory();
+  VolumeMesh slab = mesh_slab_surface(fluid, bed, d_ref, p, bad_cells_path, release_memory, k, slabs,
                                       {asked.clip_bottom_d, asked.clip_top_d});
   slab.report["planes_d"] = std::move(planes_used);
   if (cut) slab.report["plane_cut"] = std::move(cut_report);

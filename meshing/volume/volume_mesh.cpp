@@ -250,8 +250,9 @@ void insert_layers(const PrismLayers& layers) {
 
 // Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
 // mesh before it: measured 1360 (a = 10, N = 4000, enlarge: 14.2 GB, 10.4 M cells) and 1230
-// (a = 5, N = 300, enlarge); 1500 leaves a margin.
-constexpr double kHxtOptimiserBytesPerCell = 1500.0;
+// (a = 5, N = 300, enlarge); 1500 leaves a margin. gmsh's Delaunay as the fallback took as much:
+// 1378 (a piece of a = 14, N = 1e4, bridges: 7.9 GB after 5.7 M cells).
+constexpr double kRetryBytesPerCell = 1500.0;
 
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
@@ -296,12 +297,12 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       entry[key] = why;
       attempts.push_back(entry);
     };
-    if (hxt_optimiser) {
-      // Skipped, not crashed, when it will not fit: about three cells per surface triangle when
-      // no attempt before it gave cells.
+    if (hxt_optimiser || previous_cells > 0.0) {
+      // A retry is skipped, not crashed, when it will not fit: about three cells per surface
+      // triangle when no attempt before it gave cells.
       const double cells =
           previous_cells > 0.0 ? previous_cells : 3.0 * static_cast<double>(boundary.triangles.size());
-      const double need = kHxtOptimiserBytesPerCell * cells, available = available_memory_bytes();
+      const double need = kRetryBytesPerCell * cells, available = available_memory_bytes();
       if (need > available) {
         const std::string why = fmt::format("it would need about {:.1f} GB and {:.1f} GB are available", need / 1e9,
                                             available / 1e9);
@@ -410,6 +411,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     }
     // Say where the bad cells are: the nearest particle surface to each.
     const DefectLocations where = locate_bad_cells(bed, out.mesh, out.quality, bad, bad_cells_path);
+    attempts.back()["cells_failing_near"] = where.summary;  // kept when a later attempt passes
     failure += fmt::format("{}: {} of {} cells fail the gate (max non-orthogonality {:.1f} deg, limit {}; max skewness "
                           "{:.2f}, limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}), "
                           "most near {}; cells written to {}",

@@ -12,6 +12,7 @@
 
 #include "meshing/surface/fluid_surface.hpp"
 #include "meshing/surface/surface_checks.hpp"
+#include "support/cli.hpp"
 #include "support/packed_bed.hpp"
 #include "support/temp_dir.hpp"
 
@@ -135,6 +136,28 @@ TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
   EXPECT_NE(text.str().find("DATASET POLYDATA"), std::string::npos);
   EXPECT_NE(text.str().find("SCALARS nearest_particle"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
+}
+
+// A retry (HXT's own optimiser, gmsh's Delaunay) takes about 1500 bytes per cell: where that
+// would not fit in what this process may take (here one of a billion ranks on this machine,
+// OMPI_COMM_WORLD_LOCAL_SIZE, as under mpirun), it is skipped and said; the control, the same
+// command as one process, tries both.
+TEST(VolumeMesh, ARetryThatWouldNotFitInARanksShareOfTheMachineIsSkippedAndSaid) {
+  const fs::path dir = cli_test::fresh_dir("retry_share");
+  const std::string bedforge = std::string(BEDFORGE_BINARY) + " --quiet ";
+  ASSERT_EQ(cli_test::shell(bedforge + "pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string() +
+                            " && " + bedforge + "surface " + dir.string() + " --edge-length-d 0.25")
+                .status,
+            0);
+  const std::string mesh = bedforge + "mesh " + dir.string() + " --max-non-orthogonality 5";  // no mesh passes
+  const cli_test::Result rank = cli_test::shell("OMPI_COMM_WORLD_LOCAL_SIZE=1000000000 " + mesh);
+  EXPECT_EQ(rank.status, 3) << rank.output;
+  EXPECT_NE(rank.output.find("hxt (its own optimiser) skipped: it would need about"), std::string::npos) << rank.output;
+  EXPECT_NE(rank.output.find("delaunay skipped: it would need about"), std::string::npos) << rank.output;
+  const cli_test::Result alone = cli_test::shell(mesh);
+  EXPECT_EQ(alone.status, 3) << alone.output;
+  EXPECT_EQ(alone.output.find("skipped"), std::string::npos) << alone.output;
+  EXPECT_NE(alone.output.find("delaunay: "), std::string::npos) << alone.output;
 }
 
 // Enlarged contacts leave fluid wedges of about 16 degrees around each neck, where gmsh's
