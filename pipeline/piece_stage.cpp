@@ -12,6 +12,8 @@
 #include <numeric>
 #include <optional>
 #include <regex>
+#include <sys/wait.h>
+#include <cstring>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -204,7 +206,7 @@ std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceP
   return {whole.clip_bottom_d * d, whole.clip_top_d * d};
 }
 
-RanksLog read_ranks_log(const std::filesystem::path& log) {
+RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code) {
   // Open MPI 4.1's words (Debian 12) for a rank killed, a rank's non-zero exit and too few slots.
   static const std::regex killed(R"(process rank (\d+) with PID \d+ on node \S+ exited on signal (\d+) \(([^)]*)\))"),
       first(R"(Process name: \[\[\d+,\d+\],(\d+)\])");
@@ -220,6 +222,12 @@ RanksLog read_ranks_log(const std::filesystem::path& log) {
     } else if (out.failed_rank < 0 && std::regex_search(line, m, first)) {
       out.failed_rank = std::stoi(m[1]);
     }
+  }
+  // mpirun does not always name the rank (it races with its own abort), but it exits with 128 +
+  // the signal that ended the first rank to stop.
+  if (out.signal == 0 && mpirun_exit_code > 128) {
+    out.signal = mpirun_exit_code - 128;
+    out.signal_name = strsignal(out.signal);
   }
   return out;
 }
@@ -244,7 +252,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     const int status = std::system(cmd.c_str());
     progress.finish();
     if (status == 0) return;
-    const RanksLog said = read_ranks_log(log);
+    const RanksLog said = read_ranks_log(log, WIFEXITED(status) ? WEXITSTATUS(status) : 0);
     if (said.too_few_slots)
       throw InputError(fmt::format(
           "mesh.pieces = {}: mpirun has fewer slots than {} ranks here (see {}); allowed: mesh.pieces at most the "

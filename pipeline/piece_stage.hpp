@@ -42,10 +42,10 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
 // window's ends when it has one), as its pieces and the case that holds them take them.
 std::pair<double, double> domain_heights(const Bed& bed, const meshing::SurfaceParams& surface);
 
-// What mpirun's output `log` (case/log.pieces) says of a job whose ranks did not all succeed: the
-// first line a rank wrote starting "bedforge: " (its error; "" when none did), whether mpirun had
-// too few slots, and the rank that stopped first (-1 when not named) with the signal that ended
-// it (0 and "" when it exited on its own).
+// What mpirun's output `log` (case/log.pieces) and its exit code say of a job whose ranks did not
+// all succeed: the first line a rank wrote starting "bedforge: " (its error; "" when none did),
+// whether mpirun had too few slots, the rank that stopped first (-1 when mpirun did not name it,
+// which it does not always do) and the signal that ended it (0 and "" when it exited on its own).
 struct RanksLog {
   std::string message;
   bool too_few_slots = false;
@@ -53,7 +53,7 @@ struct RanksLog {
   int signal = 0;
   std::string signal_name;
 };
-RanksLog read_ranks_log(const std::filesystem::path& log);
+RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 
 // The pieces of the case a run writes (case_stage with CasePieces): `pieces` ranks started as
 // `mpirun -np pieces <this program> piece run_dir` (run_dir holds bed.csv and scene.toml as run,

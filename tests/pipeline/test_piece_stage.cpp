@@ -256,29 +256,30 @@ TEST(PieceStage, MoreRanksThanMpirunHasSlotsAreRefusedNamingThePieces) {
   EXPECT_FALSE(fs::exists(dir / "case/processor0"));
 }
 
-// mpirun's own words when a rank stops: the run reads which rank stopped first, and the signal
-// when one was killed from outside (as the kernel kills a process for want of memory), from the
-// output of this machine's Open MPI, here of ranks that stop on purpose.
+// mpirun's own words and exit code when a rank stops: the run reads the signal when one was
+// killed from outside (as the kernel kills a process for want of memory), the rank's own
+// error, and which rank stopped first where mpirun names it (it did in 4 of 6 runs here: its
+// notice races with its abort), from this machine's Open MPI, here of ranks that stop on purpose.
 TEST(PieceStage, TheRankThatStoppedAndTheSignalThatKilledItAreReadFromMpirun) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (mpirun) not on PATH";
   const fs::path dir = fresh_dir("piece_ranks_log");
   fs::create_directories(dir);
   const auto job = [&](const std::string& name, const std::string& rank_one) {
     const fs::path log = dir / name;
-    shell(kOpenFoam + "mpirun -np 2 sh -c 'if [ $OMPI_COMM_WORLD_RANK = 1 ]; then " + rank_one +
-          "; fi; sleep 2' > " + log.string() + " 2>&1");
-    return bedforge::pipeline::read_ranks_log(log);
+    const Result r = shell(kOpenFoam + "mpirun -np 2 sh -c 'if [ $OMPI_COMM_WORLD_RANK = 1 ]; then " + rank_one +
+                           "; fi; sleep 2' > " + log.string() + " 2>&1; echo $?");
+    return std::pair{bedforge::pipeline::read_ranks_log(log, std::stoi(r.output)), read(log)};
   };
-  const auto killed = job("killed.log", "kill -9 $$");
-  EXPECT_EQ(killed.failed_rank, 1);
-  EXPECT_EQ(killed.signal, 9);
-  EXPECT_EQ(killed.signal_name, "Killed");
-  EXPECT_EQ(killed.message, "");
-  const auto failed = job("failed.log", "echo \"bedforge: error: the reason\"; exit 2");
-  EXPECT_EQ(failed.failed_rank, 1);
-  EXPECT_EQ(failed.signal, 0);
-  EXPECT_EQ(failed.message, "bedforge: error: the reason");
-  EXPECT_FALSE(failed.too_few_slots);
+  const auto [killed, killed_log] = job("killed.log", "kill -9 $$");
+  EXPECT_EQ(killed.signal, 9) << killed_log;
+  EXPECT_EQ(killed.signal_name, "Killed") << killed_log;
+  EXPECT_EQ(killed.message, "") << killed_log;
+  EXPECT_TRUE(killed.failed_rank == 1 || killed.failed_rank == -1) << killed_log;
+  const auto [failed, failed_log] = job("failed.log", "echo \"bedforge: error: the reason\"; exit 2");
+  EXPECT_EQ(failed.signal, 0) << failed_log;
+  EXPECT_EQ(failed.message, "bedforge: error: the reason") << failed_log;
+  EXPECT_TRUE(failed.failed_rank == 1 || failed.failed_rank == -1) << failed_log;
+  EXPECT_FALSE(failed.too_few_slots) << failed_log;
 }
 
 // A piece failing the gate where the whole mesh would pass has its planes to blame: the ranks
