@@ -70,7 +70,9 @@ double available_memory_bytes() {
   // Ranks of one mpirun on this machine share it: each may take its share of what was available
   // when it first asked (the others, started with it, had taken little then).
   const char* ranks = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-  static const double share = available / std::max(1, ranks ? std::atoi(ranks) : 1);
+  const int local = ranks ? std::max(1, std::atoi(ranks)) : 1;
+  if (local == 1) return available;
+  static const double share = available / local;
   return std::min(available, share);
 }
 

@@ -2,18 +2,18 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <numeric>
 #include <optional>
 #include <regex>
-#include <sys/wait.h>
-#include <cstring>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -273,7 +273,8 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     if (said.signal == 9)
       throw InputError(fmt::format(
           "mesh.pieces = {}: {} was killed by signal 9 ({}), most likely by the kernel for want of memory (each "
-          "rank checks its piece against this machine's memory before it starts, by an estimate that errs low); "
+          "rank checks its piece against its share of this machine's memory before it starts, by an estimate that "
+          "errs low); "
           "allowed: more pieces (with as many ranks, spread over machines), fewer ranks per machine, or a longer "
           "surface.edge_length_d; see {}",
           pieces, which, said.signal_name, log.string()));
@@ -284,9 +285,8 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}{}); see {}", pieces,
                                          self.filename().string(), which == "a rank" ? "" : which + ": ",
                                          said.message.empty() ? "no rank said why" : said.message, log.string());
-    const std::string& message = said.message;
-    if (message.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
-    if (message.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
+    if (said.message.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
+    if (said.message.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
     throw std::runtime_error(what);
   };
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
