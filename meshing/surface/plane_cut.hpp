@@ -19,6 +19,9 @@ struct PlaneCutParams {
   // edge, the face's edge there is their distance / cells_per_gap, at least `finest` (m). 0: the
   // edge everywhere (its triangles then span a narrow gap in one step).
   double cells_per_gap = 0.0, finest = 0.0;
+  // Flip the triangles near the plane towards Delaunay (see cut_by_plane); off, the cut is left
+  // as snapped and split (to measure what the flips do).
+  bool delaunay_flips = true;
 };
 
 struct PlaneCut {
@@ -27,6 +30,7 @@ struct PlaneCut {
   long loops = 0;             // where the plane meets the surface
   long faces = 0;             // of the plane's section: the walls' and any fluid that solid rings in there
   long vertices_snapped = 0;  // surface vertices moved onto the plane along an edge (see cut_by_plane)
+  long edges_flipped = 0;     // near the plane, towards Delaunay (see cut_by_plane)
 };
 
 // `surface` (closed, welded, normals out of the region it bounds; m) cut by the plane z = `z`
@@ -37,7 +41,9 @@ struct PlaneCut {
 // and unions), touch the surface along an edge, or turn a triangle over; nor a vertex where
 // patches meet. Each edge still
 // crossing is split where it meets the plane, and the triangles on either side are kept whole
-// or split in two or three. The
+// or split in two or three, then flipped towards Delaunay within two edges of the plane (an
+// edge of one patch whose opposite angles sum to more than pi; the loops are left alone), so
+// that gmsh has fewer of them to recover. The
 // region's section by the plane is one face or more (bridged spheres and the wall can ring in a
 // pocket of fluid there), each an outer loop (clockwise seen from above on the part below) less
 // the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with

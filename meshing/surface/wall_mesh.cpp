@@ -74,6 +74,10 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   // recovering those facets cost it 3 to 4 times its memory.
   struct Row {
     double z;
+    // Its vertices' distance to those of the rows beside it: with the step as their spacing,
+    // rows nearer than 0.62 step (short parts) lost every other row to the spacing test and
+    // left rectangles of cocircular points again.
+    double spacing;
     bool shifted, fixed;  // fixed: an end or a ring, whose vertices are added on their own
   };
   std::vector<double> bounds{z0};
@@ -84,9 +88,10 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   for (std::size_t b = 0; b + 1 < bounds.size(); ++b) {
     const double lo = bounds[b], hi = bounds[b + 1];
     const int nz = 2 * std::max(1, static_cast<int>(std::ceil((hi - lo) / (std::sqrt(3.0) * step))));
-    for (int k = 0; k < nz; ++k) rows.push_back({k == 0 ? lo : lo + (hi - lo) * k / nz, k % 2 == 1, k == 0});
+    const double spacing = std::min(step, std::hypot((hi - lo) / nz, 0.5 * step));
+    for (int k = 0; k < nz; ++k) rows.push_back({k == 0 ? lo : lo + (hi - lo) * k / nz, spacing, k % 2 == 1, k == 0});
   }
-  rows.push_back({z1, false, true});
+  rows.push_back({z1, step, false, true});
   const Eigen::Vector3d shift(period, 0.0, 0.0);
 
   std::vector<Eigen::Vector3d> points;  // 3D vertices
@@ -245,10 +250,12 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
         else if (shift == 0.0)
           throw CutConflict(fmt::format("the wall's ring at z = {} m cannot be joined across the strip's seam", z));
       }
-      // Free vertices keep off the constraint as off the ring's points.
+      // Free vertices keep off the constraint as off the ring's points; along a whole step, the
+      // shifted row beside it (0.44 step away at the least) is let in.
       const double length = sb - sa;
       for (double t : {0.25, 0.5, 0.75})
-        spaced.add(Eigen::Vector3d(R * wrap_2pi((sa + t * length) / R), z, 0.0), std::min(step, length));
+        spaced.add(Eigen::Vector3d(R * wrap_2pi((sa + t * length) / R), z, 0.0),
+                   length < 0.99 * step ? length : 0.25 * step);
     }
   }
   auto on_wall = [&](const Eigen::Vector2d& q) {
@@ -285,7 +292,8 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   for (const Row& row : rows)
     if (!row.fixed)
       for (int j = 0; j < n; ++j)
-        try_add(Eigen::Vector2d(R * ((j + (row.shifted ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row.z), step);
+        try_add(Eigen::Vector2d(R * ((j + (row.shifted ? 0.5 : 0.0)) * 2.0 * std::numbers::pi / n - seam), row.z),
+                row.spacing);
 
   // 4. Constrained Delaunay triangulation of the strip; faces inside a hole go to `inside`.
   Cdt cdt;
