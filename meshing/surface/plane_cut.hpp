@@ -19,8 +19,8 @@ struct PlaneCutParams {
   // edge, the face's edge there is their distance / cells_per_gap, at least `finest` (m). 0: the
   // edge everywhere (its triangles then span a narrow gap in one step).
   double cells_per_gap = 0.0, finest = 0.0;
-  // Flip the triangles near the plane towards Delaunay (see cut_by_plane); off, the cut is left
-  // as snapped and split (to measure what the flips do).
+  // Flip and split the triangles near the plane towards Delaunay (see cut_by_plane); off, the
+  // cut is left as snapped and split (to measure what they do).
   bool delaunay_flips = true;
 };
 
@@ -31,6 +31,8 @@ struct PlaneCut {
   long faces = 0;             // of the plane's section: the walls' and any fluid that solid rings in there
   long vertices_snapped = 0;  // surface vertices moved onto the plane along an edge (see cut_by_plane)
   long edges_flipped = 0;     // near the plane, towards Delaunay (see cut_by_plane)
+  long edges_split = 0;       // near the plane, where the flips left triangles gmsh would recover
+  long left_to_recover = 0;   // such triangles left where the splits could not take all away (both parts)
 };
 
 // `surface` (closed, welded, normals out of the region it bounds; m) cut by the plane z = `z`
@@ -42,8 +44,11 @@ struct PlaneCut {
 // patches meet. Each edge still
 // crossing is split where it meets the plane, and the triangles on either side are kept whole
 // or split in two or three, then flipped towards Delaunay within two edges of the plane (an
-// edge of one patch whose opposite angles sum to more than pi; the loops are left alone), so
-// that gmsh has fewer of them to recover. The
+// edge of one patch whose opposite angles sum to more than pi; the loops are left alone); the
+// triangles there that are still no facet of the Delaunay tetrahedra of the points (checked by
+// CGAL) have their longest edge off the plane split at its midpoint, round by round, so that
+// gmsh, which recovers such facets at 4 times its memory, has none to recover (where the
+// splits cannot finish, a part is left as the flips made it). The
 // region's section by the plane is one face or more (bridged spheres and the wall can ring in a
 // pocket of fluid there), each an outer loop (clockwise seen from above on the part below) less
 // the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with

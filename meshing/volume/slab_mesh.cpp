@@ -343,7 +343,8 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
       try {
         PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), plane_cut_params(surface, d));
         cut_report.push_back({{"plane_d", planes[j]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
-                              {"plane_triangles", c.plane_triangles}});
+                              {"plane_triangles", c.plane_triangles}, {"edges_flipped", c.edges_flipped},
+                              {"edges_split", c.edges_split}, {"left_to_recover", c.left_to_recover}});
         fs.fluid = std::move(keep_above ? c.above : c.below);
       } catch (const CutConflict& e) {
         throw cannot(e.what());

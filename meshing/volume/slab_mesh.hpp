@@ -96,7 +96,8 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 // are the pieces ranks would make); treated contacts in a box are cut from `whole` (the surface
 // stage's fluid surface of the same bed under `surface`; m), which may be null otherwise.
 // `d_ref` (m) scales the parameters; the report holds each slab's report under "slabs" (a cut
-// slab's with "plane_cut": each cut's plane, loops, snapped vertices, plane triangles).
+// slab's with "plane_cut": each cut's plane, loops, snapped vertices, plane triangles, edges
+// flipped and split, and the triangles left for gmsh to recover).
 // Writes the joined mesh (MSH 2.2: physical groups per patch and `fluid`) to `msh_path` when
 // not empty. std::runtime_error when two slabs' shared plane is not triangulated alike (a
 // defect of ours); InputError naming mesh.slabs when a slab cannot be cut from the bed;
