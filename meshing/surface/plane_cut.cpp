@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <tuple>
@@ -271,6 +272,53 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
     if (!ok || changes != 2) continue;
     x[snap.v] = snap.to, s[snap.v] = 0.0, moved[snap.v] = 1;
     ++out.vertices_snapped;
+  }
+
+  // 1b. A vertex the snaps left near the plane beside it (a saddle, where the plane would meet
+  // the surface twice, one whose snap would turn a triangle, or a neighbour of a point snapped)
+  // moves away from it along z: crossing edges cut within a hair of it leave a triangle of a few
+  // thousandths of d beside the plane's face, and the four surface points of a flat tetrahedron
+  // that no optimiser can move. It goes to where its crossing edges are cut kPlaneCutClearance
+  // of the height difference away, at most (and with none, exactly) a tenth of its shortest
+  // edge away, unless that turns a triangle. By height, then coordinates, as the snaps, so that
+  // both windows of a plane move the same points.
+  {
+    std::vector<int> near;
+    for (int v = 0; v < nv; ++v) {
+      bool beside = false;
+      for (int t : incident[v])
+        for (int u : m.triangles[t]) beside |= s[u] * s[v] <= 0.0;
+      if (s[v] != 0.0 && !between_patches[v] && beside) near.push_back(v);
+    }
+    std::sort(near.begin(), near.end(), [&](int a, int b) {
+      return std::tuple{std::abs(s[a]), x[a].x(), x[a].y(), x[a].z()} <
+             std::tuple{std::abs(s[b]), x[b].x(), x[b].y(), x[b].z()};
+    });
+    for (int v : near) {
+      double across = 0.0, shortest = std::numeric_limits<double>::infinity();
+      for (int t : incident[v])
+        for (int u : m.triangles[t]) {
+          if (u == v) continue;
+          if (s[u] * s[v] < 0.0) across = std::max(across, std::abs(s[u]));
+          shortest = std::min(shortest, (x[u] - x[v]).norm());
+        }
+      double clear = 0.1 * shortest;
+      if (across > 0.0) clear = std::min(clear, kPlaneCutClearance / (1.0 - kPlaneCutClearance) * across);
+      if (std::abs(s[v]) >= clear) continue;
+      const Eigen::Vector3d from = x[v];
+      const double to = std::copysign(clear, s[v]);
+      bool turns = false;
+      for (int t : incident[v]) {
+        const Eigen::Vector3d before = normal(x, m.triangles[t]);
+        x[v].z() = z + to;
+        const Eigen::Vector3d after = normal(x, m.triangles[t]);
+        x[v] = from;
+        turns |= !(after.dot(before) > 0.25 * after.norm() * before.norm());
+      }
+      if (turns) continue;
+      x[v].z() = z + to, s[v] = to;
+      ++out.vertices_cleared;
+    }
   }
 
   // 2. Each edge still crossing gets one point on the plane, shared by its two triangles.

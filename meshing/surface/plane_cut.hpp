@@ -30,6 +30,7 @@ struct PlaneCut {
   long loops = 0;             // where the plane meets the surface
   long faces = 0;             // of the plane's section: the walls' and any fluid that solid rings in there
   long vertices_snapped = 0;  // surface vertices moved onto the plane along an edge (see cut_by_plane)
+  long vertices_cleared = 0;  // surface vertices left near the plane and moved away from it (see cut_by_plane)
   long edges_flipped = 0;     // near the plane, towards Delaunay (see cut_by_plane)
   long edges_split = 0;       // near the plane, where the flips left triangles gmsh would recover
   long left_to_recover = 0;   // such triangles left where the splits could not take all away (both parts)
@@ -41,7 +42,9 @@ struct PlaneCut {
 // mostly the surface's own vertices, spaced as its edges, with no needles beside them; not
 // where the plane would then pass through that vertex twice (a saddle: the necks of bridges
 // and unions), touch the surface along an edge, or turn a triangle over; nor a vertex where
-// patches meet. Each edge still
+// patches meet. A vertex so left near the plane beside a crossing edge or a point on the plane
+// moves away from it along z until its crossing edges are cut kPlaneCutClearance of the height
+// difference away, at most (and with none, exactly) a tenth of its shortest edge away. Each edge still
 // crossing is split where it meets the plane, and the triangles on either side are kept whole
 // or split in two or three, then flipped towards Delaunay within two edges of the plane (an
 // edge of one patch whose opposite angles sum to more than pi; the loops are left alone); the
@@ -64,6 +67,10 @@ struct PlaneCut {
 // in 3 slabs (2026-11-30, docs/findings.md) 0.2 left 9 and 23 plane triangles under 5 deg and
 // 11 dual cells failing checkMesh, 0.4 none under 5 deg and 4 failing, 0.5 none and 2 or 3.
 inline constexpr double kPlaneCutSnap = 0.5;
+// 0.2: a = 14, N = 1e4 (2026-11-30, docs/findings.md) left two saddle vertices 0.0008 and
+// 0.0013 d below a plane, its crossing edges cut 0.0017 d from them, and 2 of 6.2 M cells at
+// 87.4 deg non-orthogonality there.
+inline constexpr double kPlaneCutClearance = 0.2;
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
 
 }  // namespace bedforge::meshing

@@ -160,6 +160,18 @@ PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
           .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};
 }
 
+// What a slab's report says of one of its plane cuts (at `plane_d`, d above the floor).
+nlohmann::json cut_json(const PlaneCut& c, double plane_d) {
+  return {{"plane_d", plane_d},
+          {"loops", c.loops},
+          {"vertices_snapped", c.vertices_snapped},
+          {"vertices_cleared", c.vertices_cleared},
+          {"plane_triangles", c.plane_triangles},
+          {"edges_flipped", c.edges_flipped},
+          {"edges_split", c.edges_split},
+          {"left_to_recover", c.left_to_recover}};
+}
+
 // The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, sorted.
 std::vector<double> sphere_ends_d(const Bed& bed, const SurfaceParams& s) {
   const double d = reference_diameter(bed);
@@ -342,9 +354,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
       if (j < 0 || j + 1 >= slabs) continue;
       try {
         PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), plane_cut_params(surface, d));
-        cut_report.push_back({{"plane_d", planes[j]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
-                              {"plane_triangles", c.plane_triangles}, {"edges_flipped", c.edges_flipped},
-                              {"edges_split", c.edges_split}, {"left_to_recover", c.left_to_recover}});
+        cut_report.push_back(cut_json(c, planes[j]));
         fs.fluid = std::move(keep_above ? c.above : c.below);
       } catch (const CutConflict& e) {
         throw cannot(e.what());
@@ -418,8 +428,7 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
       if (k + 1 < slabs) {
         try {
           PlaneCut c = cut_by_plane(own, planes[k] * d, plane_cut_params(surface, d));
-          cut_report.push_back({{"plane_d", planes[k]}, {"loops", c.loops}, {"vertices_snapped", c.vertices_snapped},
-                                {"plane_triangles", c.plane_triangles}});
+          cut_report.push_back(cut_json(c, planes[k]));
           own = std::move(c.below), above = std::move(c.above);
         } catch (const CutConflict& e) {
           throw InputError(fmt::format("mesh.slabs: the plane at {:.3f} d above the floor cannot be cut from the bed's "
