@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -16,12 +17,19 @@ namespace bedforge {
 
 namespace {
 
-// VmHWM of /proc/self/status in MB, or the process's rusage peak where /proc is missing.
-double high_water_mark_mb() {
+// A line of /proc/self/status ("VmHWM:", "VmRSS:") in kB; NaN where it cannot be read.
+double status_kb(const std::string& key) {
   std::ifstream status("/proc/self/status");
   std::string line;
   while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;  // kB
+    if (line.rfind(key, 0) == 0) return std::stod(line.substr(key.size()));
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// VmHWM in MB, or the process's rusage peak where /proc is missing.
+double high_water_mark_mb() {
+  const double kb = status_kb("VmHWM:");
+  if (!std::isnan(kb)) return kb / 1024.0;
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return static_cast<double>(u.ru_maxrss) / 1024.0;
@@ -72,9 +80,14 @@ double available_memory_bytes() {
   const char* ranks = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
   const int local = ranks ? std::max(1, std::atoi(ranks)) : 1;
   if (local == 1) return available;
-  static const double share = available / local;
-  return std::min(available, share);
+  static const double share = available / local, resident_then = resident_memory_bytes();
+  const double taken = std::isnan(resident_then) ? 0.0 : std::max(0.0, resident_memory_bytes() - resident_then);
+  return std::min(available, share - taken);
 }
+
+double resident_memory_bytes() { return status_kb("VmRSS:") * 1024.0; }
+
+double peak_resident_memory_bytes() { return status_kb("VmHWM:") * 1024.0; }
 
 void release_free_memory() {
   if (MallocExtension_ReleaseFreeMemory)

@@ -27,9 +27,14 @@ double children_peak_memory_mb();
 
 // Memory this process may still take, bytes: the kernel's MemAvailable, or what the cgroup's
 // limit leaves if that is less; for one of the ranks Open MPI started on this machine
-// (OMPI_COMM_WORLD_LOCAL_SIZE), at most its share of that as it was at the first call.
-// Infinity when neither can be read.
+// (OMPI_COMM_WORLD_LOCAL_SIZE), at most its share of that as it was at the first call, less
+// what the rank has taken since. Infinity when neither can be read.
 double available_memory_bytes();
+
+// This process's resident memory now, and its peak (since the last StageMeter started, where
+// the kernel allows the reset), bytes; NaN where /proc/self/status cannot be read.
+double resident_memory_bytes();
+double peak_resident_memory_bytes();
 
 // Hands memory the allocator keeps after a free back to the system: tcmalloc (when the program
 // links it) and glibc hold freed pages for reuse, and a stage that frees one large structure

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <numeric>
@@ -248,11 +249,17 @@ void insert_layers(const PrismLayers& layers) {
 
 }  // namespace
 
-// Peak bytes per cell of the mesh stage when HXT's own optimisation runs, cells counted in the
-// mesh before it: measured 1360 (a = 10, N = 4000, enlarge: 14.2 GB, 10.4 M cells) and 1230
-// (a = 5, N = 300, enlarge); 1500 leaves a margin. gmsh's Delaunay as the fallback took as much:
-// 1378 (a piece of a = 14, N = 1e4, bridges: 7.9 GB after 5.7 M cells).
+// Peak bytes per cell of a retry whose algorithm has not run on this surface yet: gmsh's
+// Delaunay took 1378 (a piece of a = 14, N = 1e4, bridges: 7.9 GB after 5.7 M cells), HXT's own
+// optimisation on surfaces with facets to recover 1360 (a = 10, N = 4000, enlarge: 14.2 GB,
+// 10.4 M cells) and 1230 (a = 5, N = 300, enlarge); 1500 leaves a margin.
 constexpr double kRetryBytesPerCell = 1500.0;
+// HXT's own optimisation after HXT without it took 0.95-1.12 times the memory per cell the
+// first attempt grew by (2026-11-30, docs/findings.md: 178 against 173 bytes per cell on a
+// piece of a = 8, N = 1500 with no facet to recover, 1145-1239 against 1106-1199 with 631; 203
+// against 196 on a piece of the 1e4 bed), so the first attempt's own growth, with this margin,
+// sizes it: the constant above, from surfaces with facets to recover, skipped retries that fit.
+constexpr double kSameAlgorithmMargin = 1.25;
 
 VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
                              const std::filesystem::path& msh_path, const std::filesystem::path& bad_cells_path,
@@ -284,7 +291,13 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
   const TriangleMesh& boundary = layers ? layers->top : surface;
   nlohmann::json attempts = nlohmann::json::array();
   std::string failure;  // one sentence per attempt
-  double previous_cells = 0.0;  // the last attempt's, to size HXT's optimisation before it starts
+  // The last attempt that gave cells: its algorithm, cells and the memory it grew by per cell
+  // (NaN where unmeasured), to size a retry before it starts.
+  struct Previous {
+    Algorithm algorithm;
+    double cells = 0.0, bytes_per_cell = std::nan("");
+  };
+  std::optional<Previous> previous;
   for (const auto& [algorithm, hxt_optimiser] : tries) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::string name =
@@ -297,12 +310,13 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       entry[key] = why;
       attempts.push_back(entry);
     };
-    if (hxt_optimiser || previous_cells > 0.0) {
+    if (hxt_optimiser || previous) {
       // A retry is skipped, not crashed, when it will not fit: about three cells per surface
       // triangle when no attempt before it gave cells.
-      const double cells =
-          previous_cells > 0.0 ? previous_cells : 3.0 * static_cast<double>(boundary.triangles.size());
-      const double need = kRetryBytesPerCell * cells, available = available_memory_bytes();
+      const double cells = previous ? previous->cells : 3.0 * static_cast<double>(boundary.triangles.size());
+      const bool measured = previous && previous->algorithm == algorithm && !std::isnan(previous->bytes_per_cell);
+      const double need = (measured ? kSameAlgorithmMargin * previous->bytes_per_cell : kRetryBytesPerCell) * cells;
+      const double available = available_memory_bytes();
       if (need > available) {
         const std::string why = fmt::format("it would need about {:.1f} GB and {:.1f} GB are available", need / 1e9,
                                             available / 1e9);
@@ -312,6 +326,7 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       }
     }
     progress.update(fmt::format("{}: loading {} surface triangles", name, boundary.triangles.size()));
+    const double resident_before = resident_memory_bytes();
     GmshSession session;
     auto failed = [&](const std::string& why) {
       record("error", why);
@@ -384,9 +399,12 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       failure += fmt::format("{} gave an invalid mesh: {}. ", name, broken);
       continue;
     }
-    previous_cells = static_cast<double>(out.mesh.cells);
+    // What the attempt grew the process by, at most: the peak may be an earlier stage's.
+    const double grown = peak_resident_memory_bytes() - resident_before;
+    previous = Previous{algorithm, static_cast<double>(out.mesh.cells), grown / static_cast<double>(out.mesh.cells)};
     nlohmann::json attempt = tried;
     attempt.update({{"cells", out.mesh.cells},
+                    {"memory_grown_mb", std::isnan(grown) ? nlohmann::json() : nlohmann::json(grown / 1048576.0)},
                     {"time_generate_s", generated_at},
                     {"optimiser_passes", history.size() - 1},
                     {"history", history},

@@ -28,7 +28,8 @@ struct VolumeMeshParams {
   // gmsh's tetrahedral optimiser (needed for checkMesh's aspect ratio); when its passes leave
   // cells failing the gate, HXT meshes again with its own optimisation, on one thread and
   // several times slower, which clears the slivers in the narrow wedges of enlarged contacts
-  // (skipped when its memory, estimated from the cells before it, exceeds what is available).
+  // (skipped when its memory, estimated from the cells and memory of the attempt before it,
+  // exceeds what is available).
   bool optimize = true;
   int max_optimize_passes = 3;           // optimiser passes: the first always, more while cells fail the gate
   int threads = 0;                       // 0: every core
@@ -57,7 +58,8 @@ struct VolumeMesh {
 // (MSH 4.1, physical groups per patch and `fluid`) to `msh_path` when not empty. Tries, in
 // turn: `algorithm`; HXT with its own optimisation when `algorithm` is hxt and `optimize`;
 // then, with `fallback`, the other algorithm (and HXT's own optimisation after it when that is
-// hxt). When none passes the gate, throws std::runtime_error saying how many cells fail which
+// hxt); the report's "attempts" give each one's cells, times, quality and memory_grown_mb (what
+// it grew the process by, at most). When none passes the gate, throws std::runtime_error saying how many cells fail which
 // limit and near which particles, after writing them as a legacy VTK file to `bad_cells_path`
 // (open it in ParaView). With `release_memory`, what each step frees goes back to the system
 // before the next (a lower peak; on a = 10, N = 4000 in slabs, 1.6 times the mesh stage's time,
