@@ -1,9 +1,5 @@
 #include "meshing/surface/delaunay_walls.hpp"
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +8,7 @@
 #include <utility>
 
 #include "core/edge_key.hpp"
+#include "meshing/surface/delaunay_facets.hpp"
 #include "meshing/surface/spaced_points.hpp"
 
 namespace bedforge::meshing {
@@ -52,33 +49,18 @@ bool has_empty_circumsphere(const TriangleMesh& f, const std::array<int, 3>& t, 
 }
 
 // Of the triangles `candidates` of f (which failed has_empty_circumsphere), those that are
-// not facets of CGAL's Delaunay tetrahedra of the points within `reach` of one of them: more
-// points only take facets away, so each is certainly missing from gmsh's start too.
+// not facets of the Delaunay tetrahedra of the points within `reach` of one of them.
 std::vector<std::size_t> certainly_missing(const TriangleMesh& f, const std::vector<std::size_t>& candidates,
                                            const PointsByCell& grid, double reach) {
-  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-  using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
-  using Delaunay =
-      CGAL::Delaunay_triangulation_3<K, CGAL::Triangulation_data_structure_3<Vb, CGAL::Delaunay_triangulation_cell_base_3<K>>>;
-  std::unordered_map<int, Delaunay::Vertex_handle> handle;
-  std::vector<std::pair<K::Point_3, int>> near;
+  std::vector<int> near;
+  std::unordered_set<int> seen;
   for (std::size_t t : candidates) {
     const Eigen::Vector3d centroid = (f.points[f.triangles[t][0]] + f.points[f.triangles[t][1]] + f.points[f.triangles[t][2]]) / 3.0;
     grid.near(centroid, [&](int v) {
-      if ((f.points[v] - centroid).squaredNorm() < reach * reach && handle.emplace(v, Delaunay::Vertex_handle()).second)
-        near.emplace_back(K::Point_3(f.points[v].x(), f.points[v].y(), f.points[v].z()), v);
+      if ((f.points[v] - centroid).squaredNorm() < reach * reach && seen.insert(v).second) near.push_back(v);
     });
   }
-  const Delaunay dt(near.begin(), near.end());
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
-  std::vector<std::size_t> missing;
-  for (std::size_t t : candidates) {
-    const auto& tri = f.triangles[t];
-    Delaunay::Cell_handle c;
-    int i, j, k;
-    if (!dt.is_facet(handle.at(tri[0]), handle.at(tri[1]), handle.at(tri[2]), c, i, j, k)) missing.push_back(t);
-  }
-  return missing;
+  return off_delaunay_facets(f, near, candidates);
 }
 
 // The corner of triangle t that is neither a nor b.

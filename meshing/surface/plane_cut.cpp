@@ -1,8 +1,5 @@
 #include "meshing/surface/plane_cut.hpp"
 
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -16,6 +13,7 @@
 #include <unordered_map>
 
 #include "core/edge_key.hpp"
+#include "meshing/surface/delaunay_facets.hpp"
 #include "meshing/surface/planar_cdt.hpp"
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/spaced_points.hpp"
@@ -31,78 +29,21 @@ Eigen::Vector3d normal(const std::vector<Eigen::Vector3d>& x, const std::array<i
 
 std::string where(const Eigen::Vector3d& q) { return fmt::format("({:.4g}, {:.4g}, {:.4g}) m", q.x(), q.y(), q.z()); }
 
-// Lawson's flips on one side's triangles with a vertex within `band` of the plane (`s`: the
-// points' heights above it): an edge shared by two triangles of one patch whose angles opposite
-// it sum to more than pi gives way to the other diagonal, round by round, unless that would fold
-// the surface (a new normal more than 37 deg from the pair's) or lay an edge in the plane. The
-// snaps and splits leave such pairs by the hundred (a = 8, N = 1500, two planes: 631), each a
-// triangle that is no facet of the Delaunay tetrahedra gmsh starts from; recovering even a few
-// cost HXT 4 times its memory. The side's boundary, the loops, is left as it is. Returns the flips.
-long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& s,
-                           std::vector<std::array<int, 3>>& tris, const std::vector<int>& patch, double band) {
-  auto angle_at = [&](int c, int a, int b) {
-    const Eigen::Vector3d u = (x[a] - x[c]).normalized(), v = (x[b] - x[c]).normalized();
-    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
-  };
-  long flips = 0;
-  for (int round = 0; round < 20; ++round) {
-    std::unordered_map<std::uint64_t, std::vector<int>> edges;
-    for (std::size_t t = 0; t < tris.size(); ++t) {
-      const auto& v = tris[t];
-      if (std::min({std::abs(s[v[0]]), std::abs(s[v[1]]), std::abs(s[v[2]])}) >= band) continue;
-      for (int k = 0; k < 3; ++k) edges[edge_key(v[k], v[(k + 1) % 3])].push_back(static_cast<int>(t));
-    }
-    std::vector<char> changed(tris.size(), 0);
-    long this_round = 0;
-    for (const auto& [key, ts] : edges) {
-      if (ts.size() != 2 || patch[ts[0]] != patch[ts[1]] || changed[ts[0]] || changed[ts[1]]) continue;
-      std::array<int, 3>& t1 = tris[ts[0]];
-      std::array<int, 3>& t2 = tris[ts[1]];
-      // t1 = (a, b, c) from its edge a -> b shared with t2 = (b, a, d).
-      int k = 0;
-      while (edge_key(t1[k], t1[(k + 1) % 3]) != key) ++k;
-      const int a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
-      const int d = t2[0] + t2[1] + t2[2] - a - b;
-      if (angle_at(c, a, b) + angle_at(d, a, b) <= std::numbers::pi) continue;
-      if ((s[c] == 0.0 && s[d] == 0.0) || edges.count(edge_key(c, d))) continue;
-      const std::array<int, 3> n1{a, d, c}, n2{d, b, c};
-      const Eigen::Vector3d pair = (normal(x, t1).normalized() + normal(x, t2).normalized()).normalized();
-      if (normal(x, n1).normalized().dot(pair) < 0.8 || normal(x, n2).normalized().dot(pair) < 0.8) continue;
-      t1 = n1, t2 = n2;
-      changed[ts[0]] = changed[ts[1]] = 1;
-      ++this_round;
-    }
-    flips += this_round;
-    if (this_round == 0) break;
-  }
-  return flips;
-}
-
 // The triangles of `part` with a vertex within `band` of the plane z that are no facet of the
 // Delaunay tetrahedra of its points within 2 band of the plane: more points only take facets
 // away, so each is missing from gmsh's start too.
 std::vector<std::size_t> off_delaunay_near_plane(const TriangleMesh& part, double z, double band) {
-  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-  using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, K>;
-  using Delaunay = CGAL::Delaunay_triangulation_3<K, CGAL::Triangulation_data_structure_3<Vb>>;
-  std::vector<std::pair<K::Point_3, int>> near;
+  std::vector<int> near;
   for (std::size_t v = 0; v < part.points.size(); ++v)
-    if (std::abs(part.points[v].z() - z) < 2.0 * band)
-      near.emplace_back(K::Point_3(part.points[v].x(), part.points[v].y(), part.points[v].z()), static_cast<int>(v));
-  const Delaunay dt(near.begin(), near.end());
-  std::vector<Delaunay::Vertex_handle> handle(part.points.size());
-  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) handle[v->info()] = v;
-  std::vector<std::size_t> missing;
-  Delaunay::Cell_handle c;
-  int i, j, k;
+    if (std::abs(part.points[v].z() - z) < 2.0 * band) near.push_back(static_cast<int>(v));
+  std::vector<std::size_t> beside;
   for (std::size_t t = 0; t < part.triangles.size(); ++t) {
     const auto& v = part.triangles[t];
     if (std::min({std::abs(part.points[v[0]].z() - z), std::abs(part.points[v[1]].z() - z),
-                  std::abs(part.points[v[2]].z() - z)}) >= band)
-      continue;
-    if (!dt.is_facet(handle[v[0]], handle[v[1]], handle[v[2]], c, i, j, k)) missing.push_back(t);
+                  std::abs(part.points[v[2]].z() - z)}) < band)
+      beside.push_back(t);
   }
-  return missing;
+  return off_delaunay_facets(part, near, beside);
 }
 
 // What the flips leave for gmsh to recover (where the plane meets a bridge's rim, or a sphere's
@@ -177,6 +118,49 @@ std::pair<long, long> split_off_delaunay_near_plane(TriangleMesh& part, double z
 
 }  // namespace
 
+long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& s,
+                           std::vector<std::array<int, 3>>& tris, const std::vector<int>& patch, double band) {
+  auto angle_at = [&](int c, int a, int b) {
+    const Eigen::Vector3d u = (x[a] - x[c]).normalized(), v = (x[b] - x[c]).normalized();
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  };
+  long flips = 0;
+  for (int round = 0; round < 20; ++round) {
+    std::unordered_map<std::uint64_t, std::vector<int>> edges;
+    for (std::size_t t = 0; t < tris.size(); ++t) {
+      const auto& v = tris[t];
+      if (std::min({std::abs(s[v[0]]), std::abs(s[v[1]]), std::abs(s[v[2]])}) >= band) continue;
+      for (int k = 0; k < 3; ++k) edges[edge_key(v[k], v[(k + 1) % 3])].push_back(static_cast<int>(t));
+    }
+    std::vector<char> changed(tris.size(), 0);
+    long this_round = 0;
+    for (const auto& [key, ts] : edges) {
+      if (ts.size() != 2 || patch[ts[0]] != patch[ts[1]] || changed[ts[0]] || changed[ts[1]]) continue;
+      std::array<int, 3>& t1 = tris[ts[0]];
+      std::array<int, 3>& t2 = tris[ts[1]];
+      // t1 = (a, b, c) from its edge a -> b shared with t2 = (b, a, d).
+      int k = 0;
+      while (edge_key(t1[k], t1[(k + 1) % 3]) != key) ++k;
+      const int a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
+      const int d = t2[0] + t2[1] + t2[2] - a - b;
+      if (angle_at(c, a, b) + angle_at(d, a, b) <= std::numbers::pi) continue;
+      // An edge where the surface folds (a bridge's rim on its sphere) stays: across it the new
+      // triangles would span both faces.
+      if (normal(x, t1).normalized().dot(normal(x, t2).normalized()) < kFlipCreaseCos) continue;
+      if ((s[c] == 0.0 && s[d] == 0.0) || edges.count(edge_key(c, d))) continue;
+      const std::array<int, 3> n1{a, d, c}, n2{d, b, c};
+      const Eigen::Vector3d pair = (normal(x, t1).normalized() + normal(x, t2).normalized()).normalized();
+      if (normal(x, n1).normalized().dot(pair) < 0.8 || normal(x, n2).normalized().dot(pair) < 0.8) continue;
+      t1 = n1, t2 = n2;
+      changed[ts[0]] = changed[ts[1]] = 1;
+      ++this_round;
+    }
+    flips += this_round;
+    if (this_round == 0) break;
+  }
+  return flips;
+}
+
 PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) {
   PlaneCut out;
   std::vector<Eigen::Vector3d> x = m.points;
@@ -195,6 +179,20 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
     Eigen::Vector3d q = x[a] + s[a] / (s[a] - s[b]) * (x[b] - x[a]);
     q.z() = z;
     return q;
+  };
+
+  // Whether moving vertex v to `to` would turn one of its triangles by more than about 75 degrees.
+  auto turns_a_triangle = [&](int v, const Eigen::Vector3d& to) {
+    const Eigen::Vector3d from = x[v];
+    bool turns = false;
+    for (int t : incident[v]) {
+      const Eigen::Vector3d before = normal(x, m.triangles[t]);
+      x[v] = to;
+      const Eigen::Vector3d after = normal(x, m.triangles[t]);
+      x[v] = from;
+      turns |= !(after.dot(before) > 0.25 * after.norm() * before.norm());
+    }
+    return turns;
   };
 
   // 1. Vertices near the plane along a crossing edge move onto it there, nearest first.
@@ -237,18 +235,12 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
     // around it, on one arc above and one below (at a saddle, the necks of bridges and unions,
     // two loops would touch there), any neighbour on the plane between the two (below); and no
     // triangle turned by more than about 75 degrees.
-    bool ok = true;
-    const Eigen::Vector3d from = x[snap.v];
+    bool ok = !turns_a_triangle(snap.v, snap.to);
     std::unordered_map<int, int> after_in_link;  // neighbour -> the next one around the vertex
     for (int t : incident[snap.v]) {
       const auto& tri = m.triangles[t];
       const int k = static_cast<int>(std::find(tri.begin(), tri.end(), snap.v) - tri.begin());
       after_in_link[tri[(k + 1) % 3]] = tri[(k + 2) % 3];
-      const Eigen::Vector3d before = normal(x, tri);
-      x[snap.v] = snap.to;
-      const Eigen::Vector3d after = normal(x, tri);
-      x[snap.v] = from;
-      if (!(after.dot(before) > 0.25 * after.norm() * before.norm())) ok = false;
     }
     std::vector<int> signs;  // around the vertex
     for (int u = after_in_link.begin()->first; ok && signs.size() <= after_in_link.size();) {
@@ -305,17 +297,8 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
       double clear = 0.1 * shortest;
       if (across > 0.0) clear = std::min(clear, kPlaneCutClearance / (1.0 - kPlaneCutClearance) * across);
       if (std::abs(s[v]) >= clear) continue;
-      const Eigen::Vector3d from = x[v];
       const double to = std::copysign(clear, s[v]);
-      bool turns = false;
-      for (int t : incident[v]) {
-        const Eigen::Vector3d before = normal(x, m.triangles[t]);
-        x[v].z() = z + to;
-        const Eigen::Vector3d after = normal(x, m.triangles[t]);
-        x[v] = from;
-        turns |= !(after.dot(before) > 0.25 * after.norm() * before.norm());
-      }
-      if (turns) continue;
+      if (turns_a_triangle(v, Eigen::Vector3d(x[v].x(), x[v].y(), z + to))) continue;
       x[v].z() = z + to, s[v] = to;
       ++out.vertices_cleared;
     }

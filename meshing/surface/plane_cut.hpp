@@ -71,6 +71,24 @@ inline constexpr double kPlaneCutSnap = 0.5;
 // 0.0013 d below a plane, its crossing edges cut 0.0017 d from them, and 2 of 6.2 M cells at
 // 87.4 deg non-orthogonality there.
 inline constexpr double kPlaneCutClearance = 0.2;
+// Lawson's flips on one side's triangles with a vertex within `band` of the plane: an edge shared
+// by two triangles of one patch whose angles opposite it sum to more than pi gives way to the
+// other diagonal, round by round, unless that would fold the surface (a new normal more than
+// 37 deg from the pair's), lay an edge in the plane, or take away a crease (the pair's normals
+// more than acos(kFlipCreaseCos) apart). The snaps and splits leave such pairs by the hundred
+// (a = 8, N = 1500, two planes: 631), each a triangle that is no facet of the Delaunay
+// tetrahedra gmsh starts from; recovering even a few cost HXT 4 times its memory. The side's
+// boundary, the loops, is left as it is.
+//   x      points, m;  s: their heights above the plane, m (0: on it)
+//   tris   triangles into x, flipped in place; patch: per triangle
+// Returns the flips.
+// 0.5 (60 deg): a bridge's rim meets its sphere at 78-90 deg, neighbours on a sphere or a bridge
+// differ by under 30; flips across rims left 2 dual cells failing checkMesh's face pyramids on
+// the default bed in 3 pieces (2026-11-30, docs/findings.md).
+inline constexpr double kFlipCreaseCos = 0.5;
+long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& s,
+                           std::vector<std::array<int, 3>>& tris, const std::vector<int>& patch, double band);
+
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
 
 }  // namespace bedforge::meshing

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <numbers>
 #include <set>
 
 #include "meshing/surface/fluid_surface.hpp"
@@ -264,4 +265,19 @@ TEST(PlaneCut, NoVertexIsLeftAHairFromThePlaneBesideIt) {
   ASSERT_GT(cuts, 20);
   ASSERT_GT(cleared, 0) << "no vertex was left near a plane here; the test tests nothing";
   EXPECT_EQ(hairs, 0) << "of " << cuts << " cuts, " << cleared << " cleared";
+}
+
+// Two triangles on an edge whose opposite angles sum to 236 deg, folded by `fold_deg` about it:
+// flipped towards Delaunay when nearly flat (10 deg), kept where they fold by more than
+// acos(kFlipCreaseCos) (64 deg, as a bridge's rim crossing a plane does on the default bed:
+// a flip there spanned the sphere and the bridge, and their dual cells failed checkMesh).
+TEST(PlaneCut, FlipsTowardsDelaunayButNotAcrossACrease) {
+  for (const double fold_deg : {10.0, 64.0}) {
+    const double phi = fold_deg * std::numbers::pi / 180.0;
+    const std::vector<Eigen::Vector3d> x{
+        {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.5, 0.3, 0.0}, {0.5, -0.3 * std::cos(phi), 0.3 * std::sin(phi)}};
+    std::vector<std::array<int, 3>> tris{{0, 1, 2}, {1, 0, 3}};
+    const long flips = flip_towards_delaunay(x, {0.01, 0.01, 0.01, 0.01}, tris, {0, 0}, 1.0);
+    EXPECT_EQ(flips, fold_deg < 60.0 ? 1 : 0) << fold_deg << " deg";
+  }
 }
