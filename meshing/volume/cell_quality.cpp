@@ -162,7 +162,7 @@ FaceFigures face_figures(const std::vector<Eigen::Vector3d>& points, std::span<c
 
 bool FaceFigures::fails(const QualityGate& gate) const {
   return non_orthogonality_deg > gate.max_non_orthogonality_deg || skewness > gate.max_skewness ||
-         pyramid_owner < 0.0 || pyramid_neighbour < 0.0;
+         pyramid_owner < gate.min_face_pyramid_m3 || pyramid_neighbour < gate.min_face_pyramid_m3;
 }
 
 CellQuality cell_quality(const PolyMesh& mesh) { return cell_quality_of(mesh); }
@@ -173,7 +173,7 @@ std::vector<int> CellQuality::bad_cells(const QualityGate& gate, double d_ref) c
   const double min_vol = gate.min_volume_d3 * d_ref * d_ref * d_ref;
   for (std::size_t c = 0; c < volume.size(); ++c)
     if (non_orthogonality_deg[c] > gate.max_non_orthogonality_deg || skewness[c] > gate.max_skewness ||
-        aspect_ratio[c] > gate.max_aspect_ratio || volume[c] < min_vol || min_face_pyramid[c] < 0.0)
+        aspect_ratio[c] > gate.max_aspect_ratio || volume[c] < min_vol || min_face_pyramid[c] < gate.min_face_pyramid_m3)
       bad.push_back(static_cast<int>(c));
   return bad;
 }

@@ -20,13 +20,16 @@ struct QualityGate {
   double max_skewness = 4.0;
   double max_aspect_ratio = 1000.0;
   double min_volume_d3 = 1e-12;  // smallest cell volume, in reference diameters cubed
+  double min_face_pyramid_m3 = 0.0;  // smallest face pyramid, m^3 (absolute, as checkMesh's)
 };
 
 // checkMesh's own limits, which a case's polyhedra (the dual of tetrahedra that passed
 // QualityGate) are checked against: a case that fails them fails Allrun's checkMesh. The dual is
 // not held to the tetrahedra's 85 deg: it exceeds that on meshes that pass checkMesh and whose
-// flow converges (docs/findings.md, session 44). The volume limit is the tetrahedra's.
-inline constexpr QualityGate kCheckMeshLimits{90.0, 4.0, 1000.0, 1e-12};
+// flow converges (docs/findings.md, session 44). The volume limit is the tetrahedra's. A face
+// pyramid fails checkMesh below -SMALL = -1e-15 m^3 (primitiveMesh::checkFacePyramids' default),
+// whatever the mesh's size: a cell of a 3 mm bed at -1e-8 d^3 (-2.7e-16 m^3) passes it.
+inline constexpr QualityGate kCheckMeshLimits{90.0, 4.0, 1000.0, 1e-12, -1e-15};
 
 // Per-cell and summary quality of a PolyMesh, with OpenFOAM's definitions
 // (primitiveMeshTools): non-orthogonality of an internal face is the angle between its area

@@ -409,10 +409,10 @@ JudgedQuality check_polyhedra(PolyhedralMesh& dual, std::vector<bool> judged, st
   worst.failure = fmt::format(
       "{}: {} of {} cells fail checkMesh's limits (max non-orthogonality {:.1f} deg, limit {}; max skewness {:.2f}, "
       "limit {}; max aspect ratio {:.0f}, limit {}; min volume {:.2e} d^3, limit {:.0e}; smallest face pyramid "
-      "{:.2e} d^3, limit 0){}, most near {}; cells written to {}",
+      "{:.2e} d^3, limit {:.2e} (checkMesh's {:.0e} m^3)){}, most near {}; cells written to {}",
       what, bad.size(), worst.cells, worst.max_non_orthogonality_deg, gate.max_non_orthogonality_deg,
       worst.max_skewness, gate.max_skewness, worst.max_aspect_ratio, gate.max_aspect_ratio, worst.min_volume / d3,
-      gate.min_volume_d3, worst.min_face_pyramid / d3,
+      gate.min_volume_d3, worst.min_face_pyramid / d3, gate.min_face_pyramid_m3 / d3, gate.min_face_pyramid_m3,
       merged ? fmt::format(" after {} cells were merged with their neighbours across failing faces", merged) : "",
       where.summary, bad_cells_path.string());
   return worst;

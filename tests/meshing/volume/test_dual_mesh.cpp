@@ -244,13 +244,32 @@ TEST(DualMesh, PolyhedraFailingCheckMeshsLimitsAreSaidWhereJudged) {
   const auto vtk = dir / "bad_polyhedra.vtk";
   const JudgedQuality q = check_polyhedra(cube, {}, nullptr, bed, 1.0, "the cube's polyhedra", vtk);
   EXPECT_EQ(q.failing_cells, 1);
-  for (const char* said : {"the cube's polyhedra: 1 of 1 cells", "smallest face pyramid -2.29e-01 d^3, limit 0",
+  for (const char* said : {"the cube's polyhedra: 1 of 1 cells", "smallest face pyramid -2.29e-01 d^3, limit -1.00e-15",
                            "particle 0", "bad_polyhedra.vtk"})
     EXPECT_NE(q.failure.find(said), std::string::npos) << said << " not in: " << q.failure;
   EXPECT_TRUE(std::filesystem::exists(vtk));
   // A cell not judged (a neighbour's, around a piece) does not fail the piece; the stale file goes.
   EXPECT_EQ(check_polyhedra(cube, {false}, nullptr, bed, 1.0, "the cube's polyhedra", vtk).cells, 0);
   EXPECT_FALSE(std::filesystem::exists(vtk));
+}
+
+// checkMesh fails a face pyramid below -SMALL = -1e-15 m^3 whatever the cell's size, so the same
+// turned cube (its pyramid -11/48 of its volume) passes at 10 um (-2.3e-16 m^3) and fails at
+// 100 um (-2.3e-13 m^3).
+TEST(DualMesh, AFacePyramidFailsBelowCheckMeshsAbsoluteLimit) {
+  Bed bed;
+  bed.centres = {Eigen::Vector3d(0.5, 0.5, 2.0)};
+  bed.diameters = {1.0};
+  const auto dir = cli_test::fresh_dir("dual_pyramid_limit");
+  std::filesystem::create_directories(dir);
+  for (const double size : {1e-5, 1e-4}) {
+    std::vector<Eigen::Vector3d> corners{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    for (auto& c : corners) c *= size;
+    PolyhedralMesh cube = one_hexahedron(corners, {7, 6, 5, 4});
+    const JudgedQuality q = check_polyhedra(cube, {}, nullptr, bed, size, "the cube", dir / "bad.vtk");
+    EXPECT_NEAR(q.min_face_pyramid, -11.0 / 48.0 * size * size * size, 1e-3 * size * size * size);
+    EXPECT_EQ(q.failing_cells, size < 5e-5 ? 0 : 1) << size << " m: " << q.failure;
+  }
 }
 
 TEST(DualMesh, PiecesJudgedApartAddUpToOneMeshsFigures) {
