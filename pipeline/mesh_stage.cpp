@@ -174,10 +174,15 @@ void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_he
   throw InputError(fmt::format(
       "mesh.pieces = {}: a piece would take at least {:.1f} GB to mesh ({:.3g} million cells of the whole bed shared "
       "among the pieces, an estimate that errs low), and a rank may take {:.1f} GB here ({} rank{} on this "
-      "machine sharing its memory); allowed: mesh.pieces >= {} (with as many ranks, spread over machines), fewer "
-      "ranks per machine, or a longer surface.edge_length_d",
+      "machine sharing its memory); allowed: {}",
       pieces, per_piece / 1e9, e.cells / 1e6, available_bytes / 1e9, ranks_here, ranks_here == 1 ? "" : "s",
-      static_cast<int>(std::ceil(e.mesh_peak_bytes / available_bytes))));
+      pieces_memory_remedies(
+          fmt::format("mesh.pieces >= {}", static_cast<int>(std::ceil(e.mesh_peak_bytes / available_bytes))))));
+}
+
+std::string pieces_memory_remedies(const std::string& more_pieces) {
+  return more_pieces + " (with as many ranks, spread over machines), fewer ranks per machine, or a longer "
+                       "surface.edge_length_d";
 }
 
 }  // namespace bedforge::pipeline

@@ -88,4 +88,8 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
 // took 3060 MB (docs/mesh_case_benchmark.md, pieces).
 void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes);
 
+// What a user may change when the pieces' ranks lack memory, for the "allowed:" of a message;
+// `more_pieces` says how many pieces (e.g. "mesh.pieces >= 6").
+std::string pieces_memory_remedies(const std::string& more_pieces);
+
 }  // namespace bedforge::pipeline

@@ -29,6 +29,7 @@
 #include "meshing/volume/flat_ears.hpp"
 #include "meshing/volume/processor_patches.hpp"
 #include "meshing/volume/slab_mesh.hpp"
+#include "pipeline/mesh_stage.hpp"
 
 namespace bedforge::pipeline {
 
@@ -274,10 +275,8 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
       throw InputError(fmt::format(
           "mesh.pieces = {}: {} was killed by signal 9 ({}), most likely by the kernel for want of memory (each "
           "rank checks its piece against its share of this machine's memory before it starts, by an estimate that "
-          "errs low); "
-          "allowed: more pieces (with as many ranks, spread over machines), fewer ranks per machine, or a longer "
-          "surface.edge_length_d; see {}",
-          pieces, which, said.signal_name, log.string()));
+          "errs low); allowed: {}; see {}",
+          pieces, which, said.signal_name, pieces_memory_remedies("more pieces"), log.string()));
     if (said.signal > 0)
       throw std::runtime_error(fmt::format("the case's pieces: {} stopped on signal {} ({}); see {}", which,
                                            said.signal, said.signal_name, log.string()));
