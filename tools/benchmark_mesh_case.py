@@ -83,6 +83,11 @@ pieces_large: the same bed 3 times longer (--pieces-large-spheres spheres), the 
         spheres per rank the default bed leaves at 8 ranks.
 weak_scaling: --weak-spheres spheres per rank, the column P times longer on P ranks (each of --weak-ranks).
 projection: the largest rank's peak and time, fitted on the pieces sections' ranks, projected to 1e5 and 1e6 spheres.
+pieces_1e4: issue 58's own bed (a = 14, N = 1e4, bridges, 0.1 d, tetrahedra, not solved) in one piece, then in P
+        pieces on P ranks (each of --pieces-1e4-ranks): each rank's peak and time, checkMesh in parallel, and at 4
+        ranks the pieces joined by reconstructParMesh and checked whole; the issue's targets for it.
+weak_scaling_1e4: --weak-1e4-spheres spheres per rank at a = 14 (bridges, 0.1 d, tetrahedra), on 1, 2 and 4 ranks.
+projection_1e4: the projection from pieces_1e4's ranks.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
 stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stage's: bedforge
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
@@ -108,7 +113,8 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice", "pieces", "pieces_large", "weak_scaling", "projection"]
+            "periodic_slice", "pieces", "pieces_large", "weak_scaling", "projection", "pieces_1e4", "weak_scaling_1e4",
+            "projection_1e4"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -693,6 +699,26 @@ def pieces_scene(count, solve, spheres=None):
     return text
 
 
+BED_1E4 = ("a = 14, seed 1, bridges, surface edge 0.1 d (0.033 d where contacts meet), no refinement across gaps, "
+           "gmsh's tetrahedra as the case's cells, not solved (the scale_1e4 scene: its one-piece mesh stage took "
+           "14.2 GB; simpleFoam on it would take some 37 GB here)")
+
+
+def bed_1e4_scene(count, solve, spheres=10000):
+    """Issue 58's bed (BED_1E4) with `spheres` spheres (the column longer or shorter), in `count` pieces (0: one
+    piece); `solve` must be False (simpleFoam on it does not fit here)."""
+    if solve:
+        raise SystemExit("bed_1e4_scene: the 1e4 bed is not solved on this machine")
+    text = scene(14, spheres, "bridge", 0.1, False)
+    for old, new in [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'),
+                     ("run = false", 'run = false\ncells = "tetrahedra"'),
+                     ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')]:
+        if old not in text:
+            raise SystemExit(f"scene(): no {old}; update bed_1e4_scene")
+        text = text.replace(old, new, 1)
+    return text
+
+
 def timed_run(path, text, env):
     """`bedforge run` of the scene `text` (written to path.toml) into `path`: its wall time (s)."""
     open(path + ".toml", "w").write(text)
@@ -715,17 +741,21 @@ def one_rank_piece(path, env):
     return time.time() - t0
 
 
-def pieces(tmp, ranks, spheres=500, solved=(0, 2)):
+def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=()):
     """Issue 58 on one machine: the default bed with shrink (`spheres` of them) in one piece (mesh stage,
     then the case stage's dual, and the solve when 0 is in `solved`), then in P pieces on P ranks
     (`[mesh] pieces = P`, mpirun oversubscribed where P exceeds the cores): each rank's peak and time,
     the run's wall time, dp/L where P is in `solved` against one piece's. P = 1 is one rank's piece of
-    the one-piece run's case (`bedforge piece`). The one-piece run is left out when `solved` is empty."""
+    the one-piece run's case (`bedforge piece`). The one-piece run is left out when `one_piece` is false
+    (by default when `solved` is empty). `make_scene(count, solve, spheres)` gives the scene (pieces_scene,
+    bed_1e4_scene); for P in `reconstruct` the pieces are joined (reconstructParMesh) and checked whole."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
     rows = []
-    for p in ([0] if solved else []) + ranks:
-        path = os.path.join(tmp, f"pieces_{spheres}_{p}")
-        wall = timed_run(path, pieces_scene(p if p > 1 else 0, p in solved, spheres), env)
+    one_run = bool(solved) if one_piece is None else one_piece
+    for p in ([0] if one_run else []) + ranks:
+        # P = 1 takes the one-piece run's case when there is one, not a second run of it.
+        path = os.path.join(tmp, f"pieces_{spheres}_{0 if p == 1 and one_run else p}")
+        wall = 0.0 if p == 1 and one_run else timed_run(path, make_scene(p if p > 1 else 0, p in solved, spheres), env)
         rep = json.load(open(os.path.join(path, "report.json")))
         case = rep["stages"]["case"]
         row = {"pieces": p, "spheres": spheres, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
@@ -750,23 +780,29 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2)):
                     env=dict(env, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")).stdout
                 row["check_mesh_ok"] = "Mesh OK." in log
                 row["check_mesh_failed"] = re.findall(r"^\s*\*\*\*(.*)$", log, re.M)
+            if p in reconstruct:
+                case_dir = os.path.join(path, "case")
+                t_join, _ = timed(["reconstructParMesh", "-constant", "-case", case_dir])
+                ok, cells, _, _, check_s = check_mesh(case_dir)
+                row["reconstructed"] = {"mesh_ok": ok, "cells": cells, "reconstruct_s": t_join, "check_mesh_s": check_s}
         rows.append({**commit_and_date(), **row})
     return rows
 
 
-def weak_scaling(tmp, ranks, per_rank):
+def weak_scaling(tmp, ranks, per_rank, make_scene=pieces_scene, bed=None):
     """Issue 58's weak scaling: beds of `per_rank` x P spheres (a = 5, the column P times longer) in P
     pieces on P ranks, the case written (not solved); P = 1 is one rank's piece of the one-piece run's
-    case, as in pieces(). Each rank's peak and time."""
+    case, as in pieces(). Each rank's peak and time. `make_scene` and `bed` (its description, for the section)
+    as in pieces()."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
     rows = []
     for p in ranks:
-        path = os.path.join(tmp, f"weak_{p}")
-        wall = timed_run(path, pieces_scene(p if p > 1 else 0, False, per_rank * p), env)
+        path = os.path.join(tmp, f"weak_{per_rank}_{p}")
+        wall = timed_run(path, make_scene(p if p > 1 else 0, False, per_rank * p), env)
         if p == 1:
             wall = one_rank_piece(path, env)
         ranks_out = [json.load(open(os.path.join(path, "case", f"processor{k}", "bedforge_piece.json"))) for k in range(p)]
-        rows.append({**commit_and_date(), "ranks": p, "spheres": per_rank * p, "wall_s": wall,
+        rows.append({**commit_and_date(), **({"bed": bed} if bed else {}), "ranks": p, "spheres": per_rank * p, "wall_s": wall,
                      "cells": sum(r["cells"] for r in ranks_out),
                      "rank_cells": [r["cells"] for r in ranks_out],
                      "rank_peak_mb": [r["peak_memory_mb"] for r in ranks_out], "rank_time_s": [r["time_s"] for r in ranks_out]})
@@ -776,11 +812,12 @@ def weak_scaling(tmp, ranks, per_rank):
 def weak_scaling_lines(rows):
     """Issue 58's weak-scaling target: the largest rank's peak within 20 % of one rank's, 1 to 4 ranks."""
     one = max(rows[0]["rank_peak_mb"])
-    lines = ["## Weak scaling of the pieces: a bed P times longer on P ranks (issue 58)", "",
-             f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml with contacts shrunk (a = 5, 0.15 d, "
-             f"4 cells per gap, seed 1) and {rows[0]['spheres']} spheres per rank, the column P times longer; `[mesh] "
-             "pieces = P`, the case written, not solved (P = 1: one rank's piece of the one-piece run's case). Ranks "
-             "beyond the 2 cores are oversubscribed, so their times are not a speed-up.", "",
+    bed = rows[0].get("bed", "scenes/default.toml with contacts shrunk (a = 5, 0.15 d, 4 cells per gap, seed 1)")
+    lines = [f"## Weak scaling of the pieces: a bed P times longer on P ranks ({bed.split(',')[0]}; issue 58)", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. {bed[0].upper() + bed[1:]}; {rows[0]['spheres']} spheres "
+             "per rank, the column P times longer; `[mesh] pieces = P`, the case written, not solved (P = 1: one rank's "
+             "piece of the one-piece run's case). Ranks beyond the 2 cores are oversubscribed, so their times are not "
+             "a speed-up.", "",
              "| ranks | spheres | polyhedra | ranks' polyhedra, largest / smallest | largest rank's peak (MB) | x one rank's | "
              "ranks' time (s) | run's wall time (s) |",
              "|---|---|---|---|---|---|---|---|"]
@@ -797,10 +834,11 @@ def weak_scaling_lines(rows):
     return lines
 
 
-def projection(results):
-    """Issue 58's projection to 1e5 and 1e6 spheres on 64 to 1024 ranks, from the pieces section's measured ranks (no
-    runs): the largest rank's peak and time fitted as a + b x spheres per rank (least squares over 1 to 8 ranks)."""
-    rows = [r for key in ("pieces", "pieces_large") for r in results.get(key, []) if r["pieces"] >= 1]
+def projection(results, keys=("pieces", "pieces_large"), a=5.0, settings=None):
+    """Issue 58's projection to 1e5 and 1e6 spheres on 64 to 1024 ranks, from the measured ranks of the sections
+    `keys` (no runs; their bed's column is a = `a`, its settings said by `settings`): the largest rank's peak and
+    time fitted as a + b x spheres per rank (least squares over 1 to 8 ranks)."""
+    rows = [r for key in keys for r in results.get(key, []) if r["pieces"] >= 1]
     x = [r.get("spheres", 500) / r["pieces"] for r in rows]  # rows before the bed size was recorded: 500
     fit = {}
     for key, field in (("peak_mb", "peak_mb"), ("time_s", "time_s")):
@@ -812,30 +850,34 @@ def projection(results):
     # thinner than the thinnest measured (the fewest spheres per rank, at the measured a = 5) while
     # a <= 5 sqrt(spheres per rank / those fewest).
     table = [{"spheres": n, "ranks": p, "per_rank": n / p, "peak_gb": (fit["peak_mb"]["a"] + fit["peak_mb"]["b"] * n / p) / 1024,
-              "time_s": fit["time_s"]["a"] + fit["time_s"]["b"] * n / p, "widest_a": 5.0 * math.sqrt(n / p / min(x))}
+              "time_s": fit["time_s"]["a"] + fit["time_s"]["b"] * n / p, "widest_a": a * math.sqrt(n / p / min(x))}
              for n in (100000, 1000000) for p in (64, 128, 256, 512, 1024)]
     return {**commit_and_date(), "from": sorted({r["commit"] for r in rows}), "fit": fit, "table": table,
-            "spheres_per_rank": [min(x), max(x)]}
+            "spheres_per_rank": [min(x), max(x)], "a": a, "sections": list(keys),
+            **({"settings": settings} if settings else {})}
 
 
 def projection_lines(r):
     f = r["fit"]
     made_from = r["from"] if isinstance(r["from"], str) else ", ".join(r["from"])
     low, high = r.get("spheres_per_rank", [62, 500])  # results before the range was recorded: the 500-sphere bed's
-    lines = ["## Projection past one machine: 1e5 and 1e6 spheres on 64 to 1024 ranks (issue 58)", "",
-             f"Made at {r['commit']} on {r['date']} from the pieces sections' ranks (made at {made_from}), no runs. The "
+    a = r.get("a", 5.0)
+    settings = r.get("settings", "the default bed's settings (a = 5, shrink, 0.15 d, 4 cells per gap; a wider column "
+                                 "has relatively less wall, about as many cells per sphere)")
+    sections = " and ".join(r.get("sections", ["pieces", "pieces_large"]))
+    lines = [f"## Projection past one machine: 1e5 and 1e6 spheres on 64 to 1024 ranks (from {sections}; issue 58)", "",
+             f"Made at {r['commit']} on {r['date']} from the ranks of {sections} (made at {made_from}), no runs. The "
              f"largest rank's peak and time fitted as a + b x spheres per rank over 1 to 8 ranks ({low:.0f} to "
              f"{high:.0f} spheres per rank): peak "
              f"{f['peak_mb']['a']:.0f} MB + {f['peak_mb']['b']:.2f} MB per sphere (largest residual "
              f"{f['peak_mb']['max_residual']:.0f} MB), time {f['time_s']['a']:.0f} s + {f['time_s']['b']:.3f} s per sphere "
              f"(largest residual {f['time_s']['max_residual']:.0f} s; 4 and 8 ranks ran oversubscribed on 2 cores, so "
-             "the time's slope is high). Assumptions: the default bed's settings (a = 5, shrink, 0.15 d, 4 cells per "
-             "gap; a wider column has relatively less wall, about as many cells per sphere), a rank's cost grows with "
+             f"the time's slope is high). Assumptions: {settings}, a rank's cost grows with "
              "its spheres alone (its pieces' planes and layers are a few per cent), each rank has one core and its "
              "memory to itself, and the pack stage (one process) and simpleFoam (850 bytes per polyhedron together, "
              f"mesh_stage.hpp) are not counted. Not measured past {high:.0f} spheres per rank or 8 ranks. The pieces are "
              f"axial slabs, whose thickness goes as the spheres per rank over the column's cross-section: the measured "
-             f"slabs were no thinner than {low:.0f} spheres' worth at a = 5, and the last column gives the widest "
+             f"slabs were no thinner than {low:.0f} spheres' worth at a = {a:g}, and the last column gives the widest "
              "column (a = D / d) whose slabs stay as thick; a wider bed on that many ranks has thinner slabs, more of "
              "its cost in the planes, and wants blocks (not made yet).", "",
              "| spheres | ranks | spheres per rank | largest rank's peak (GB) | its time (s) | widest column (a) |",
@@ -856,7 +898,8 @@ def pieces_lines(rows):
              f"## A case in pieces on a bed of {spheres} spheres: the memory per rank (issue 58)")
     lines = [title, "",
              f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = {spheres}, seed 1, "
-             "0.15 d, 4 cells per gap) with contacts shrunk (the pieces' planes cannot cut bridges yet), one mesh. " +
+             "0.15 d, 4 cells per gap) with contacts shrunk (the only treatment pieces could cut when this section "
+             "was first made), one mesh. " +
              ("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if one else
               "The case written, not solved. ") +
              "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
@@ -885,8 +928,8 @@ def pieces_lines(rows):
         dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if "dp_pa_m" in r else ""
         lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak:.0f} | {scaled} | "
                      f"{times} | {r['wall_s']:.0f} | {check} | {dp} |")
-    lines += ["", "Issue 58's targets as far as this bed goes (its own bed, a = 14, N = 1e4 with bridges, waits for "
-              "planes that cut bridges, issue 56):", ""]
+    lines += ["", "Issue 58's targets as far as this bed goes (its own bed, a = 14, N = 1e4 with bridges, has its "
+              "section below when made: \"Issue 58's bed in pieces\"):", ""]
     verdict = lambda ok: "**met**" if ok else "**not met**"
     two = next((r for r in rows if r["pieces"] == 2 and "dp_pa_m" in r), None)
     if two and one and "dp_pa_m" in one:
@@ -908,6 +951,66 @@ def pieces_lines(rows):
                      f"{verdict(all(r['check_mesh_ok'] for r in checked))} "
                      f"({', '.join(str(r['pieces']) + ': ' + ('OK' if r['check_mesh_ok'] else 'failed') for r in checked)}).")
     lines.append("")
+    return lines
+
+
+def pieces_1e4_lines(rows):
+    """Issue 58's own bed in pieces: each route's ranks, and the issue's targets for it."""
+    one = next(r for r in rows if r["pieces"] == 0)
+    two = next((r for r in rows if r["pieces"] == 2), None)
+    one_peak = one["stage_peak_mb"]["mesh"]
+    lines = ["## Issue 58's bed in pieces: a = 14, N = 1e4, bridges, 1 to 8 ranks", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. {BED_1E4[0].upper() + BED_1E4[1:]}. *One piece*: the "
+             "run as before pieces, its mesh stage holding the whole mesh. *P pieces*: `[mesh] pieces = P`, the run "
+             "writes the case and starts `mpirun -np P bedforge piece`, each rank cutting, meshing and writing its "
+             "slab as `processorK` (P = 1: one rank's piece of the one-piece run's case). Ranks beyond the 2 cores are "
+             "oversubscribed, so their times are not a speed-up. checkMesh: `mpirun -np P checkMesh -parallel` on "
+             "the pieces as written, no decomposePar" +
+             ("; where marked, the pieces joined by `reconstructParMesh -constant` and checked whole" if any(
+                 "reconstructed" in r for r in rows) else "") + ".", "",
+             "| route | tetrahedra | largest rank's peak (MB) | each rank's peak (MB) | x 2/P of 2 ranks' | ranks' time (s) "
+             "| run's wall time (s) | checkMesh |",
+             "|---|---|---|---|---|---|---|---|"]
+    lines.append(f"| one piece | {one['cells']} | {one_peak:.0f} (mesh stage) | | | | {one['wall_s']:.0f} | |")
+    for r in rows:
+        if r["pieces"] < 1:
+            continue
+        peak = largest_peak(r)
+        scaled = f"{peak / (largest_peak(two) * 2 / r['pieces']):.2f}" if two else ""
+        times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
+        check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
+        if "reconstructed" in r:
+            w = r["reconstructed"]
+            check += (f"; reconstructed ({w['reconstruct_s']:.0f} s): {'OK' if w['mesh_ok'] else 'FAILED'}, "
+                      f"{w['cells']} cells ({w['check_mesh_s']:.0f} s)")
+        each = ", ".join(f"{k['peak_mb']:.0f}" for k in r["ranks"])
+        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak:.0f} | {each} | "
+                     f"{scaled} | {times} | {r['wall_s']:.0f} | {check} |")
+    verdict = lambda ok: "**met**" if ok else "**not met**"
+    lines += ["", "Issue 58's targets on this bed:", ""]
+    four = next((r for r in rows if r["pieces"] == 4), None)
+    if four:
+        ratio = largest_peak(four) / one_peak
+        lines.append(f"- 4 ranks: the largest rank's peak at most a third of the one-piece route's (its mesh stage, "
+                     f"{one_peak / 1024:.1f} GB, measured in the same run): {largest_peak(four) / 1024:.2f} GB, "
+                     f"{ratio:.2f} of it, {verdict(ratio <= 1 / 3)}. The case runs in parallel without decomposePar "
+                     f"(checkMesh -parallel: {'OK' if four['check_mesh_ok'] else 'failed'})" +
+                     (f"; checkMesh on the reconstructed mesh: {verdict(four['reconstructed']['mesh_ok'])}"
+                      if "reconstructed" in four else "") + ".")
+    if two:
+        ratios = [(r["pieces"], largest_peak(r) / (largest_peak(two) * 2 / r["pieces"])) for r in rows if r["pieces"] > 2]
+        if ratios:
+            lines.append("- The largest rank's peak falls as 1/P within 20 % from 2 to 8 ranks (against 2/P of 2 "
+                         "ranks'): " + ", ".join(f"{x:.2f} at {p}" for p, x in ratios) +
+                         f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}.")
+    cells = [r for r in rows if r["pieces"] >= 2]
+    if cells:
+        lines.append("- The pieces' tetrahedra against the one piece's: " +
+                     ", ".join(f"{r['pieces']} pieces {100 * (r['cells'] / one['cells'] - 1):+.2f} %" for r in cells) +
+                     " (the planes' cut faces; gmsh's threads also make other tetrahedra on each run).")
+    lines += ["- dp/L within 0.5 % of the one-piece route's, and scene to dp/L on 2 ranks no slower than one piece: "
+              "not measurable at this edge here (simpleFoam would need some 37 GB); measured at 0.15 d by hand, "
+              "docs/findings.md (2026-11-30, session 52).", ""]
     return lines
 
 
@@ -1375,6 +1478,12 @@ def write(results):
         lines += weak_scaling_lines(results["weak_scaling"])
     if "projection" in results:
         lines += projection_lines(results["projection"])
+    if "pieces_1e4" in results:
+        lines += pieces_1e4_lines(results["pieces_1e4"])
+    if "weak_scaling_1e4" in results:
+        lines += weak_scaling_lines(results["weak_scaling_1e4"])
+    if "projection_1e4" in results:
+        lines += projection_lines(results["projection_1e4"])
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
@@ -1486,6 +1595,8 @@ def main():
     ap.add_argument("--pieces-large-ranks", type=int, nargs="+", default=[2, 4, 8], help="pieces_large: ranks to run")
     ap.add_argument("--weak-ranks", type=int, nargs="+", default=[1, 2, 4], help="weak_scaling: ranks (pieces) to run")
     ap.add_argument("--weak-spheres", type=int, default=200, help="weak_scaling: spheres per rank")
+    ap.add_argument("--pieces-1e4-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces_1e4: ranks to run")
+    ap.add_argument("--weak-1e4-spheres", type=int, default=1250, help="weak_scaling_1e4: spheres per rank (1, 2, 4 ranks)")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -1567,6 +1678,16 @@ def main():
             write(results)
         if "projection" in args.only:
             results["projection"] = projection(results)
+            write(results)
+        if "pieces_1e4" in args.only:
+            results["pieces_1e4"] = pieces(tmp, args.pieces_1e4_ranks, 10000, solved=(), make_scene=bed_1e4_scene,
+                                           one_piece=True, reconstruct=(4,))
+            write(results)
+        if "weak_scaling_1e4" in args.only:
+            results["weak_scaling_1e4"] = weak_scaling(tmp, [1, 2, 4], args.weak_1e4_spheres, bed_1e4_scene, BED_1E4)
+            write(results)
+        if "projection_1e4" in args.only:
+            results["projection_1e4"] = projection(results, ("pieces_1e4",), 14.0, BED_1E4)
             write(results)
 
 
