@@ -281,3 +281,26 @@ TEST(PlaneCut, FlipsTowardsDelaunayButNotAcrossACrease) {
     EXPECT_EQ(flips, fold_deg < 60.0 ? 1 : 0) << fold_deg << " deg";
   }
 }
+
+// A sphere touching the wall of a = 14 (from issue 58's bed, N = 1e4, seed 1, at d = 1) whose
+// bridge's foot on the wall reaches 0.001 d above a plane the pieces are cut at: the wall's
+// ring there runs along an edge of the foot's loop, and a ring point between that edge's ends
+// (a vertex of the wall's triangles, not of the bridge's) left the cut open ("the surface is not
+// closed along the plane", rank 0 of 4, 2026-11-30). The window and its cut close.
+TEST(PlaneCut, AWallRingAlongABridgesFootIsCutClosed) {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(7.0);
+  b.centres = {Eigen::Vector3d(-0.010616186583059101, 0.016356918996382894, 0.040763702623057611) / 0.003};
+  b.diameters = {1.0};
+  SurfaceParams sp;
+  sp.treatment = sp.wall_treatment = Treatment::bridge;
+  sp.edge_length_d = 0.1, sp.contact_edge_length_d = 0.03333;
+  const double plane = 13.686989826380598;
+  sp.clip = true, sp.clip_bottom_d = plane - 1.0, sp.clip_top_d = plane + 1.0;
+  sp.wall_rings_d = {plane};
+  const FluidSurface whole = build_fluid_surface(b, sp);
+  expect_valid(whole.fluid, "the window");
+  const PlaneCut c = cut_by_plane(whole.fluid, plane, {sp.edge_length_d, sp.growth, "outlet", "inlet"});
+  expect_valid(c.below, "below");
+  expect_valid(c.above, "above");
+}
