@@ -699,10 +699,9 @@ def pieces_scene(count, solve, spheres=None):
     return text
 
 
-BED_1E4 = ("a = 14, seed 1, bridges, surface edge 0.1 d (the default 0.05 d where contacts meet: at the scale_1e4 "
-           "scene's 0.033 d a wall ring at a plane left the cut surface open, docs/findings.md 2026-11-30), no "
-           "refinement across gaps, gmsh's tetrahedra as the case's cells, not solved (simpleFoam on it would take "
-           "some 37 GB here)")
+BED_1E4 = ("a = 14, seed 1, bridges, surface edge 0.1 d (the default 0.05 d where contacts meet), no refinement "
+           "across gaps, gmsh's tetrahedra as the case's cells, not solved (simpleFoam on it would take some 37 GB "
+           "here)")
 
 
 def bed_1e4_scene(count, solve, spheres=10000):
