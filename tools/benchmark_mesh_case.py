@@ -845,7 +845,10 @@ def projection(results, keys=("pieces", "pieces_large"), a=5.0, settings=None):
         y = [max(k[field] for k in r["ranks"]) for r in rows]
         mx, my = sum(x) / len(x), sum(y) / len(y)
         b = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sum((xi - mx) ** 2 for xi in x)
-        fit[key] = {"a": my - b * mx, "b": b, "max_residual": max(abs(yi - (my - b * mx) - b * xi) for xi, yi in zip(x, y))}
+        a = my - b * mx
+        if a < 0.0:  # a rank costs no less than nothing: the line through the origin instead
+            a, b = 0.0, sum(xi * yi for xi, yi in zip(x, y)) / sum(xi * xi for xi in x)
+        fit[key] = {"a": a, "b": b, "max_residual": max(abs(yi - a - b * xi) for xi, yi in zip(x, y))}
     # A slab's thickness goes as its spheres over the column's cross-section, so a rank's slab is no
     # thinner than the thinnest measured (the fewest spheres per rank, at the measured a = 5) while
     # a <= 5 sqrt(spheres per rank / those fewest).
@@ -875,7 +878,8 @@ def projection_lines(r):
              f"the time's slope is high). Assumptions: {settings}, a rank's cost grows with "
              "its spheres alone (its pieces' planes and layers are a few per cent), each rank has one core and its "
              "memory to itself, and the pack stage (one process) and simpleFoam (850 bytes per polyhedron together, "
-             f"mesh_stage.hpp) are not counted. Not measured past {high:.0f} spheres per rank or 8 ranks. The pieces are "
+             f"mesh_stage.hpp) are not counted. Not measured outside {low:.0f} to {high:.0f} spheres per rank or past 8 "
+             "ranks (where the free fit's intercept came out negative, the line is taken through the origin). The pieces are "
              f"axial slabs, whose thickness goes as the spheres per rank over the column's cross-section: the measured "
              f"slabs were no thinner than {low:.0f} spheres' worth at a = {a:g}, and the last column gives the widest "
              "column (a = D / d) whose slabs stay as thick; a wider bed on that many ranks has thinner slabs, more of "
