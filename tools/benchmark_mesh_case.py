@@ -845,10 +845,10 @@ def projection(results, keys=("pieces", "pieces_large"), a=5.0, settings=None):
         y = [max(k[field] for k in r["ranks"]) for r in rows]
         mx, my = sum(x) / len(x), sum(y) / len(y)
         b = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sum((xi - mx) ** 2 for xi in x)
-        a = my - b * mx
-        if a < 0.0:  # a rank costs no less than nothing: the line through the origin instead
-            a, b = 0.0, sum(xi * yi for xi, yi in zip(x, y)) / sum(xi * xi for xi in x)
-        fit[key] = {"a": a, "b": b, "max_residual": max(abs(yi - a - b * xi) for xi, yi in zip(x, y))}
+        intercept = my - b * mx
+        if intercept < 0.0:  # a rank costs no less than nothing: the line through the origin instead
+            intercept, b = 0.0, sum(xi * yi for xi, yi in zip(x, y)) / sum(xi * xi for xi in x)
+        fit[key] = {"a": intercept, "b": b, "max_residual": max(abs(yi - intercept - b * xi) for xi, yi in zip(x, y))}
     # A slab's thickness goes as its spheres over the column's cross-section, so a rank's slab is no
     # thinner than the thinnest measured (the fewest spheres per rank, at the measured a = 5) while
     # a <= 5 sqrt(spheres per rank / those fewest).
