@@ -78,7 +78,8 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     ClipHeight h = clip_height(*z, p.clip_shift_d * d, clearance, everything);
     const bool opens = !(h.clearance >= clearance) && can_open;
     if (opens) h = clip_height(*z, p.clip_shift_d * d, clearance, with_shrunk);
-    if (!(h.clearance >= clearance))
+    const bool clear_enough = h.clearance >= clearance || (p.clip_faces_cut_away && h.clearance > 0.0);
+    if (!clear_enough)
       throw InputError(fmt::format(
           "surface.clip_window_d: the {} clip plane at {:.4g} d finds no height within surface.clip_shift_d = {} d "
           "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom{} (at best {:.3g} d, at "

@@ -106,6 +106,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"clip_clearance_d", p.clip_clearance_d},
           {"min_angle_deg", p.min_angle_deg}};
   if (!p.wall_rings_d.empty()) j["wall_rings_d"] = p.wall_rings_d;
+  if (p.clip_faces_cut_away) j["clip_faces_cut_away"] = true;
   return j;
 }
 

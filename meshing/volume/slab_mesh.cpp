@@ -323,13 +323,14 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     // The window's own clip planes go with what lies beyond its cuts: set a further
     // kWindowPlaneSlack_d out and free to move that far, they stay piece_margin_d away and find a
     // height clear of the spheres' ends where surface.clip_shift_d does not (a = 14, N = 1e4:
-    // at best 0.0032 of the 0.005 d clearance within 0.25 d).
+    // at best 0.0032 of the 0.005 d clearance within 0.25 d), or else the clearest height.
     constexpr double kWindowPlaneSlack_d = 1.0;
     const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
     const double margin = piece_margin_d(bed, surface) + kWindowPlaneSlack_d;
     if (k > 0) q.clip_bottom_d = std::max(whole.clip_bottom_d, planes[k - 1] - margin);
     if (k + 1 < slabs) q.clip_top_d = std::min(whole.clip_top_d, planes[k] + margin);
     q.clip_shift_d = std::max(q.clip_shift_d, kWindowPlaneSlack_d);
+    q.clip_faces_cut_away = true;
     q.wall_rings_d = planes;
   }
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
