@@ -21,9 +21,12 @@ def read_csv(path):
 
 
 def commit_and_date():
-    """Which code made a result: the short commit checked out here and today's date."""
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    """Which code made a result: the commit the program was built from (`bedforge --version`, not
+    the checkout, which may be newer than the build), marked "-dirty" if built with uncommitted
+    changes, and today's date."""
+    version = subprocess.run([BEDFORGE, "--version"], capture_output=True, text=True, check=True).stdout.strip()
+    built = version.split("+", 1)[1] if "+" in version else version
+    commit = built[:7] + ("-dirty" if built.endswith("-dirty") else "")
     return {"commit": commit, "date": time.strftime("%Y-%m-%d")}
 
 
@@ -48,7 +51,7 @@ def gaps_not_coarsened(study):
     """Whether a gap-refined study's result was made before its coarser levels coarsened the gaps."""
     if not study.get("cells_per_gap"):
         return False
-    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, study["commit"]],
+    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, study["commit"].removesuffix("-dirty")],
                            cwd=ROOT, capture_output=True, text=True)
     if known.returncode not in (0, 1):  # 1: not an ancestor; anything else: git could not tell
         raise SystemExit(f"cannot tell whether the study made at {study['commit']} coarsened its gaps (after "
