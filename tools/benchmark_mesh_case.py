@@ -894,6 +894,37 @@ def projection_lines(r):
     return lines
 
 
+def rank_columns(r, reference):
+    """A pieces row's columns shared by the pieces sections: its largest rank's peak (MB), that peak over
+    `reference`'s scaled by reference's ranks / P (1 where it falls as 1/P; blank without a reference), the
+    ranks' times (s) and checkMesh's verdict (with the reconstructed mesh's where checked)."""
+    peak = largest_peak(r)
+    scaled = f"{peak_over_1_by_p(r, reference):.2f}" if reference else ""
+    times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
+    check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
+    if "reconstructed" in r:
+        w = r["reconstructed"]
+        check += (f"; reconstructed ({w['reconstruct_s']:.0f} s): {'OK' if w['mesh_ok'] else 'FAILED'}, "
+                  f"{w['cells']} cells ({w['check_mesh_s']:.0f} s)")
+    return f"{peak:.0f}", scaled, times, check
+
+
+def peak_over_1_by_p(r, reference):
+    """r's largest rank's peak over reference's scaled by reference's ranks / r's: 1 where it falls as 1/P."""
+    return largest_peak(r) / (largest_peak(reference) * reference["pieces"] / r["pieces"])
+
+
+def one_over_p_line(rows, reference, verdict):
+    """The target line 'the largest rank's peak falls as 1/P within 20 % up to 8 ranks' against `reference`."""
+    p0 = reference["pieces"]
+    ratios = [(r["pieces"], peak_over_1_by_p(r, reference)) for r in rows if p0 < r["pieces"] <= 8]
+    if not ratios:
+        return []
+    against = "1/P of one rank's, 2" if p0 == 1 else f"{p0}/P of {p0} ranks', {p0 * 2}"
+    return [f"- The largest rank's peak within 20 % of {against} to 8 ranks: " +
+            ", ".join(f"{x:.2f} at {p}" for p, x in ratios) + f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}."]
+
+
 def pieces_lines(rows):
     """Issue 58's section: one piece (when run) against P pieces on P ranks, and its targets as far as measured."""
     one = next((r for r in rows if r["pieces"] == 0), None)
@@ -916,8 +947,6 @@ def pieces_lines(rows):
              "|---|---|---|---|---|---|---|---|"]
     # The peaks are held against the fewest ranks run: one rank, or where one rank's piece would not fit, two.
     fewest = min((r for r in rows if r["pieces"] >= 1), key=lambda r: r["pieces"], default=None)
-    # The largest rank's peak over the fewest ranks' scaled by their count: 1 where it falls as 1/P.
-    peak_ratio = lambda r: largest_peak(r) / (largest_peak(fewest) * fewest["pieces"] / r["pieces"])
     if one:
         lines.append(f"| one piece | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0.0):.0f} (mesh stage), "
                      f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | | | {one['wall_s']:.0f} | | "
@@ -925,12 +954,9 @@ def pieces_lines(rows):
     for r in rows:
         if r["pieces"] < 1:
             continue
-        peak = largest_peak(r)
-        scaled = f"{peak_ratio(r):.2f}"
-        times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
-        check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
+        peak, scaled, times, check = rank_columns(r, fewest)
         dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if "dp_pa_m" in r else ""
-        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak:.0f} | {scaled} | "
+        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak} | {scaled} | "
                      f"{times} | {r['wall_s']:.0f} | {check} | {dp} |")
     lines += ["", "Issue 58's targets as far as this bed goes (its own bed, a = 14, N = 1e4 with bridges, has its "
               "section below when made: \"Issue 58's bed in pieces\"):", ""]
@@ -942,13 +968,7 @@ def pieces_lines(rows):
                      f"the cells differ by {two['cells'] - one['cells']:+d} ({100 * (two['cells'] / one['cells'] - 1):+.2f} %: "
                      "gmsh's threads make other tetrahedra on each run; the pieces themselves add none).")
     if fewest:
-        p0 = fewest["pieces"]
-        ratios = [(r["pieces"], peak_ratio(r)) for r in rows if p0 < r["pieces"] <= 8]
-        if ratios:
-            against = "1/P of one rank's, 2" if p0 == 1 else f"{p0}/P of {p0} ranks', {p0 * 2}"
-            lines.append(f"- The largest rank's peak within 20 % of {against} to 8 ranks: " +
-                         ", ".join(f"{x:.2f} at {p}" for p, x in ratios) +
-                         f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}.")
+        lines += one_over_p_line(rows, fewest, verdict)
     checked = [r for r in rows if r["pieces"] > 1]
     if checked:
         lines.append(f"- checkMesh on the pieces (parallel, no decomposePar): "
@@ -979,16 +999,9 @@ def pieces_1e4_lines(rows):
     for r in rows:
         if r["pieces"] < 1:
             continue
-        peak = largest_peak(r)
-        scaled = f"{peak / (largest_peak(two) * 2 / r['pieces']):.2f}" if two else ""
-        times = "-".join(f"{t:.0f}" for t in (min(k["time_s"] for k in r["ranks"]), max(k["time_s"] for k in r["ranks"])))
-        check = "" if r["pieces"] == 1 else "OK" if r["check_mesh_ok"] else "FAILED: " + "; ".join(r["check_mesh_failed"])
-        if "reconstructed" in r:
-            w = r["reconstructed"]
-            check += (f"; reconstructed ({w['reconstruct_s']:.0f} s): {'OK' if w['mesh_ok'] else 'FAILED'}, "
-                      f"{w['cells']} cells ({w['check_mesh_s']:.0f} s)")
+        peak, scaled, times, check = rank_columns(r, two)
         each = ", ".join(f"{k['peak_mb']:.0f}" for k in r["ranks"])
-        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak:.0f} | {each} | "
+        lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak} | {each} | "
                      f"{scaled} | {times} | {r['wall_s']:.0f} | {check} |")
     verdict = lambda ok: "**met**" if ok else "**not met**"
     lines += ["", "Issue 58's targets on this bed:", ""]
@@ -1005,11 +1018,7 @@ def pieces_1e4_lines(rows):
                      (f"; checkMesh on the reconstructed mesh: {verdict(four['reconstructed']['mesh_ok'])}"
                       if "reconstructed" in four else "") + ".")
     if two:
-        ratios = [(r["pieces"], largest_peak(r) / (largest_peak(two) * 2 / r["pieces"])) for r in rows if r["pieces"] > 2]
-        if ratios:
-            lines.append("- The largest rank's peak falls as 1/P within 20 % from 2 to 8 ranks (against 2/P of 2 "
-                         "ranks'): " + ", ".join(f"{x:.2f} at {p}" for p, x in ratios) +
-                         f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}.")
+        lines += one_over_p_line(rows, two, verdict)
     cells = [r for r in rows if r["pieces"] >= 2]
     if cells:
         lines.append("- The pieces' tetrahedra against the one piece's: " +

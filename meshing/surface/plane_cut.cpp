@@ -146,10 +146,11 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
       if (angle_at(c, a, b) + angle_at(d, a, b) <= std::numbers::pi) continue;
       // An edge where the surface folds (a bridge's rim on its sphere) stays: across it the new
       // triangles would span both faces.
-      if (normal(x, t1).normalized().dot(normal(x, t2).normalized()) < kFlipCreaseCos) continue;
+      const Eigen::Vector3d m1 = normal(x, t1).normalized(), m2 = normal(x, t2).normalized();
+      if (m1.dot(m2) < kFlipCreaseCos) continue;
       if ((s[c] == 0.0 && s[d] == 0.0) || edges.count(edge_key(c, d))) continue;
       const std::array<int, 3> n1{a, d, c}, n2{d, b, c};
-      const Eigen::Vector3d pair = (normal(x, t1).normalized() + normal(x, t2).normalized()).normalized();
+      const Eigen::Vector3d pair = (m1 + m2).normalized();
       if (normal(x, n1).normalized().dot(pair) < 0.8 || normal(x, n2).normalized().dot(pair) < 0.8) continue;
       t1 = n1, t2 = n2;
       changed[ts[0]] = changed[ts[1]] = 1;
