@@ -920,8 +920,8 @@ def one_over_p_line(rows, reference, verdict):
     ratios = [(r["pieces"], peak_over_1_by_p(r, reference)) for r in rows if p0 < r["pieces"] <= 8]
     if not ratios:
         return []
-    against = "1/P of one rank's, 2" if p0 == 1 else f"{p0}/P of {p0} ranks', {p0 * 2}"
-    return [f"- The largest rank's peak within 20 % of {against} to 8 ranks: " +
+    against = "1/P of one rank's" if p0 == 1 else f"{p0}/P of {p0} ranks'"
+    return [f"- The largest rank's peak falls as 1/P within 20 % from {p0} to 8 ranks (against {against}): " +
             ", ".join(f"{x:.2f} at {p}" for p, x in ratios) + f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}."]
 
 
