@@ -59,16 +59,20 @@ constexpr double kDensestVoidFraction = 0.36;
 constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 1200.0;
 
 MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                        const cases::CaseParams& c, double fluid_volume_m3, double gap_cells, double d) {
+                        const cases::CaseParams& c, const meshing::FluidDomainSize& fluid, double d) {
   const bool in_slabs = meshing::slabs_possible(mesh) &&
                         (mesh.slabs > 1 || (mesh.slabs == 0 && meshing::slabs_from_clip_windows(surface)));
   const double mesh_bytes = in_slabs ? 300.0 : 460.0;
   const bool solver = c.run && !c.snappy_cells;
   const double h = std::min(surface.edge_length_d, mesh.max_size_d) * d;  // the edge away from the surfaces
   MeshEstimate e;
-  e.fluid_volume_m3 = fluid_volume_m3;
-  e.gap_cells = gap_cells;
-  e.cells = fluid_volume_m3 / (kEstimateVolumePerCell * h * h * h) + gap_cells;
+  e.fluid_volume_m3 = fluid.volume_m3;
+  e.gap_cells = fluid.gap_cells;
+  // With cells_per_gap, the gaps' cells already hold those graded from the contacts' loops.
+  const double grading = std::clamp(2.0 * (1.0 - surface.contact_edge_length_d / surface.edge_length_d), 0.0, 1.0);
+  e.contact_cells =
+      surface.cells_per_gap > 0.0 ? 0.0 : kCellsPerContactLoopEdge * grading * fluid.contact_loop_edges;
+  e.cells = fluid.volume_m3 / (kEstimateVolumePerCell * h * h * h) + e.gap_cells + e.contact_cells;
   e.mesh_peak_bytes = e.cells * mesh_bytes;
   const double solver_bytes = c.polyhedra ? kSolverBytesPerCellDual : kSolverBytesPerCellTetrahedra;
   e.peak_bytes = solver ? e.cells * solver_bytes : e.mesh_peak_bytes;
@@ -117,12 +121,12 @@ MeshEstimate estimate_mesh(const Scene& scene) {
     const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
     fluid = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
   }
-  return with_cells(scene.surface, scene.mesh, scene.case_params, fluid, 0.0, d);
+  return with_cells(scene.surface, scene.mesh, scene.case_params, {fluid, 0.0, 0.0}, d);
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d) {
-  return with_cells(surface, mesh, case_params, fluid.volume_m3, fluid.gap_cells, d);
+  return with_cells(surface, mesh, case_params, fluid, d);
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
@@ -138,14 +142,17 @@ MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {
 
 std::string estimate_line(const MeshEstimate& e, double available_bytes) {
   const std::string gaps =
-      e.gap_cells > 0.0 ? fmt::format(" ({:.3g} million across narrow gaps)", e.gap_cells / 1e6) : std::string();
+      e.gap_cells > 0.0     ? fmt::format(" ({:.3g} million across narrow gaps)", e.gap_cells / 1e6)
+      : e.contact_cells > 0 ? fmt::format(" ({:.3g} million around contacts)", e.contact_cells / 1e6)
+                            : std::string();
   return fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB available",
                      e.cells / 1e6, gaps, e.peak_bytes / 1e9, e.peak_in_solver ? "simpleFoam" : "mesh stage",
                      available_bytes / 1e9);
 }
 
 nlohmann::json to_json(const MeshEstimate& e) {
-  return {{"cells", e.cells}, {"gap_cells", e.gap_cells}, {"peak_memory_mb", e.peak_bytes / 1048576.0}};
+  return {{"cells", e.cells}, {"gap_cells", e.gap_cells}, {"contact_cells", e.contact_cells},
+          {"peak_memory_mb", e.peak_bytes / 1048576.0}};
 }
 
 void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes) {

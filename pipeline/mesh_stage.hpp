@@ -40,7 +40,12 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 cells where this gives 5.6 M); once the bed is packed, plus the cells its
 //                 narrow gaps add with surface.cells_per_gap (meshing::fluid_domain_profile;
 //                 gmsh made 1.03-1.39 times these cells in nine runs with cells_per_gap 3-8,
-//                 docs/findings.md);
+//                 docs/findings.md); without cells_per_gap, plus kCellsPerContactLoopEdge per
+//                 edge of the loops graded from the contact edge (treated contacts, clip cuts;
+//                 in full up to a contact edge of half the surface edge, then taken to fall
+//                 linearly to none at the surface edge, not measured there): a calibration on a = 14, N = 1e4, bridges (8.5-9.9 cells per
+//                 edge at three edges), validated on a = 5, N = 500 (bridges 9.6-10.1, caps 15.4;
+//                 docs/findings.md, 2026-12-01);
 //   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
 //                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
@@ -52,7 +57,8 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 tetrahedra, 2 processes; docs/findings.md).
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
-  double gap_cells = 0.0;  // of `cells`, those the narrow gaps add
+  double gap_cells = 0.0;      // of `cells`, those the narrow gaps add
+  double contact_cells = 0.0;  // of `cells`, those graded from the contacts' loops (without cells_per_gap)
   double cells = 0.0;
   double mesh_peak_bytes = 0.0;  // the mesh stage's
   double peak_bytes = 0.0;       // the run's: the mesh stage's, or simpleFoam's when the case is run
@@ -68,6 +74,8 @@ MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing:
                            const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d);
 // The estimate's volume per cell in the bulk, edge^3 (above).
 inline constexpr double kEstimateVolumePerCell = 0.24;
+// The estimate's cells per edge of a graded loop (above).
+inline constexpr double kCellsPerContactLoopEdge = 8.0;
 // The console's line for `e` against `available_bytes`, and its report entry (stages.mesh.estimate).
 std::string estimate_line(const MeshEstimate& e, double available_bytes);
 nlohmann::json to_json(const MeshEstimate& e);

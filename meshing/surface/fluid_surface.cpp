@@ -209,6 +209,17 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
                       sphere_slab_volume(r, zc, lo, hi) * per_volume;
     }
   }
+  // A loop's spacing is the contact edge (or less, on a short loop): graded from it up to `edge`.
+  if (p.contact_edge_length_d < p.edge_length_d) {
+    const double graded = 0.5 * (p.contact_edge_length_d + p.edge_length_d) * d;
+    for (std::size_t i = 0; i < bed.size(); ++i)
+      if (tb.kept[i])
+        for (const SphereCut& c : tb.cuts[i])
+          if (c.spacing < graded) out.size.contact_loop_edges += static_cast<double>(c.loop.size());
+    for (const auto& holes : tb.wall_holes)
+      for (const WallHole& h : holes)
+        if (h.spacing < graded) out.size.contact_loop_edges += static_cast<double>(h.loop.size());
+  }
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);
   if (gaps) {
     // The added cells go as one over the volume per cell (GapSpacing::added_cells_profile).
