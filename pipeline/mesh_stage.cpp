@@ -80,9 +80,16 @@ MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::Vo
   return e;
 }
 
+// The part of e.cells the bed's narrow gaps or contacts add, in parentheses ("" when none);
+// `of_them` goes after the count.
+std::string added_cells(const MeshEstimate& e, const char* of_them) {
+  if (e.gap_cells > 0.0) return fmt::format(" ({:.3g} million{} across the bed's narrow gaps)", e.gap_cells / 1e6, of_them);
+  if (e.contact_cells > 0.0) return fmt::format(" ({:.3g} million{} around its contacts)", e.contact_cells / 1e6, of_them);
+  return {};
+}
+
 std::string beyond_memory(const MeshEstimate& e, double available_bytes) {
-  const std::string gaps =
-      e.gap_cells > 0.0 ? fmt::format(" ({:.3g} million of them across the bed's narrow gaps)", e.gap_cells / 1e6) : "";
+  const std::string gaps = added_cells(e, " of them");
   return fmt::format("the volume mesh would take at least {:.3g} million cells{} and {:.1f} GB in {} (an estimate "
                      "that errs low), and this machine has {:.1f} GB available",
                      e.cells / 1e6, gaps, e.peak_bytes / 1e9,
@@ -94,10 +101,16 @@ std::string or_not_run(const MeshEstimate& e) { return e.peak_in_solver ? ", cas
 
 void refuse_edge(const Scene& scene, const MeshEstimate& e, double available_bytes) {
   // Cells scale with h^-3, so the edge that would fit is this one times the cube root of the excess.
+  // (Cells graded around contacts do not: a longer contact edge has fewer.)
   const double fits = scene.surface.edge_length_d * std::cbrt(e.peak_bytes / available_bytes);
-  throw InputError(fmt::format("surface.edge_length_d = {}: {}; allowed: surface.edge_length_d >= {:.3g}, fewer "
+  const std::string contacts =
+      e.contact_cells > 0.0 ? fmt::format(", a longer surface.contact_edge_length_d (now {})",
+                                          scene.surface.contact_edge_length_d)
+                            : std::string();
+  throw InputError(fmt::format("surface.edge_length_d = {}: {}; allowed: surface.edge_length_d >= {:.3g}{}, fewer "
                                "spheres, a clip window (surface.clip_window_d){}",
-                               scene.surface.edge_length_d, beyond_memory(e, available_bytes), fits, or_not_run(e)));
+                               scene.surface.edge_length_d, beyond_memory(e, available_bytes), fits, contacts,
+                               or_not_run(e)));
 }
 
 }  // namespace
@@ -141,10 +154,7 @@ MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {
 }
 
 std::string estimate_line(const MeshEstimate& e, double available_bytes) {
-  const std::string gaps =
-      e.gap_cells > 0.0     ? fmt::format(" ({:.3g} million across narrow gaps)", e.gap_cells / 1e6)
-      : e.contact_cells > 0 ? fmt::format(" ({:.3g} million around contacts)", e.contact_cells / 1e6)
-                            : std::string();
+  const std::string gaps = added_cells(e, "");
   return fmt::format("mesh estimate: at least {:.3g} million cells{}, {:.1f} GB at the peak ({}) of the {:.1f} GB available",
                      e.cells / 1e6, gaps, e.peak_bytes / 1e9, e.peak_in_solver ? "simpleFoam" : "mesh stage",
                      available_bytes / 1e9);

@@ -43,9 +43,10 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 docs/findings.md); without cells_per_gap, plus kCellsPerContactLoopEdge per
 //                 edge of the loops graded from the contact edge (treated contacts, clip cuts;
 //                 in full up to a contact edge of half the surface edge, then taken to fall
-//                 linearly to none at the surface edge, not measured there): a calibration on a = 14, N = 1e4, bridges (8.5-9.9 cells per
-//                 edge at three edges), validated on a = 5, N = 500 (bridges 9.6-10.1, caps 15.4;
-//                 docs/findings.md, 2026-12-01);
+//                 linearly to none at the surface edge, not measured there): a calibration on
+//                 a = 14, N = 1e4, bridges (8.5-9.9 cells per edge at three edges), validated on
+//                 a = 5, N = 500 and a = 4, N = 40 (gmsh made 1.02-1.21 times the estimate, caps
+//                 the most; docs/findings.md, 2026-12-01);
 //   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
 //                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may

@@ -560,18 +560,36 @@ TEST(RunScene, TheMeshEstimateWithGapsIsLowButNear) {
 // estimate in nine runs on four beds, 0.1-0.15 d (docs/findings.md, 2026-12-01); this bed (a = 4,
 // N = 40, 0.15 d) 1.12, and 1.66 times the estimate without the contacts' term. 1.4 leaves room
 // for gmsh's meshes differing between builds and fails the estimate without that term.
+const std::string kBridgedForty =
+    "[container]\ndiameter_d = 4\n[particles]\ncount = 40\ndiameter_m = 0.003\n[contacts]\ntreatment = \"bridge\"\n"
+    "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\ncells_per_gap = 0\n[mesh]\nthreads = 1\n"
+    "[outputs]\nfiles = [\"mesh\"]\n";
+
 TEST(RunScene, TheMeshEstimateAtContactsIsLowButNear) {
-  const std::string text =
-      "[container]\ndiameter_d = 4\n[particles]\ncount = 40\ndiameter_m = 0.003\n[contacts]\ntreatment = \"bridge\"\n"
-      "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\ncells_per_gap = 0\n[mesh]\nthreads = 1\n"
-      "[outputs]\nfiles = [\"mesh\"]\n";
   const fs::path dir = test_support::fresh_dir("estimate_at_contacts");
-  const RunOutcome r = run(read_scene(parse_scene_text(text, "t.toml"), "t.toml"), dir);
+  const RunOutcome r = run(read_scene(parse_scene_text(kBridgedForty, "t.toml"), "t.toml"), dir);
   const double cells = r.stages["mesh"]["cells"].get<double>();
   const double estimate = r.stages["mesh"]["estimate"]["cells"].get<double>();
   ASSERT_GT(r.stages["mesh"]["estimate"]["contact_cells"].get<double>(), 0.0);
   EXPECT_GT(cells, estimate);
   EXPECT_LT(cells, 1.4 * estimate);
+}
+
+// Cells graded around contacts do not fall with the surface edge as the bulk's do: a mesh that
+// does not fit for them names the contact edge too.
+TEST(RunScene, AMeshWhoseContactsDoNotFitNamesTheContactEdge) {
+  const Scene scene = read_scene(parse_scene_text(kBridgedForty, "t.toml"), "t.toml");
+  const Bed bed = pack_stage(scene, {false, false}).bed;
+  const MeshEstimate e = estimate_mesh(scene, bed);
+  ASSERT_GT(e.contact_cells, 0.0);
+  try {
+    refuse_mesh_beyond_memory(scene, bed, 0.5 * e.peak_bytes);
+    FAIL() << "a mesh of " << e.cells << " cells was not refused in half its memory";
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("million of them around its contacts"), std::string::npos) << what;
+    EXPECT_NE(what.find("a longer surface.contact_edge_length_d (now 0.05)"), std::string::npos) << what;
+  }
 }
 
 // A target void fraction sets a periodic section's period from the spheres drawn (a normal size
