@@ -70,8 +70,10 @@ MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::Vo
   e.gap_cells = fluid.gap_cells;
   // With cells_per_gap, the gaps' cells already hold those graded from the contacts' loops.
   const double grading = std::clamp(2.0 * (1.0 - surface.contact_edge_length_d / surface.edge_length_d), 0.0, 1.0);
-  e.contact_cells =
-      surface.cells_per_gap > 0.0 ? 0.0 : kCellsPerContactLoopEdge * grading * fluid.contact_loop_edges;
+  e.contact_cells = surface.cells_per_gap > 0.0
+                        ? 0.0
+                        : kCellsPerContactLoopEdge * grading * fluid.contact_loop_edges +
+                              kCellsPerThinGapContact / surface.edge_length_d * fluid.thin_gap_contacts;
   e.cells = fluid.volume_m3 / (kEstimateVolumePerCell * h * h * h) + e.gap_cells + e.contact_cells;
   e.mesh_peak_bytes = e.cells * mesh_bytes;
   const double solver_bytes = c.polyhedra ? kSolverBytesPerCellDual : kSolverBytesPerCellTetrahedra;
@@ -134,7 +136,7 @@ MeshEstimate estimate_mesh(const Scene& scene) {
     const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
     fluid = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
   }
-  return with_cells(scene.surface, scene.mesh, scene.case_params, {fluid, 0.0, 0.0}, d);
+  return with_cells(scene.surface, scene.mesh, scene.case_params, {fluid, 0.0, 0.0, 0.0}, d);
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,

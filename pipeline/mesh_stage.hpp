@@ -46,7 +46,10 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 linearly to none at the surface edge, not measured there): a calibration on
 //                 a = 14, N = 1e4, bridges (8.5-9.9 cells per edge at three edges), validated on
 //                 a = 5, N = 500 and a = 4, N = 40 (gmsh made 1.02-1.21 times the estimate, caps
-//                 the most; docs/findings.md, 2026-12-01);
+//                 the most); and kCellsPerThinGapContact x d / edge per contact left as a thin gap
+//                 (shrunk, or untreated): a calibration on a = 5, N = 500, shrink (15.2-16.2 at
+//                 0.2-0.1 d, 10 taken), validated on a = 4, N = 80 (1.02-1.36; docs/findings.md,
+//                 2026-12-01);
 //   bytes:        460 per cell, the mesh stage's peak at a = 10, N = 4000 in one piece (3956 MB
 //                 for 8.61 M cells): a calibration on that one run (a = 6, N = 860 gave 490 per
 //                 cell at 2.1 M cells, where gmsh's fixed costs weigh more); 300 where the bed may
@@ -59,7 +62,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 struct MeshEstimate {
   double fluid_volume_m3 = 0.0;
   double gap_cells = 0.0;      // of `cells`, those the narrow gaps add
-  double contact_cells = 0.0;  // of `cells`, those graded from the contacts' loops (without cells_per_gap)
+  double contact_cells = 0.0;  // of `cells`, those graded around contacts (without cells_per_gap)
   double cells = 0.0;
   double mesh_peak_bytes = 0.0;  // the mesh stage's
   double peak_bytes = 0.0;       // the run's: the mesh stage's, or simpleFoam's when the case is run
@@ -77,6 +80,8 @@ MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing:
 inline constexpr double kEstimateVolumePerCell = 0.24;
 // The estimate's cells per edge of a graded loop (above).
 inline constexpr double kCellsPerContactLoopEdge = 8.0;
+// The estimate's cells per contact left as a thin gap, times d / edge (above).
+inline constexpr double kCellsPerThinGapContact = 10.0;
 // The console's line for `e` against `available_bytes`, and its report entry (stages.mesh.estimate).
 std::string estimate_line(const MeshEstimate& e, double available_bytes);
 nlohmann::json to_json(const MeshEstimate& e);

@@ -18,7 +18,10 @@ void ContactTreatment::pair(std::size_t i, std::size_t j, const NeighbourList& n
   const bool treated = gap < treat_below(p_.treatment);
   if ((treated && beyond_planes(key(i, j), who)) || !out_.kept[i] || !out_.kept[j]) return;
   if (!treated) {
-    if (p_.treatment == Treatment::shrink && dist - (ri + rj) / scale_ <= kContact * d_) ++treated_pp_;
+    if (dist - (ri + rj) / scale_ <= kContact * d_) {
+      if (p_.treatment == Treatment::shrink) ++treated_pp_;
+      ++out_.thin_gap_contacts;
+    }
     return gap_left(gap, nullptr, who);
   }
   const Eigen::Vector3d a = (cj - ci) / dist;

@@ -44,7 +44,10 @@ void ContactTreatment::wall(std::size_t i, const Wall& w, const NeighbourList& n
   const bool treated = gap < treat_below(t);
   if ((treated && beyond_planes(key(i, bed_.size() + w.index), who)) || !out_.kept[i]) return;
   if (!treated) {
-    if (t == Treatment::shrink && w.gap(c, r / scale_) <= kContact * d_) ++treated_pw_;
+    if (w.gap(c, r / scale_) <= kContact * d_) {
+      if (t == Treatment::shrink) ++treated_pw_;
+      ++out_.thin_gap_contacts;
+    }
     return gap_left(gap, &w, who);
   }
   ++treated_pw_;

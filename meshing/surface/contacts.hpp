@@ -31,6 +31,7 @@ struct TreatedBed {
   std::vector<WallHole> inlet_holes, outlet_holes;
   DomainPlanes planes;                            // as used: clip planes move off near-tangent spheres and contacts
   double solid_volume = 0.0;                      // exact volume of the treated solid (m^3)
+  long thin_gap_contacts = 0;                     // contacts left as thin gaps (shrunk, or untreated)
   // Narrowest gap left between a sphere and a cylinder wall around the fluid (m): that wall's
   // facets lie inside it, towards the spheres (an annulus's inner wall's lie away from them).
   // With clip planes, the narrower of the window's and the whole bed's.

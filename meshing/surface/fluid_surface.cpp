@@ -220,6 +220,7 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
       for (const WallHole& h : holes)
         if (h.spacing < graded) out.size.contact_loop_edges += static_cast<double>(h.loop.size());
   }
+  out.size.thin_gap_contacts = static_cast<double>(tb.thin_gap_contacts);
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);
   if (gaps) {
     // The added cells go as one over the volume per cell (GapSpacing::added_cells_profile).

@@ -75,8 +75,8 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
 // its narrow gaps. Throws treat_contacts's InputErrors.
 //   size   the treated bed's exact fluid volume (m^3), the tetrahedra its narrow gaps add to a
 //          mesh of the surface edge everywhere (GapSpacing::added_cells_profile at `volume_per_cell`
-//          edge^3 per cell; 0 without cells_per_gap) and the edges of its graded loops: what
-//          the mesh estimate takes;
+//          edge^3 per cell; 0 without cells_per_gap), the edges of its graded loops and its
+//          contacts left as thin gaps: what the mesh estimate takes;
 //   cells  along the height, `bins` bins of equal height from the inlet z0 to the outlet z1 (m),
 //          each with a weight for the cells a mesh would have there (no unit): the fluid volume
 //          over one edge^3 (the spheres at their treated radii, bridges and caps left out), plus
@@ -96,6 +96,8 @@ struct FluidDomainSize {
   // surface edge (treated contacts, clip planes' cuts; the spheres' and the walls' sides alike);
   // 0 when the contact edge is not the shorter.
   double contact_loop_edges = 0.0;
+  // Contacts left as thin gaps (shrunk, or untreated), each refined around by the volume mesh.
+  double thin_gap_contacts = 0.0;
 };
 struct FluidDomainProfile {
   FluidDomainSize size;
