@@ -563,7 +563,7 @@ const std::string kBridgedForty =
 // Without cells_per_gap the estimate counts the cells graded around contacts: per edge of a
 // treated contact's loop (kCellsPerContactLoopEdge, calibrated on a = 14, N = 1e4) and per
 // contact left as a thin gap (kCellsPerThinGapContact, calibrated on a = 5, N = 500, shrink).
-// gmsh made 1.02-1.36 times the estimate in eleven runs on five beds, 0.1-0.2 d
+// gmsh made 1.02-1.36 times the estimate in fifteen runs on five beds, 0.1-0.2 d
 // (docs/findings.md, 2026-12-01); this bed (a = 4, N = 40, 0.15 d) 1.12 bridged and 1.10 shrunk,
 // and 1.66 and 1.21 times the estimate without the contacts' terms. 1.4 leaves room for gmsh's
 // meshes differing between builds and fails the bridged estimate without its term; the shrunk
