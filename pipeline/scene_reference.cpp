@@ -152,7 +152,8 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"surface.edge_length_d",
        {"target triangle edge; the volume mesh follows it. A mesh whose estimated memory exceeds what the machine has "
         "is refused before packing, naming the edge that would fit; once the bed is packed the estimate is made again "
-        "with its narrow gaps, printed as `mesh estimate` and kept in the report's `stages.mesh.estimate`",
+        "with its narrow gaps (without cells_per_gap, with the cells graded around its contacts), printed as `mesh "
+        "estimate` and kept in the report's `stages.mesh.estimate`",
         "", kWhySurface}},
       {"surface.contact_edge_length_d",
        {"edge on the loops of treated contacts; on a bridge to a wall, times the bridge's length over that of a "
