@@ -52,8 +52,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"axial period: the bed repeats along z every period, with neither floor nor top (a periodic section of a long "
         "bed; `particles.count` in one period sets its void fraction); at least 3 largest diameters; packed by the "
         "accelerated soft-sphere packer, which compresses a longer period down to this one without gravity and "
-        "stops with an error where the spheres jam first; analysed, not meshed (its surface and cyclic case are not "
-        "made yet)"}},
+        "taps them where they jam first, or stops with an error naming the void fraction it jammed at; meshed as a "
+        "cyclic case (its spheres cut by the periodic planes; contacts shrunk or untreated: bridges and caps through "
+        "the planes are not made yet)"}},
       {"container.period_z_m", {"the same in metres"}},
       // [particles]
       {"particles.count",
