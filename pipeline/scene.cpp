@@ -110,7 +110,7 @@ void check_pieces(const Scene& sc) {
 }
 
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
-// periodic planes, no treated contact crossing them, one piece.
+// periodic planes, the bridges and caps they cross opened (not enlarge), one piece.
 void check_periodic_surface(const Scene& sc) {
   if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
   if (sc.surface.clip)

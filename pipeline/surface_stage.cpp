@@ -32,6 +32,9 @@ SurfaceStage surface_stage(const Bed& bed, const meshing::SurfaceParams& p, cons
     const long opened = j["clip"]["inlet"]["contacts_opened"].get<long>() + j["clip"]["outlet"]["contacts_opened"].get<long>();
     if (opened > 0) line += fmt::format(" ({} contacts opened there)", opened);
   }
+  if (j.contains("periodic_planes_m"))
+    if (const long opened = j["periodic_planes_m"]["contacts_opened"].get<long>(); opened > 0)
+      line += fmt::format(", {} contacts opened where the periodic planes cross them", opened);
   SurfaceStage out{built, std::move(j)};  // the entry lives in the stage result, not twice
   finish_stage(out.report, meter, line, console);
   return out;

@@ -109,12 +109,19 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p) {
   using Treatment = SurfaceParams::Treatment;
   for (auto [t, key] : {std::pair{p.treatment, "contacts.treatment"}, std::pair{p.wall_treatment, "contacts.wall_treatment"}})
-    if (t != Treatment::none && t != Treatment::shrink)
-      throw InputError(fmt::format("{} = \"{}\" on a periodic section (container.period_z): its bridges, caps and "
-                                   "unions would cross the periodic planes, which cut spheres only so far; allowed: "
-                                   "\"shrink\" or \"none\" (or no surface: outputs without \"stl\", \"mesh\" "
-                                   "and \"case\")",
-                                   key, treatment_name(t)));
+    if (t == Treatment::enlarge)
+      throw InputError(fmt::format("{} = \"enlarge\" on a periodic section (container.period_z): the contacts a "
+                                   "periodic plane crosses are opened by shrinking their spheres, which their "
+                                   "enlarged neighbours would still overlap; allowed: \"bridge\", \"cap\", "
+                                   "\"shrink\" or \"none\" (or no surface: outputs without \"stl\", \"mesh\" and "
+                                   "\"case\")",
+                                   key));
+}
+
+bool opens_contacts_at_periodic_planes(const SurfaceParams& p) {
+  using Treatment = SurfaceParams::Treatment;
+  auto treated = [](Treatment t) { return t == Treatment::bridge || t == Treatment::cap; };
+  return treated(p.treatment) || treated(p.wall_treatment);
 }
 
 UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p) {
@@ -124,11 +131,13 @@ UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p)
   const double scale = p.treatment == Treatment::shrink ? p.shrink_factor : 1.0;
   auto radius = [&](std::size_t i) { return 0.5 * scale * bed.diameters[i]; };
   // Candidate heights: the middles of the intervals between the spheres' ends over one period
-  // (round it), the 64 widest.
+  // (round it), the 64 widest; where contacts may be opened at the planes, the ends at the
+  // shrunk radius too, so that a sphere crosses a plane at either radius or at neither.
+  const bool opens = opens_contacts_at_periodic_planes(p);
   std::vector<double> ends;
   for (std::size_t i = 0; i < bed.size(); ++i)
-    for (double e : {bed.centres[i].z() - radius(i), bed.centres[i].z() + radius(i)})
-      ends.push_back(e - H * std::floor(e / H));
+    for (double r : {radius(i), opens ? 0.5 * p.shrink_factor * bed.diameters[i] : radius(i)})
+      for (double e : {bed.centres[i].z() - r, bed.centres[i].z() + r}) ends.push_back(e - H * std::floor(e / H));
   std::sort(ends.begin(), ends.end());
   std::vector<std::pair<double, double>> candidates;  // clearance, height
   for (std::size_t k = 0; k < ends.size(); ++k) {

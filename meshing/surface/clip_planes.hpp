@@ -47,9 +47,12 @@ struct ClipPlacement {
 ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes asked,
                                 const std::vector<double>& radius, const ContactExtents& extents);
 
-// InputError naming the key when `p` treats contacts in a way a periodic plane cannot cut yet
-// (bridge, cap, enlarge); the scene reader calls it too, before any work.
+// InputError naming the key when `p` treats contacts in a way a periodic section cannot take
+// (enlarge: see treat_periodic_section); the scene reader calls it too, before any work.
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
+// True when `p` bridges or caps contacts (of pairs or walls): a periodic plane does not cut
+// through them yet, so treat_periodic_section opens those it crosses.
+bool opens_contacts_at_periodic_planes(const SurfaceParams& p);
 
 // A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
 // planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between
@@ -59,9 +62,10 @@ void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
 // a period into [z0, z0 + H), then a copy a period away of each sphere crossing a plane. The
 // bed's container has no period (the copies are its images); copies count in its Sauter mean.
 // twin[i]: for a sphere crossing the upper plane, the index of its copy crossing the lower one,
-// whose cut loop it takes (-1 for the others). Treatments none and shrink only (a bridge, cap or
-// union would cross the planes; refuse_treatments_across_periodic_planes names the key), and
-// InputError when no height lies surface.clip_clearance_d clear of every sphere's end.
+// whose cut loop it takes (-1 for the others). Not enlarge (refuse_treatments_across_periodic_planes
+// names the key); with bridges or caps the heights keep clear of the spheres' ends at their
+// radius and shrunk by contacts.shrink_factor alike. InputError when no height lies
+// surface.clip_clearance_d clear of every sphere's end.
 struct UnwrappedSection {
   Bed bed;
   DomainPlanes planes;

@@ -277,8 +277,61 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
   return out;
 }
 
+namespace {
+
+// The bridges and caps of a laid-out periodic section that its planes cross (by `extents`, a
+// survey of the whole layout), to be opened as a clip window opens them; a sphere and its image
+// a period away shrink alike, and so do their contacts' images, so that the two planes see the
+// same solid.
+ClipOpening periodic_opening(const UnwrappedSection& section, const SurfaceParams& p, const ContactExtents& extents) {
+  const Bed& bed = section.bed;
+  const std::size_t n = bed.size();
+  const double d = reference_diameter(bed), clearance = p.clip_clearance_d * d;
+  const double moved = (1.0 - p.shrink_factor) * largest_diameter(bed);  // as place_clip_planes
+  std::vector<int> image(n, -1);
+  for (std::size_t i = 0; i < section.twin.size(); ++i)
+    if (const int t = section.twin[i]; t >= 0) image[i] = t, image[static_cast<std::size_t>(t)] = static_cast<int>(i);
+  ClipOpening out;
+  out.spheres.assign(n, 0);
+  for (const auto& [k, range] : extents) {
+    bool crosses = false;
+    for (double z : {section.planes.z0, section.planes.z1})
+      crosses = crosses || (range.first < z + clearance + moved && range.second > z - clearance - moved);
+    if (!crosses) continue;
+    const auto [i, j] = contact_of(k, n);
+    out.contacts.insert(k);
+    // The same contact at the other plane, where both spheres have an image there.
+    const int ii = image[i], jj = j < n ? image[j] : static_cast<int>(j);
+    if (ii >= 0 && jj >= 0) {
+      const auto [a, b] = std::minmax(static_cast<std::size_t>(ii), static_cast<std::size_t>(jj));
+      out.contacts.insert(j < n ? contact_key(a, b, n) : contact_key(static_cast<std::size_t>(ii), j, n));
+    }
+    for (std::size_t s : {i, j})
+      if (s < n) {
+        out.spheres[s] = 1;
+        if (image[s] >= 0) out.spheres[static_cast<std::size_t>(image[s])] = 1;
+      }
+  }
+  return out;
+}
+
+}  // namespace
+
 TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p) {
-  TreatedBed out = contact_parts::ContactTreatment(section.bed, p, section.planes).run();
+  // Bridges and caps that the planes cross are opened (a survey of the layout finds them).
+  ContactExtents extents;
+  ClipOpening opening;
+  if (opens_contacts_at_periodic_planes(p)) {
+    const double inf = std::numeric_limits<double>::infinity();
+    contact_parts::ContactTreatment survey(section.bed, p, {-inf, inf, false}, {.record_extents = true});
+    survey.run();
+    extents = survey.extents();
+    opening = periodic_opening(section, p, extents);
+  }
+  const contact_parts::ClipContext context =
+      opens_contacts_at_periodic_planes(p) ? contact_parts::ClipContext{.surveyed = &extents, .opening = &opening}
+                                           : contact_parts::ClipContext{};
+  TreatedBed out = contact_parts::ContactTreatment(section.bed, p, section.planes, context).run();
   // A sphere crossing the upper plane takes its twin's loop on the lower one, moved up a period:
   // the outlet's holes are then the inlet's, bit for bit in x and y, as a cyclic patch needs.
   auto plane_cut = [&](std::size_t i, const char* name) -> SphereCut& {
@@ -293,9 +346,14 @@ TreatedBed treat_periodic_section(const UnwrappedSection& section, const Surface
     for (Eigen::Vector3d& q : upper.loop) q.z() = section.planes.z1;
   }
   out.outlet_holes.clear();  // the outlet is the inlet's mesh, moved up a period
+  long opened = 0;
+  if (out.report.contains("opened_at_clip_planes"))
+    opened = out.report["opened_at_clip_planes"]["particle_particle"].get<long>() +
+             out.report["opened_at_clip_planes"]["particle_wall"].get<long>();
   out.report["periodic_planes_m"] = {{"lower", section.planes.z0}, {"upper", section.planes.z1},
                                      {"clearance_d", section.clearance / reference_diameter(section.bed)},
-                                     {"narrowest_gap_d", section.narrowest_gap / reference_diameter(section.bed)}};
+                                     {"narrowest_gap_d", section.narrowest_gap / reference_diameter(section.bed)},
+                                     {"contacts_opened", opened}};
   return out;
 }
 

@@ -60,7 +60,10 @@ TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes p
 struct UnwrappedSection;  // clip_planes.hpp
 // The same for a periodic section laid out by unwrap_periodic_section: its spheres cut by the
 // two planes, and each loop on the upper plane its twin's on the lower one moved up a period
-// (outlet_holes left empty: the outlet is meshed as a copy of the inlet).
+// (outlet_holes left empty: the outlet is meshed as a copy of the inlet). A bridge or cap that
+// a plane crosses (within surface.clip_clearance_d) is not cut through yet: the contact is
+// opened as a clip window opens it (its spheres, and their images a period away, shrink by
+// contacts.shrink_factor and it is left as a gap); report "periodic_planes_m" counts them.
 TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p);
 
 }  // namespace bedforge::meshing

@@ -173,8 +173,10 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
     EXPECT_NE(m.find(key), std::string::npos) << m;
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
   }
-  const std::string bridged = message(section + "[outputs]\nfiles = [\"case\"]\n");  // bridged by default
-  EXPECT_NE(bridged.find("contacts.treatment = \"bridge\""), std::string::npos) << bridged;
+  // Bridged by default: read (the planes open the bridges they cross); enlarge is refused.
+  EXPECT_EQ(read(section + "[outputs]\nfiles = [\"case\"]\n").container->axial_period(), 0.005);
+  const std::string enlarged = message(section + "[contacts]\ntreatment = \"enlarge\"\n[outputs]\nfiles = [\"case\"]\n");
+  EXPECT_NE(enlarged.find("contacts.treatment = \"enlarge\""), std::string::npos) << enlarged;
 #endif
 }
 

@@ -707,10 +707,32 @@ TEST(FluidSurface, CellsPerGapShortensTheEdgesFacingANarrowGap) {
   EXPECT_LE(longest_edge_near(boxed.fluid, "particles", {1.5, 0.0, 0.6}), 1.6 * 0.05);
 }
 
+// The triangles of a periodic section's inlet and outlet: each at its plane, and the outlet's
+// the inlet's one period up, bit for bit in x and y (each triangle's x and y, sorted).
+void expect_matching_planes(const FluidSurface& fs, const std::string& label) {
+  const double z0 = fs.report["domain_m"]["inlet_z"].get<double>(), z1 = fs.report["domain_m"]["outlet_z"].get<double>();
+  std::array<std::vector<std::array<double, 6>>, 2> planes;
+  for (std::size_t k = 0; k < fs.fluid.triangles.size(); ++k) {
+    const std::string& patch = fs.fluid.patches[fs.fluid.patch[k]];
+    if (patch != "inlet" && patch != "outlet") continue;
+    std::array<std::pair<double, double>, 3> q;
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d& x = fs.fluid.points[fs.fluid.triangles[k][j]];
+      EXPECT_EQ(x.z(), patch == "inlet" ? z0 : z1) << label;
+      q[j] = {x.x(), x.y()};
+    }
+    std::sort(q.begin(), q.end());
+    planes[patch == "outlet"].push_back({q[0].first, q[0].second, q[1].first, q[1].second, q[2].first, q[2].second});
+  }
+  for (auto& plane : planes) std::sort(plane.begin(), plane.end());
+  EXPECT_GT(planes[0].size(), 50u) << label;
+  EXPECT_TRUE(planes[0] == planes[1]) << label << ": the outlet is not the inlet one period up";
+}
+
 // A section of a tube periodic along z (R = 1.5 d, period 3 d): spheres crossing where the
 // periodic planes go are cut there, each once at either plane, so the solid in the domain is
 // every sphere's whole volume; the outlet's triangles are the inlet's, bit for bit in x and y,
-// one period up; treatments that would cross the planes are refused naming the key.
+// one period up.
 TEST(FluidSurface, APeriodicSectionHasMatchingPlanes) {
   auto tube = std::make_shared<Cylinder>(1.5);
   tube->set_axial_period(3.0);
@@ -724,30 +746,40 @@ TEST(FluidSurface, APeriodicSectionHasMatchingPlanes) {
     const double r = t == Treatment::shrink ? 0.5 * p.shrink_factor : 0.5;
     EXPECT_NEAR(fs.report["fluid_volume_exact_m3"].get<double>(),
                 std::numbers::pi * 1.5 * 1.5 * 3.0 - 5.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r, 1e-9);
-    std::array<std::vector<std::array<double, 6>>, 2> planes;  // each triangle's x and y, sorted
-    for (std::size_t k = 0; k < fs.fluid.triangles.size(); ++k) {
-      const std::string& patch = fs.fluid.patches[fs.fluid.patch[k]];
-      if (patch != "inlet" && patch != "outlet") continue;
-      std::array<std::pair<double, double>, 3> q;
-      for (int j = 0; j < 3; ++j) {
-        const Eigen::Vector3d& x = fs.fluid.points[fs.fluid.triangles[k][j]];
-        EXPECT_EQ(x.z(), patch == "inlet" ? z0 : z1);
-        q[j] = {x.x(), x.y()};
-      }
-      std::sort(q.begin(), q.end());
-      planes[patch == "outlet"].push_back({q[0].first, q[0].second, q[1].first, q[1].second, q[2].first, q[2].second});
-    }
-    for (auto& plane : planes) std::sort(plane.begin(), plane.end());
-    EXPECT_GT(planes[0].size(), 50u);
-    EXPECT_TRUE(planes[0] == planes[1]) << treatment_name(t) << ": the outlet is not the inlet one period up";
+    expect_matching_planes(fs, treatment_name(t));
     EXPECT_GT(fs.report["periodic_planes_m"]["clearance_d"].get<double>(), p.clip_clearance_d);
   }
-  SurfaceParams bridged;
-  bridged.treatment = Treatment::bridge;
+}
+
+// Bridges and caps that a periodic plane crosses are opened, not cut through: a touching pair
+// side by side at z = 1.5 and a sphere touching the wall there, with two spheres placed so that
+// only z = 1.5 keeps surface.clip_clearance_d = 0.4 clear of every sphere's end (the others' ends
+// lie 0.3 apart elsewhere). Both contacts are opened at either plane (4), their three spheres
+// shrink and nothing else changes (the fluid volume), and the planes still match; enlarge,
+// whose grown neighbours a shrunk sphere would overlap, is refused naming the key.
+TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
+  auto tube = std::make_shared<Cylinder>(1.5);
+  tube->set_axial_period(3.0);
+  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15}});
+  for (Treatment t : {Treatment::bridge, Treatment::cap}) {
+    SurfaceParams p;
+    p.treatment = p.wall_treatment = t;
+    p.clip_clearance_d = 0.4;
+    const FluidSurface fs = valid_surface(b, p, treatment_name(t));
+    EXPECT_NEAR(fs.report["domain_m"]["inlet_z"].get<double>(), 1.5, 1e-9) << treatment_name(t);
+    EXPECT_EQ(fs.report["periodic_planes_m"]["contacts_opened"].get<long>(), 4) << treatment_name(t);
+    const double r = 0.5 * p.shrink_factor;
+    EXPECT_NEAR(fs.report["fluid_volume_exact_m3"].get<double>(),
+                std::numbers::pi * 1.5 * 1.5 * 3.0 - 4.0 / 3.0 * std::numbers::pi * (3.0 * r * r * r + 2.0 * 0.125), 1e-9)
+        << treatment_name(t);
+    expect_matching_planes(fs, treatment_name(t));
+  }
+  SurfaceParams enlarged;
+  enlarged.treatment = Treatment::enlarge;
   try {
-    build_fluid_surface(b, bridged);
-    ADD_FAILURE() << "bridges through a periodic plane were accepted";
+    build_fluid_surface(b, enlarged);
+    ADD_FAILURE() << "enlarged spheres on a periodic section were accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("contacts.treatment = \"bridge\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("contacts.treatment = \"enlarge\""), std::string::npos) << e.what();
   }
 }
