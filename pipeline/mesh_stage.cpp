@@ -69,10 +69,9 @@ MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::Vo
   e.fluid_volume_m3 = fluid.volume_m3;
   e.gap_cells = fluid.gap_cells;
   // With cells_per_gap, the gaps' cells already hold those graded from the contacts' loops.
-  const double grading = std::clamp(2.0 * (1.0 - surface.contact_edge_length_d / surface.edge_length_d), 0.0, 1.0);
   e.contact_cells = surface.cells_per_gap > 0.0
                         ? 0.0
-                        : kCellsPerContactLoopEdge * grading * fluid.contact_loop_edges +
+                        : kCellsPerContactLoopEdge * fluid.contact_loop_edges +
                               kCellsPerThinGapContact / surface.edge_length_d * fluid.thin_gap_contacts;
   e.cells = fluid.volume_m3 / (kEstimateVolumePerCell * h * h * h) + e.gap_cells + e.contact_cells;
   e.mesh_peak_bytes = e.cells * mesh_bytes;

@@ -42,8 +42,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
 //                 gmsh made 1.03-1.39 times these cells in nine runs with cells_per_gap 3-8,
 //                 docs/findings.md); without cells_per_gap, plus kCellsPerContactLoopEdge per
 //                 edge of the loops graded from the contact edge (treated contacts, clip cuts;
-//                 in full up to a contact edge of half the surface edge, then taken to fall
-//                 linearly to none at the surface edge, not measured there): a calibration on
+//                 weighted by how much grading there is: FluidDomainSize): a calibration on
 //                 a = 14, N = 1e4, bridges (8.5-9.9 cells per edge at three edges), validated on
 //                 a = 5, N = 500 and a = 4, N = 40 (gmsh made 1.02-1.21 times the estimate, caps
 //                 the most); and kCellsPerThinGapContact x d / edge per contact left as a thin gap

@@ -209,16 +209,19 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
                       sphere_slab_volume(r, zc, lo, hi) * per_volume;
     }
   }
-  // A loop's spacing is the contact edge (or less, on a short loop): graded from it up to `edge`.
+  // A loop's spacing is the contact edge (or less, on a short loop): graded from it up to `edge`,
+  // in full up to a contact edge of half the edge, taken to fall linearly to none at the edge.
   if (p.contact_edge_length_d < p.edge_length_d) {
     const double graded = 0.5 * (p.contact_edge_length_d + p.edge_length_d) * d;
+    double edges = 0.0;
     for (std::size_t i = 0; i < bed.size(); ++i)
       if (tb.kept[i])
         for (const SphereCut& c : tb.cuts[i])
-          if (c.spacing < graded) out.size.contact_loop_edges += static_cast<double>(c.loop.size());
+          if (c.spacing < graded) edges += static_cast<double>(c.loop.size());
     for (const auto& holes : tb.wall_holes)
       for (const WallHole& h : holes)
-        if (h.spacing < graded) out.size.contact_loop_edges += static_cast<double>(h.loop.size());
+        if (h.spacing < graded) edges += static_cast<double>(h.loop.size());
+    out.size.contact_loop_edges = edges * std::min(2.0 * (1.0 - p.contact_edge_length_d / p.edge_length_d), 1.0);
   }
   out.size.thin_gap_contacts = static_cast<double>(tb.thin_gap_contacts);
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);

@@ -93,8 +93,10 @@ struct FluidDomainSize {
   double volume_m3 = 0.0;
   double gap_cells = 0.0;
   // Edges on the loops where the mesh is graded from surface.contact_edge_length_d up to the
-  // surface edge (treated contacts, clip planes' cuts; the spheres' and the walls' sides alike);
-  // 0 when the contact edge is not the shorter.
+  // surface edge (treated contacts, clip planes' cuts; the spheres' and the walls' sides alike),
+  // weighted by how much grading there is: 1 up to a contact edge of half the surface edge,
+  // falling linearly to 0 when the two are equal (not measured there); 0 when the contact edge
+  // is not the shorter.
   double contact_loop_edges = 0.0;
   // Contacts left as thin gaps (shrunk, or untreated), each refined around by the volume mesh.
   double thin_gap_contacts = 0.0;
