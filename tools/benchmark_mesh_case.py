@@ -568,7 +568,8 @@ def default_scene_with(seed, treatment, count=None):
 
 def slice_run(path, text):
     """A default-settings run of one bed: its convergence study, void fractions and E&S, or the
-    packer's refusal (a periodic section that jams before its period) as `jammed`."""
+    packer's refusal (a periodic section that jams before its period) as `jammed`, or any other
+    failure of the run (a flow solve that diverged) as `failed`, so that the other beds still run."""
     open(path + ".toml", "w").write(text)
     t0 = time.time()
     out = subprocess.run([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"], capture_output=True,
@@ -576,7 +577,7 @@ def slice_run(path, text):
     if out.returncode == 3 and "jammed" in out.stderr:
         return {"jammed": out.stderr.strip()}
     if out.returncode != 0:
-        raise RuntimeError(f"bedforge run {path}.toml failed:\n{out.stdout}\n{out.stderr}")
+        return {"failed": f"exit {out.returncode}: {out.stderr.strip()}"}
     rep = json.load(open(os.path.join(path, "report.json")))
     case = rep["stages"]["case"]
     finest = case["convergence"]["levels"][0]
@@ -599,7 +600,10 @@ def periodic_slice(tmp, seeds, period_d, count, slices, full_exclude_d, treatmen
     for s in seeds:
         text = default_scene_with(s, treatment).replace("[case]\n", f"[case]\nsection_exclude_d = {full_exclude_d}\n", 1)
         out["full"][str(s)] = slice_run(os.path.join(tmp, f"full_{s}"), text)
-    eps = sum(r["eps_central"] for r in out["full"].values()) / len(out["full"])
+    full = [r for r in out["full"].values() if "study" in r]
+    if not full:
+        raise SystemExit("periodic_slice: no full bed was solved: " + "; ".join(r["failed"] for r in out["full"].values()))
+    eps = sum(r["eps_central"] for r in full) / len(full)
     out["target_void_fraction"] = eps
     a = float(re.search(r"^diameter_d = ([0-9.]+)", open(DEFAULT_SCENE).read(), re.M).group(1))
     out["period_d"] = count / 6.0 / ((1.0 - eps) * (a / 2.0) ** 2)  # spheres' volume over (1 - eps) x cross-section
@@ -608,7 +612,7 @@ def periodic_slice(tmp, seeds, period_d, count, slices, full_exclude_d, treatmen
                          f"not about {period_d} d: change --slice-count")
     s = 0
     target = f"[packing.soft_sphere]\ntarget_void_fraction = {eps:.6f}\n"
-    while sum("jammed" not in r for r in out["slice"].values()) < slices and s < 4 * slices:
+    while sum("study" in r for r in out["slice"].values()) < slices and s < 4 * slices:
         s += 1
         text = default_scene_with(s, treatment, count).replace("[packing.soft_sphere]\n", target, 1)
         out["slice"][str(s)] = slice_run(os.path.join(tmp, f"slice_{s}"), text)
@@ -625,7 +629,7 @@ def slice_lines(v):
              + f", at each seed; then periodic slices of the same tube, packed to the full beds' mean central void "
              f"fraction {v['target_void_fraction']:.4f} (packing.soft_sphere.target_void_fraction; period "
              f"{v['period_d']:.3f} d), at the same settings, seed after seed (a slice that jams before its period is "
-             f"listed and the next seed taken). dp/L: the full bed's over its section "
+             f"listed and the next seed taken; so is a run that fails). dp/L: the full bed's over its section "
              f"({v.get('full_section_exclude_d', 0.5):g} d clear of floor and top), "
              "the slice's over one period; E&S at that section's meshed void fraction.", "",
              "| bed | seed | central eps (packed) | section eps (meshed) | cells (finest) | dp/L finest (Pa/m) | "
@@ -633,8 +637,9 @@ def slice_lines(v):
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for kind in ("full", "slice"):
         for seed, r in v[kind].items():
-            if "jammed" in r:
-                lines.append(f"| {kind} | {seed} | jammed: {r['jammed']} | | | | | | | | | |")
+            if "study" not in r:
+                what = "jammed" if "jammed" in r else "failed"
+                lines.append(f"| {kind} | {seed} | {what}: {r[what]} | | | | | | | | | |")
                 continue
             g = r["study"].get("grid_convergence", {})
             ext = g.get("extrapolated")
@@ -643,7 +648,7 @@ def slice_lines(v):
                          + (f"{ext:.4g} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f}" if ext is not None
                             else f"none ({r['study']['conclusion']}) | | ")
                          + f" | {r.get('contacts_opened', 0) if kind == 'slice' else ''} | {r['wall_s']:.0f} |")
-    solved = {k: [r for r in v[k].values() if "jammed" not in r] for k in ("full", "slice")}
+    solved = {k: [r for r in v[k].values() if "study" in r] for k in ("full", "slice")}
     if not solved["full"] or not solved["slice"]:
         return lines + ["", "Too few beds solved for a comparison.", ""]
 
