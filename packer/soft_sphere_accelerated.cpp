@@ -174,7 +174,8 @@ nlohmann::json compress_period(Spheres& s, Container& container, double period, 
             h, period, eps, e.contacts.max_pair_overlap / p.d_min, e.contacts.max_wall_overlap / p.d_min,
             p.given.overlap_tolerance_d, taps,
             p.given.target_void_fraction > 0.0
-                ? fmt::format("a packing.soft_sphere.target_void_fraction above {:.4f} (the void fraction it jammed at)",
+                ? fmt::format("a packing.soft_sphere.target_void_fraction above {:.4f} (the void fraction it "
+                              "jammed at)",
                               eps)
                 : "fewer spheres (particles.count) or a longer container.period_z"));
       log.recovery({{"reason", "jammed before the period asked for: let out and tapped"},

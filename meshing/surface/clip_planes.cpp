@@ -51,7 +51,6 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
                                 const std::vector<double>& radius, const ContactExtents& extents) {
   const std::size_t n = bed.size();
   const double d = reference_diameter(bed);
-  const double d_max = largest_diameter(bed);
   const double clearance = p.clip_clearance_d * d;
   std::vector<std::pair<double, double>> sphere_ends;
   for (std::size_t i = 0; i < n; ++i) {
@@ -69,7 +68,6 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     const double z = bed.centres[i].z(), r = 0.5 * p.shrink_factor * bed.diameters[i];
     for (double e : {z - r, z + r}) with_shrunk.push_back({e, e});
   }
-  const double moved = (1.0 - p.shrink_factor) * d_max;  // how far a contact's geometry moves when opened
   ClipPlacement out;
   ClipOpening& opening = out.opening;
   opening.spheres.assign(n, 0);
@@ -90,7 +88,7 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     long opened = 0;
     if (opens)
       for (const auto& [k, range] : extents) {
-        if (!(range.first < h.z + clearance + moved && range.second > h.z - clearance - moved)) continue;
+        if (!reaches_plane(range, h.z, opening_reach(bed, p))) continue;
         opening.contacts.insert(k);
         const auto [i, j] = contact_of(k, n);
         opening.spheres[i] = 1;
@@ -104,6 +102,10 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     throw InputError("surface.clip_window_d: the clip planes crossed while moving clear of the bed; allowed: a taller window");
   out.planes = planes;
   return out;
+}
+
+double opening_reach(const Bed& bed, const SurfaceParams& p) {
+  return p.clip_clearance_d * reference_diameter(bed) + (1.0 - p.shrink_factor) * largest_diameter(bed);
 }
 
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p) {

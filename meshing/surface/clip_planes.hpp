@@ -47,6 +47,15 @@ struct ClipPlacement {
 ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPlanes asked,
                                 const std::vector<double>& radius, const ContactExtents& extents);
 
+// How far (m) from a plane a treated contact's z extent may reach and be opened there: the
+// plane's surface.clip_clearance_d plus how far a contact's geometry moves when its spheres
+// shrink by contacts.shrink_factor (for the bed's largest sphere).
+double opening_reach(const Bed& bed, const SurfaceParams& p);
+// True when a contact whose geometry spans `range` (z, m) comes within `reach` (m) of the plane z.
+inline bool reaches_plane(const std::pair<double, double>& range, double z, double reach) {
+  return range.first < z + reach && range.second > z - reach;
+}
+
 // InputError naming the key when `p` treats contacts in a way a periodic section cannot take
 // (enlarge: see treat_periodic_section); the scene reader calls it too, before any work.
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p);

@@ -286,18 +286,14 @@ namespace {
 ClipOpening periodic_opening(const UnwrappedSection& section, const SurfaceParams& p, const ContactExtents& extents) {
   const Bed& bed = section.bed;
   const std::size_t n = bed.size();
-  const double d = reference_diameter(bed), clearance = p.clip_clearance_d * d;
-  const double moved = (1.0 - p.shrink_factor) * largest_diameter(bed);  // as place_clip_planes
+  const double reach = opening_reach(bed, p);
   std::vector<int> image(n, -1);
   for (std::size_t i = 0; i < section.twin.size(); ++i)
     if (const int t = section.twin[i]; t >= 0) image[i] = t, image[static_cast<std::size_t>(t)] = static_cast<int>(i);
   ClipOpening out;
   out.spheres.assign(n, 0);
   for (const auto& [k, range] : extents) {
-    bool crosses = false;
-    for (double z : {section.planes.z0, section.planes.z1})
-      crosses = crosses || (range.first < z + clearance + moved && range.second > z - clearance - moved);
-    if (!crosses) continue;
+    if (!reaches_plane(range, section.planes.z0, reach) && !reaches_plane(range, section.planes.z1, reach)) continue;
     const auto [i, j] = contact_of(k, n);
     out.contacts.insert(k);
     // The same contact at the other plane, where both spheres have an image there.
@@ -321,7 +317,8 @@ TreatedBed treat_periodic_section(const UnwrappedSection& section, const Surface
   // Bridges and caps that the planes cross are opened (a survey of the layout finds them).
   ContactExtents extents;
   ClipOpening opening;
-  if (opens_contacts_at_periodic_planes(p)) {
+  const bool opens = opens_contacts_at_periodic_planes(p);
+  if (opens) {
     const double inf = std::numeric_limits<double>::infinity();
     contact_parts::ContactTreatment survey(section.bed, p, {-inf, inf, false}, {.record_extents = true});
     survey.run();
@@ -329,8 +326,7 @@ TreatedBed treat_periodic_section(const UnwrappedSection& section, const Surface
     opening = periodic_opening(section, p, extents);
   }
   const contact_parts::ClipContext context =
-      opens_contacts_at_periodic_planes(p) ? contact_parts::ClipContext{.surveyed = &extents, .opening = &opening}
-                                           : contact_parts::ClipContext{};
+      opens ? contact_parts::ClipContext{.surveyed = &extents, .opening = &opening} : contact_parts::ClipContext{};
   TreatedBed out = contact_parts::ContactTreatment(section.bed, p, section.planes, context).run();
   // A sphere crossing the upper plane takes its twin's loop on the lower one, moved up a period:
   // the outlet's holes are then the inlet's, bit for bit in x and y, as a cyclic patch needs.
