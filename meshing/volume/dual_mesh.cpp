@@ -20,6 +20,10 @@ namespace bedforge::meshing {
 
 namespace {
 
+// Two boundary faces lie in one plane when their unit normals' dot product exceeds this: a
+// plane's triangles (flat at one height, bit for bit) give exactly 1.
+constexpr double kFlat = 1.0 - 1e-12;
+
 // Compressed rows: row r holds items[offsets[r]] ... items[offsets[r + 1] - 1].
 struct Rows {
   std::vector<int> offsets, items;
@@ -62,7 +66,7 @@ std::string where(const Eigen::Vector3d& x) { return fmt::format("({:.6g}, {:.6g
 }  // namespace
 
 PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& cell_centres, double feature_angle_deg,
-                         std::vector<int>* cell_points) {
+                         std::vector<int>* cell_points, bool join_flat) {
   const int n_points = static_cast<int>(m.points.size());
   const int n_cells = m.cells;
   const int n_faces = static_cast<int>(m.faces.size());
@@ -255,14 +259,35 @@ PolyhedralMesh dual_mesh(const PolyMesh& m, const std::vector<Eigen::Vector3d>& 
       auto on_patch = [&](int f) { return patch_of[f - n_internal] == k; };
       if (std::none_of(around.begin(), around.end(), on_patch)) continue;
       if (feature[p]) {
+        // Each run of the patch's faces about p that lie in one plane (an inlet's, an outlet's, a
+        // box side's) gives one face: their quadrilaterals joined. On a cyclic pair one small
+        // quadrilateral each side, far to the side of both cells' centres, was skewed past
+        // checkMesh's limit of 4 where a sphere's cut met the plane (docs/findings.md, 2026-12-01).
+        auto in_run = [&](int f, int g) {
+          return join_flat && g >= 0 && on_patch(g) &&
+                 boundary[f - n_internal].area.normalized().dot(boundary[g - n_internal].area.normalized()) > kFlat;
+        };
+        std::vector<int> starts;
         for (int f : around) {
           if (!on_patch(f)) continue;
-          const int at = place(m.faces[f], p);
-          const int quad[4] = {point_at[p], midpoint(p, after(m.faces[f], at)), first_boundary_centre + f,
-                               midpoint(before(m.faces[f], at), p)};
-          d.faces.push_back(quad);
-          d.owner.push_back(i);
+          const bool inside_a_run = std::any_of(around.begin(), around.end(),
+                                                [&](int h) { return h != f && next_around(p, h) == f && in_run(h, f); });
+          if (!inside_a_run) starts.push_back(f);
         }
+        const bool ring = starts.empty();  // a whole flat ring about a feature point: its quadrilaterals
+        for (int f : around)
+          if (on_patch(f) && (ring || std::count(starts.begin(), starts.end(), f))) {
+            polygon.assign({point_at[p], midpoint(p, after(m.faces[f], place(m.faces[f], p)))});
+            for (int g = f;;) {
+              polygon.push_back(first_boundary_centre + g);
+              polygon.push_back(midpoint(before(m.faces[g], place(m.faces[g], p)), p));
+              const int next = next_around(p, g);
+              if (ring || next == f || !in_run(g, next)) break;
+              g = next;
+            }
+            d.faces.push_back(polygon);
+            d.owner.push_back(i);
+          }
         continue;
       }
       polygon.clear();

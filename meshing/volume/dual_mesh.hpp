@@ -24,13 +24,17 @@ namespace bedforge::meshing {
 // edge of `mesh` becomes an internal face through the centres of the cells around it (and of the
 // two boundary faces, and its midpoint, when it lies on the boundary); each boundary point
 // becomes, per patch, a face through the centres of its boundary faces, or, at a feature point,
-// one quadrilateral per boundary face (the point, two edge midpoints, the face's centre).
+// one quadrilateral per boundary face (the point, two edge midpoints, the face's centre), joined
+// into one face where consecutive boundary faces lie in one plane (polyDualMesh keeps them
+// apart; on a cyclic pair of planes such small faces were skewed past checkMesh's limit).
 // Internal faces come in upper-triangular order, boundary faces patch by patch as in `mesh`.
 //   cell_points           when given, set to the point of `mesh` of each dual cell (C' = P)
 // std::runtime_error, with the location, when an edge's cells do not form a ring (a mesh
 // that is not a manifold there).
+//   join_flat             false: every feature point's quadrilaterals apart, as polyDualMesh
+//                         makes them (to compare with it)
 PolyhedralMesh dual_mesh(const PolyMesh& mesh, const std::vector<Eigen::Vector3d>& cell_centres,
-                         double feature_angle_deg, std::vector<int>* cell_points = nullptr);
+                         double feature_angle_deg, std::vector<int>* cell_points = nullptr, bool join_flat = true);
 
 // Checks a case's polyhedra against checkMesh's limits (kCheckMeshLimits), so that cells Allrun's
 // checkMesh will fail are found, located and said by bedforge before the run. Two judged cells
