@@ -344,6 +344,15 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       throw InputError(fmt::format("the {}: {}", what, e.what()));
     }
   };
+  // The curved walls' end rows: on a periodic section, as fine as the wall beside them where
+  // spheres cross the planes; else uniform (the structured rings of the inlet and outlet share
+  // them, and two slabs' clip windows share a plane whose row must not depend on either's bed).
+  const bool ends_cut = !box && laid.periodic();
+  const std::vector<int> row_parts = ends_cut ? end_row_parts(R, ring_points(R, wall_edge), z0, z1, field(-1))
+                                              : std::vector<int>{},
+                         inner_row_parts = ends_cut && ann ? end_row_parts(r_in, ring_points(r_in, wall_edge), z0, z1,
+                                                                           field(-1))
+                                                           : std::vector<int>{};
   const double hx = box ? 0.5 * box->size_x() : 0.0, hy = box ? 0.5 * box->size_y() : 0.0;
   auto corner = [&](const Eigen::Vector2d& s, double z) { return Eigen::Vector3d(s.x() * hx, s.y() * hy, z); };
   if (box) {
@@ -362,20 +371,21 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
           [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
     }
   } else {
-    add("wall", Shape::cylinder, R,
-        [&] { return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1), rings); });
+    add("wall", Shape::cylinder, R, [&] {
+      return wall_mesh(R, z0, z1, wall_edge, tb.wall_holes[0], p.growth, true, "wall", field(-1), rings, row_parts);
+    });
     if (ann)
-      add("inner_wall", Shape::cylinder, r_in,
-          [&] {
-            return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1), rings);
-          });
+      add("inner_wall", Shape::cylinder, r_in, [&] {
+        return wall_mesh(r_in, z0, z1, wall_edge, tb.wall_holes[1], p.growth, false, "inner_wall", field(-1), rings,
+                         inner_row_parts);
+      });
   }
   // Inlet and outlet: their edges are the walls' end rows (or the box's edges).
   using Loops = std::vector<std::vector<Eigen::Vector3d>>;
   auto end_boundary = [&](const Frame& frame, double z) {
     if (box) return Loops{box_face_loop({corner({-1, -1}, z), corner({1, -1}, z), corner({1, 1}, z), corner({-1, 1}, z)}, edge)};
-    Loops boundary{circle_loop(frame, R, ring_points(R, wall_edge))};
-    if (ann) boundary.push_back(circle_loop(frame, r_in, ring_points(r_in, wall_edge)));
+    Loops boundary{end_row(frame, R, ring_points(R, wall_edge), row_parts).points};
+    if (ann) boundary.push_back(end_row(frame, r_in, ring_points(r_in, wall_edge), inner_row_parts).points);
     return boundary;
   };
   WallMesh inlet;  // a periodic section's outlet is its copy a period up, so the two are cyclic patches

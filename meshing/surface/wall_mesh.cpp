@@ -54,8 +54,38 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std
   return moves;
 }
 
+EndRow end_row(const Frame& frame, double R, int n, const std::vector<int>& parts) {
+  EndRow row;
+  const double step = 2.0 * std::numbers::pi * R / n;
+  for (int j = 0; j < n; ++j) {
+    const int m = parts.empty() ? 1 : parts[j];
+    for (int i = 0; i < m; ++i) {
+      const double t = j + static_cast<double>(i) / m, theta = t * (2.0 * std::numbers::pi / n);  // as on_circle
+      row.points.push_back(frame.to_world({R * std::cos(theta), R * std::sin(theta), 0.0}));
+      row.angles.push_back(2.0 * std::numbers::pi * t / n);
+      row.spacing.push_back(step / m);
+    }
+  }
+  return row;
+}
+
+std::vector<int> end_row_parts(double R, int n, double z0, double z1, const SpacingField& field) {
+  std::vector<int> parts(n, 1);
+  if (!field) return parts;
+  const double step = 2.0 * std::numbers::pi * R / n;
+  for (int j = 0; j < n; ++j) {
+    const double theta = (j + 0.5) * (2.0 * std::numbers::pi / n);
+    for (double z : {z0, z1}) {
+      const double wanted = field.at({R * std::cos(theta), R * std::sin(theta), z});
+      parts[j] = std::max(parts[j], static_cast<int>(std::ceil(step / wanted - 0.25)));
+    }
+  }
+  return parts;
+}
+
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
-                   bool outward, const std::string& patch, const SpacingField& field, const std::vector<double>& rings) {
+                   bool outward, const std::string& patch, const SpacingField& field, const std::vector<double>& rings,
+                   const std::vector<int>& row_parts) {
   const int n = ring_points(R, edge);
   // Sites lie on a dyadic grid in s whose step divides the period, so a site's copy one period
   // on is its exact translate: the exact predicates then see the two ends of the strip alike
@@ -136,10 +166,9 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
   // 1. Fixed vertices: the end rows and the hole loops; a hole is unrolled around its own
   // centre, so it stays one polygon even where it crosses theta = 0.
   for (double z : {z0, z1}) {
-    const Frame frame = Frame::along(Eigen::Vector3d(0.0, 0.0, z), Eigen::Vector3d::UnitZ());
-    for (int j = 0; j < n; ++j)
-      add_vertex(frame.to_world(on_circle(R, j, n, false, 0.0)),
-                 Eigen::Vector2d(R * wrap_2pi(2.0 * std::numbers::pi * j / n - seam), z), step, true);
+    const EndRow row = end_row(Frame::along(Eigen::Vector3d(0.0, 0.0, z), Eigen::Vector3d::UnitZ()), R, n, row_parts);
+    for (std::size_t k = 0; k < row.points.size(); ++k)
+      add_vertex(row.points[k], Eigen::Vector2d(R * wrap_2pi(row.angles[k] - seam), z), row.spacing[k], true);
   }
   std::vector<std::vector<Eigen::Vector2d>> polygons;
   std::vector<std::vector<int>> loop_sites;

@@ -35,9 +35,29 @@ inline constexpr double kRingSnap = 0.25;
 std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std::vector<WallHole>& holes,
                                                                              const std::vector<double>& rings);
 
+// A curved wall's end row at the height of `frame` (origin on the axis, w along it): n equal
+// intervals of the circle of radius R (m), interval j in parts[j] equal parts (parts empty: one
+// each, the points of circle_loop(frame, R, n) bit for bit). The points (m), their angles (rad)
+// and their spacing (m), as wall_mesh and the faces sharing the row (plane_mesh's boundary) take
+// them.
+struct EndRow {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> angles, spacing;
+};
+EndRow end_row(const Frame& frame, double R, int n, const std::vector<int>& parts);
+
+// Parts for each of the n intervals of the end rows of a curved wall of radius R (m) at heights
+// z0 and z1 (m), so that the rows' spacing follows `field` (at each interval's middle, the larger
+// count of the two heights, so that both rows are alike): next to a sphere cut by a periodic
+// plane near the wall the rows are as fine as the wall beside them. The ends' rows of
+// 0.15 d between such a sphere and the wall 0.1 d from it left tetrahedra of 10 deg under the
+// plane and dual cells failing checkMesh (docs/findings.md, 2026-12-01).
+std::vector<int> end_row_parts(double R, int n, double z0, double z1, const SpacingField& field);
+
 // Lateral wall of the cylinder of radius R about the z axis, z0 <= z <= z1, with holes.
 // Meshed unrolled (s = R theta, z): a staggered lattice of spacing about `edge` (its end rows
-// are circle_loop(Frame at z0 or z1, R, ring_points(R, edge)), the edges of ring_mesh), the
+// are end_row(Frame at z0 or z1, R, ring_points(R, edge), `row_parts`), the edges of the
+// inlet's and outlet's faces), the
 // hole loops, rings graded away from them by `growth`, thinned like sphere_mesh, and a CGAL
 // constrained Delaunay triangulation with the loops as constraints (no vertex is added). The
 // unrolled strip is cut along a lattice generator clear of every hole; its two sides share
@@ -50,7 +70,7 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std
 // of one bed that share a ring cut the wall there alike (pieces on ranks of their own).
 WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vector<WallHole>& holes, double growth,
                    bool outward, const std::string& patch, const SpacingField& field = {},
-                   const std::vector<double>& rings = {});
+                   const std::vector<double>& rings = {}, const std::vector<int>& row_parts = {});
 
 // Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
 // the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the

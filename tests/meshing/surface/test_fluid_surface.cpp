@@ -751,6 +751,56 @@ TEST(FluidSurface, APeriodicSectionHasMatchingPlanes) {
   }
 }
 
+// A periodic section's wall rows at its planes are as fine as the gap beside them: three spheres
+// 0.1 d off the wall of a tube (R = 1.5 d, period 3 d), one per height 0, 1 and 2, so that the
+// planes cross one of them at its equator with its cut circle 0.1 d from the wall. With 4 cells
+// per gap the wall there asks for edges of 0.1 / 4 = 0.025 d; the inlet's edge on the wall keeps
+// to twice that within 0.2 d of the circle (a uniform row of 0.15 d edges left tetrahedra of
+// 10 deg under such a plane, docs/findings.md, 2026-12-01), and the uniform row's edge where the
+// wall is farther from every sphere than cells_per_gap x edge = 0.6 d.
+TEST(FluidSurface, APeriodicSectionsWallRowsAreAsFineAsTheGapBesideThem) {
+  auto tube = std::make_shared<Cylinder>(1.5);
+  tube->set_axial_period(3.0);
+  const double rho = 0.9, tau = 2.0 * std::numbers::pi;
+  const Bed b = column(tube, {{rho, 0.0, 0.0}, {rho * std::cos(tau / 3), rho * std::sin(tau / 3), 1.0},
+                              {rho * std::cos(2 * tau / 3), rho * std::sin(2 * tau / 3), 2.0}});
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::none;
+  p.edge_length_d = 0.15;
+  p.cells_per_gap = 4.0;
+  const FluidSurface fs = valid_surface(b, p, "none");
+  expect_matching_planes(fs, "none");
+  const double z0 = fs.report["domain_m"]["inlet_z"].get<double>();
+  // The crossed sphere's angle, and the inlet's points on the wall by angle.
+  double crossed = NAN;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (std::abs(std::remainder(b.centres[i].z() - z0, 3.0)) < 1e-9) crossed = std::atan2(b.centres[i].y(), b.centres[i].x());
+  ASSERT_FALSE(std::isnan(crossed)) << "the planes cross no sphere at its equator, at z0 = " << z0;
+  std::set<double> angles;
+  for (std::size_t k = 0; k < fs.fluid.triangles.size(); ++k) {
+    if (fs.fluid.patches[fs.fluid.patch[k]] != "inlet") continue;
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d& x = fs.fluid.points[fs.fluid.triangles[k][j]];
+      if (std::abs(std::hypot(x.x(), x.y()) - 1.5) < 1e-9) angles.insert(std::atan2(x.y(), x.x()));
+    }
+  }
+  ASSERT_GT(angles.size(), 20u);
+  const double step = tau * 1.5 / ring_points(1.5, 0.15);
+  int near = 0, far = 0;
+  for (auto it = angles.begin(); std::next(it) != angles.end(); ++it) {
+    const double mid = 0.5 * (*it + *std::next(it)), edge = 1.5 * (*std::next(it) - *it);
+    if (1.5 * std::abs(std::remainder(mid - crossed, tau)) < 0.2) {
+      EXPECT_LT(edge, 2.0 * 0.1 / 4.0) << "at " << mid << " rad";
+      ++near;
+    } else if (1.5 * std::abs(std::remainder(mid - crossed, tau)) > 1.5) {  // beyond cells_per_gap x edge of it
+      EXPECT_NEAR(edge, step, 1e-9) << "at " << mid << " rad";
+      ++far;
+    }
+  }
+  EXPECT_GE(near, 10);
+  EXPECT_GT(far, 20);
+}
+
 // Bridges and caps that a periodic plane crosses are opened, not cut through: a touching pair
 // side by side at z = 1.5 and a sphere touching the wall there, with two spheres placed so that
 // only z = 1.5 keeps surface.clip_clearance_d = 0.4 clear of every sphere's end (the others' ends
