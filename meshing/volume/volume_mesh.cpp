@@ -298,7 +298,8 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
     double cells = 0.0, bytes_per_cell = std::nan("");
   };
   std::optional<Previous> previous;
-  for (const auto& [algorithm, hxt_optimiser] : tries) {
+  for (std::size_t attempt_index = 0; attempt_index < tries.size(); ++attempt_index) {
+    const auto [algorithm, hxt_optimiser] = tries[attempt_index];
     const auto t0 = std::chrono::steady_clock::now();
     const std::string name =
         fmt::format("{}{}", algorithm_name(algorithm), hxt_optimiser ? " (its own optimiser)" : "");
@@ -310,9 +311,10 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       entry[key] = why;
       attempts.push_back(entry);
     };
-    if (hxt_optimiser || previous) {
+    if (attempt_index > 0) {
       // A retry is skipped, not crashed, when it will not fit: about three cells per surface
-      // triangle when no attempt before it gave cells.
+      // triangle when no attempt before it gave cells (the first may have failed or given an
+      // invalid mesh, as gmsh's threaded optimiser now and then does).
       const double cells = previous ? previous->cells : 3.0 * static_cast<double>(boundary.triangles.size());
       const bool measured = previous && previous->algorithm == algorithm && !std::isnan(previous->bytes_per_cell);
       const double need = (measured ? kSameAlgorithmMargin * previous->bytes_per_cell : kRetryBytesPerCell) * cells;
