@@ -68,6 +68,7 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     const double z = bed.centres[i].z(), r = 0.5 * p.shrink_factor * bed.diameters[i];
     for (double e : {z - r, z + r}) with_shrunk.push_back({e, e});
   }
+  const double reach = opening_reach(bed, p);
   ClipPlacement out;
   ClipOpening& opening = out.opening;
   opening.spheres.assign(n, 0);
@@ -88,7 +89,7 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     long opened = 0;
     if (opens)
       for (const auto& [k, range] : extents) {
-        if (!reaches_plane(range, h.z, opening_reach(bed, p))) continue;
+        if (!reaches_plane(range, h.z, reach)) continue;
         opening.contacts.insert(k);
         const auto [i, j] = contact_of(k, n);
         opening.spheres[i] = 1;

@@ -347,12 +347,11 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // The curved walls' end rows: on a periodic section, as fine as the wall beside them where
   // spheres cross the planes; else uniform (the structured rings of the inlet and outlet share
   // them, and two slabs' clip windows share a plane whose row must not depend on either's bed).
-  const bool ends_cut = !box && laid.periodic();
-  const std::vector<int> row_parts = ends_cut ? end_row_parts(R, ring_points(R, wall_edge), z0, z1, field(-1))
-                                              : std::vector<int>{},
-                         inner_row_parts = ends_cut && ann ? end_row_parts(r_in, ring_points(r_in, wall_edge), z0, z1,
-                                                                           field(-1))
-                                                           : std::vector<int>{};
+  auto row_parts_of = [&](double radius) {
+    return !box && laid.periodic() ? end_row_parts(radius, ring_points(radius, wall_edge), z0, z1, field(-1))
+                                   : std::vector<int>{};
+  };
+  const std::vector<int> row_parts = row_parts_of(R), inner_row_parts = ann ? row_parts_of(r_in) : std::vector<int>{};
   const double hx = box ? 0.5 * box->size_x() : 0.0, hy = box ? 0.5 * box->size_y() : 0.0;
   auto corner = [&](const Eigen::Vector2d& s, double z) { return Eigen::Vector3d(s.x() * hx, s.y() * hy, z); };
   if (box) {

@@ -54,13 +54,23 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std
   return moves;
 }
 
+namespace {
+
+// Equal parts of an interval `step` long so that each is about `wanted` (m) long: a quarter over
+// is let pass, so a spacing just under the step does not halve it.
+int parts_for(double step, double wanted) { return std::max(1, static_cast<int>(std::ceil(step / wanted - 0.25))); }
+
+}  // namespace
+
 EndRow end_row(const Frame& frame, double R, int n, const std::vector<int>& parts) {
   EndRow row;
   const double step = 2.0 * std::numbers::pi * R / n;
   for (int j = 0; j < n; ++j) {
     const int m = parts.empty() ? 1 : parts[j];
     for (int i = 0; i < m; ++i) {
-      const double t = j + static_cast<double>(i) / m, theta = t * (2.0 * std::numbers::pi / n);  // as on_circle
+      // theta as on_circle computes it and the angle as the strip's sites did: both rows and
+      // strips stay what they were bit for bit where nothing is divided.
+      const double t = j + static_cast<double>(i) / m, theta = t * (2.0 * std::numbers::pi / n);
       row.points.push_back(frame.to_world({R * std::cos(theta), R * std::sin(theta), 0.0}));
       row.angles.push_back(2.0 * std::numbers::pi * t / n);
       row.spacing.push_back(step / m);
@@ -77,7 +87,7 @@ std::vector<int> end_row_parts(double R, int n, double z0, double z1, const Spac
     const double theta = (j + 0.5) * (2.0 * std::numbers::pi / n);
     for (double z : {z0, z1}) {
       const double wanted = field.at({R * std::cos(theta), R * std::sin(theta), z});
-      parts[j] = std::max(parts[j], static_cast<int>(std::ceil(step / wanted - 0.25)));
+      parts[j] = std::max(parts[j], parts_for(step, wanted));
     }
   }
   return parts;
@@ -258,7 +268,7 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
         const double ds = std::abs(wrap_pi((q.x() - s_mid) / R)) * R, dz = q.y() - z;
         wanted = std::min(wanted, spacing + (growth - 1.0) * std::max(0.0, std::hypot(ds, dz) - 0.5 * step));
       }
-      const int m = std::max(1, static_cast<int>(std::ceil(step / wanted - 0.25)));
+      const int m = parts_for(step, wanted);
       for (int i = 0; i < m; ++i) {
         const double t = static_cast<double>(i) / m, angle = 2.0 * std::numbers::pi * (j + t) / n;
         const Eigen::Vector2d q = on_grid({R * wrap_2pi(angle - seam), z});
