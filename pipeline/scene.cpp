@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
 #include "meshing/surface/clip_planes.hpp"
+#include "meshing/surface/periodic_cut.hpp"
 #endif
 
 namespace bedforge::pipeline {
@@ -113,6 +114,7 @@ void check_pieces(const Scene& sc) {
 // periodic planes, the bridges and caps they cross opened (not enlarge), one piece.
 void check_periodic_surface(const Scene& sc) {
   if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
+  if (sc.surface.cut_at_periodic_planes) meshing::check_periodic_cut(*sc.container, sc.surface, sc.sizes.sauter_mean());
   if (sc.surface.clip)
     throw InputError("surface.clip_window_d on a periodic section: its planes are the period's; allowed: no clip window");
   if (sc.mesh.slabs > 1)
@@ -244,6 +246,9 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
+  if (sc.surface.cut_at_periodic_planes && sc.container->axial_period() == 0.0)
+    throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "
+                     "periodic planes; allowed: \"open\" (the default), or a periodic section");
   if (sc.mesh.pieces > 1) check_pieces(sc);
 #endif
   mesh.finish();

@@ -140,6 +140,12 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "both, spheres shrunk or enlarged, or nothing; the default changes the solid by at most 0.5 %",
         "", kWhyContacts}},
       {"contacts.wall_treatment", {"the same for sphere-wall contacts; `same` follows `treatment`"}},
+      {"contacts.at_periodic_planes",
+       {"periodic section (container.period_z_d), bridges and caps: what its planes do to the treated contacts they "
+        "cross: `open` them (their spheres shrunk by shrink_factor, the contact left a gap) or `cut` them through as "
+        "treated (a surface built over two periods and cut at one plane; cylinder or annulus, a period of at least "
+        "twice max(4 edge_length_d, 0.5) d). `cut` left checkMesh failures at the planes where `open` left none "
+        "(docs/findings.md, 2026-12-01), so `open` is the default"}},
       {"contacts.shrink_factor", {"shrink: sphere scale", "1"}},
       {"contacts.enlarge_factor", {"enlarge: sphere scale", "1"}},
       {"contacts.enlarge_join_gap_d",

@@ -105,6 +105,22 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
   return out;
 }
 
+double piece_margin_d(const Bed& bed, const SurfaceParams& surface) {
+  return 3.0 * largest_diameter(bed) / reference_diameter(bed) + surface.cells_per_gap * surface.edge_length_d +
+         surface.clip_shift_d;
+}
+
+SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, double top_d, std::vector<double> rings_d) {
+  SurfaceParams q = p;
+  q.clip = true;
+  q.clip_bottom_d = bottom_d;
+  q.clip_top_d = top_d;
+  q.clip_shift_d = std::max(q.clip_shift_d, kWindowPlaneSlack_d);
+  q.clip_faces_cut_away = true;
+  q.wall_rings_d = std::move(rings_d);
+  return q;
+}
+
 double opening_reach(const Bed& bed, const SurfaceParams& p) {
   return p.clip_clearance_d * reference_diameter(bed) + (1.0 - p.shrink_factor) * largest_diameter(bed);
 }

@@ -59,9 +59,26 @@ inline bool reaches_plane(const std::pair<double, double>& range, double z, doub
 // InputError naming the key when `p` treats contacts in a way a periodic section cannot take
 // (enlarge: see treat_periodic_section); the scene reader calls it too, before any work.
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
-// True when `p` bridges or caps contacts (of pairs or walls): a periodic plane does not cut
-// through them yet, so treat_periodic_section opens those it crosses.
+// True when `p` bridges or caps contacts (of pairs or walls): treat_periodic_section opens those
+// a periodic plane crosses (unless build_cut_periodic_surface cuts them through).
 bool opens_contacts_at_periodic_planes(const SurfaceParams& p);
+
+// How far (d) a window is widened before its surface is cut at a plane through treated
+// contacts (a slab's, a periodic section's): a sphere crossing a plane, its neighbours (whose
+// contacts shape its cuts) and theirs (which the window's own clip planes may open, moved by up
+// to surface.clip_shift_d), and the surfaces its narrow-gap spacing sees (surface.cells_per_gap
+// edges): 3 largest diameters plus those two lengths. Within it both windows of a plane hold the
+// same spheres, contacts and cuts.
+double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
+
+// A window's own clip planes go with what lies beyond the cuts made in its surface: set
+// kWindowPlaneSlack_d beyond piece_margin_d and free to move that far, they stay piece_margin_d
+// away and find a height clear of the spheres' ends where surface.clip_shift_d does not (a = 14,
+// N = 1e4: at best 0.0032 of the 0.005 d clearance within 0.25 d), or else the clearest height.
+inline constexpr double kWindowPlaneSlack_d = 1.0;
+// `p` as such a window from `bottom_d` to `top_d` (d above the floor), its curved walls ringed at
+// `rings_d` (d), the heights its surface will be cut at.
+SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, double top_d, std::vector<double> rings_d);
 
 // A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
 // planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between

@@ -61,9 +61,10 @@ struct UnwrappedSection;  // clip_planes.hpp
 // The same for a periodic section laid out by unwrap_periodic_section: its spheres cut by the
 // two planes, and each loop on the upper plane its twin's on the lower one moved up a period
 // (outlet_holes left empty: the outlet is meshed as a copy of the inlet). A bridge or cap that
-// a plane crosses (within surface.clip_clearance_d) is not cut through yet: the contact is
-// opened as a clip window opens it (its spheres, and their images a period away, shrink by
-// contacts.shrink_factor and it is left as a gap); report "periodic_planes_m" counts them.
+// a plane crosses (within surface.clip_clearance_d) is opened as a clip window opens it (its
+// spheres, and their images a period away, shrink by contacts.shrink_factor and it is left as a
+// gap); report "periodic_planes_m" counts them. (contacts.at_periodic_planes = "cut" cuts them
+// through instead: build_cut_periodic_surface, which this treatment then only sizes.)
 TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p);
 
 }  // namespace bedforge::meshing

@@ -21,6 +21,7 @@
 #include "core/version.hpp"
 #include "meshing/surface/defect_locations.hpp"
 #include "meshing/surface/clip_planes.hpp"
+#include "meshing/surface/periodic_cut.hpp"
 #include "meshing/surface/contacts.hpp"
 #include "meshing/surface/delaunay_walls.hpp"
 #include "meshing/surface/gap_spacing.hpp"
@@ -60,6 +61,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.bridge_diameter_d = c.number("bridge_diameter_d", p.bridge_diameter_d, Range{0.0, 0.8, true, true});
   p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
   p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
+  p.cut_at_periodic_planes = c.choice("at_periodic_planes", "open", {"open", "cut"}) == "cut";
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
@@ -95,6 +97,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"bridge_diameter_d", p.bridge_diameter_d},
           {"bridge_gap_d", p.bridge_gap_d},
           {"cap_gap_d", p.cap_gap_d},
+          {"at_periodic_planes", p.cut_at_periodic_planes ? "cut" : "open"},
           {"edge_length_d", p.edge_length_d},
           {"contact_edge_length_d", p.contact_edge_length_d},
           {"growth", p.growth},
@@ -234,6 +237,7 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
 }
 
 FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
+  if (cuts_contacts_at_periodic_planes(given, p)) return build_cut_periodic_surface(given, p);
   const double top = bed_height(given);
   LaidOut laid = lay_out(given, p);
   const Bed& bed = laid.bed();

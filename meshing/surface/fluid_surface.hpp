@@ -26,6 +26,9 @@ struct SurfaceParams {
   double bridge_diameter_d = 0.2;
   double bridge_gap_d = 0.01;           // pairs closer than this get a bridge
   double cap_gap_d = 0.02;              // pairs closer than this are capped, leaving this gap
+  // On a periodic section: the bridges and caps its planes cross are cut through (true) or
+  // opened there, their spheres shrunk (false; see treat_periodic_section, build_cut_periodic_surface).
+  bool cut_at_periodic_planes = false;
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
   double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
   double growth = 1.5;                  // edge growth per ring away from those loops

@@ -162,6 +162,11 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
   return flips;
 }
 
+PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
+  return {.edge = s.edge_length_d * d, .growth = s.growth, .cells_per_gap = s.cells_per_gap,
+          .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};
+}
+
 PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) {
   PlaneCut out;
   std::vector<Eigen::Vector3d> x = m.points;

@@ -1,6 +1,7 @@
 #pragma once
 #include <string>
 
+#include "meshing/surface/fluid_surface.hpp"
 #include "meshing/surface/triangle_mesh.hpp"
 
 namespace bedforge::meshing {
@@ -90,5 +91,9 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
                            std::vector<std::array<int, 3>>& tris, const std::vector<int>& patch, double band);
 
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
+
+// The cut's parameters from the surface stage's `s` (d: the reference diameter, m): the
+// surface's edge and its cells across gaps, down to the edge the gaps' spacing allows.
+PlaneCutParams plane_cut_params(const SurfaceParams& s, double d);
 
 }  // namespace bedforge::meshing

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/point_key.hpp"
 #include "core/stage_meter.hpp"
+#include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/plane_cut.hpp"
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/stl_io.hpp"
@@ -151,13 +152,6 @@ void write_msh22(const std::filesystem::path& path, const Joined& j) {
   for (const VolumeCell& c : j.cells) put(std::array<int, 7>{++e, n + 1, n + 1, c.v[0] + 1, c.v[1] + 1, c.v[2] + 1, c.v[3] + 1});
   out << "\n$EndElements\n";
   if (!out) throw std::runtime_error(fmt::format("volume mesh: cannot write {}", path.string()));
-}
-
-// The cut of a plane between slabs (d: the reference diameter, m): the surface's edge and its
-// cells across gaps, down to the edge the gaps' spacing allows (gap_spacing).
-PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
-  return {.edge = s.edge_length_d * d, .growth = s.growth, .cells_per_gap = s.cells_per_gap,
-          .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};
 }
 
 // What a slab's report says of one of its plane cuts (at `plane_d`, d above the floor).
@@ -304,12 +298,6 @@ SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const s
   return q;
 }
 
-double piece_margin_d(const Bed& bed, const SurfaceParams& surface) {
-  const double d = reference_diameter(bed);
-  const double largest = bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) / d : 0.0;
-  return 3.0 * largest + surface.cells_per_gap * surface.edge_length_d + surface.clip_shift_d;
-}
-
 VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k,
                      double d_ref, const VolumeMeshParams& p, const std::filesystem::path& bad_cells_path,
                      bool release_memory) {
@@ -320,18 +308,10 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   const bool cut = !slabs_from_clip_windows(surface);
   SurfaceParams q = asked;
   if (cut) {
-    // The window's own clip planes go with what lies beyond its cuts: set a further
-    // kWindowPlaneSlack_d out and free to move that far, they stay piece_margin_d away and find a
-    // height clear of the spheres' ends where surface.clip_shift_d does not (a = 14, N = 1e4:
-    // at best 0.0032 of the 0.005 d clearance within 0.25 d), or else the clearest height.
-    constexpr double kWindowPlaneSlack_d = 1.0;
     const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
     const double margin = piece_margin_d(bed, surface) + kWindowPlaneSlack_d;
-    if (k > 0) q.clip_bottom_d = std::max(whole.clip_bottom_d, planes[k - 1] - margin);
-    if (k + 1 < slabs) q.clip_top_d = std::min(whole.clip_top_d, planes[k] + margin);
-    q.clip_shift_d = std::max(q.clip_shift_d, kWindowPlaneSlack_d);
-    q.clip_faces_cut_away = true;
-    q.wall_rings_d = planes;
+    q = window_cut_at_rings(asked, k > 0 ? std::max(whole.clip_bottom_d, planes[k - 1] - margin) : asked.clip_bottom_d,
+                            k + 1 < slabs ? std::min(whole.clip_top_d, planes[k] + margin) : asked.clip_top_d, planes);
   }
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.

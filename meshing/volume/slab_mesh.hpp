@@ -69,13 +69,6 @@ FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, in
 // spheres, alike for the slabs on either side.
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k);
 
-// How far (d) a slab's window is widened before its surface is cut at its planes (treated
-// contacts): a sphere crossing a plane, its neighbours (whose contacts shape its cuts) and theirs
-// (which the window's own clip planes may open, moved by up to surface.clip_shift_d), and the
-// surfaces its narrow-gap spacing sees (surface.cells_per_gap edges): 3 largest diameters plus
-// those two lengths. Within it both windows of a plane hold the same spheres, contacts and cuts.
-double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
-
 // Slab `k` between `planes` meshed on its own, needing no other slab's surface: from its clip
 // window (slabs_from_clip_windows), or under treated contacts from its window widened by
 // piece_margin_d + 1 d (its own clip planes free to move 1 d, so they stay at least

@@ -177,6 +177,16 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   EXPECT_EQ(read(section + "[outputs]\nfiles = [\"case\"]\n").container->axial_period(), 0.005);
   const std::string enlarged = message(section + "[contacts]\ntreatment = \"enlarge\"\n[outputs]\nfiles = [\"case\"]\n");
   EXPECT_NE(enlarged.find("contacts.treatment = \"enlarge\""), std::string::npos) << enlarged;
+  // Cut through at the planes: read on this section; refused without a period, and where the
+  // period is shorter than twice the seam (an edge of 0.9 d: 4 edges, so 7.2 d).
+  const std::string cut = "[contacts]\nat_periodic_planes = \"cut\"\n[outputs]\nfiles = [\"case\"]\n";
+  EXPECT_TRUE(read(section + cut).surface.cut_at_periodic_planes);
+  const std::string unperiodic = message("[container]\ndiameter_d = 5\n[particles]\ncount = 105\n" + cut);
+  EXPECT_NE(unperiodic.find("contacts.at_periodic_planes = \"cut\" without container.period_z_d"), std::string::npos)
+      << unperiodic;
+  const std::string short_period = message(section + cut + "[surface]\nedge_length_d = 0.9\n");
+  EXPECT_NE(short_period.find("container.period_z_d = 5"), std::string::npos) << short_period;
+  EXPECT_NE(short_period.find("at least 7.2 d"), std::string::npos) << short_period;
 #endif
 }
 

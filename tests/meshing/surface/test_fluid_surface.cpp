@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -831,5 +832,42 @@ TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
     ADD_FAILURE() << "enlarged spheres on a periodic section were accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("contacts.treatment = \"enlarge\""), std::string::npos) << e.what();
+  }
+}
+
+// With contacts.at_periodic_planes = "cut" the same plane cuts those contacts through instead:
+// none opened, no sphere shrunk (the fluid volume is the bridged or capped bed's, its contacts'
+// change as treat_contacts gives it for one period), and the plane's section is what the
+// treatment made: bridged, the pair is one hole and the sphere bridged to the wall is part of
+// the wall's loop, so 2 loops where opening leaves 4 (the wall and three circles); capped, the
+// caps' gaps keep the 4 apart. The surface is closed, its volume within the facets' deviation of the exact one,
+// and the outlet is the inlet one period up, bit for bit in x and y.
+TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked) {
+  auto tube = std::make_shared<Cylinder>(1.5);
+  tube->set_axial_period(3.0);
+  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15}});
+  Bed tall = column(std::make_shared<Cylinder>(1.5), b.centres);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (Treatment t : {Treatment::bridge, Treatment::cap}) {
+    SurfaceParams p;
+    p.treatment = p.wall_treatment = t;
+    p.clip_clearance_d = 0.4;
+    p.cut_at_periodic_planes = true;
+    const FluidSurface fs = build_fluid_surface(b, p);
+    const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
+    EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting) << treatment_name(t);
+    EXPECT_NEAR(fs.report["domain_m"]["inlet_z"].get<double>(), 1.5, 1e-9) << treatment_name(t);
+    EXPECT_EQ(fs.report["periodic_planes_m"]["contacts_opened"].get<long>(), 0) << treatment_name(t);
+    EXPECT_EQ(fs.report["periodic_planes_m"]["cut"]["loops"].get<long>(), t == Treatment::bridge ? 2 : 4)
+        << treatment_name(t);
+    const double change = treat_contacts(tall, p, {-inf, inf, false}).report["solid_volume_change_m3"].get<double>();
+    EXPECT_GT(std::abs(change), 0.0) << treatment_name(t);
+    const double exact = std::numbers::pi * 1.5 * 1.5 * 3.0 - 5.0 * 4.0 / 3.0 * std::numbers::pi * 0.125 - change;
+    EXPECT_NEAR(fs.exact_volume_m3, exact, 1e-12) << treatment_name(t);
+    const double added = fs.report["chordal_deviation_d"].get<double>() * 5.0 * std::numbers::pi,
+                 taken = fs.report["wall_sagitta_d"].get<double>() * 2.0 * std::numbers::pi * 1.5 * 3.0 * 2.0;
+    EXPECT_GT(k.volume, exact - taken) << treatment_name(t);
+    EXPECT_LT(k.volume, exact + added) << treatment_name(t);
+    expect_matching_planes(fs, treatment_name(t));
   }
 }

@@ -1,0 +1,258 @@
+#include "meshing/surface/periodic_cut.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "core/edge_key.hpp"
+#include "core/error.hpp"
+#include "meshing/surface/clip_planes.hpp"
+#include "meshing/surface/contacts.hpp"
+#include "meshing/surface/plane_cut.hpp"
+#include "meshing/surface/primitives.hpp"
+#include "meshing/surface/spaced_points.hpp"
+#include "meshing/surface/stl_io.hpp"
+
+namespace bedforge::meshing {
+
+namespace {
+
+// The spheres of `bed` (periodic along z, period H) repeated a period apart wherever a centre
+// falls within [lo, hi] (m), in a copy of its container without the period.
+Bed repeated(const Bed& bed, double lo, double hi) {
+  const double H = bed.container->axial_period();
+  Bed out;
+  std::unique_ptr<Container> plain = bed.container->scaled(1.0);
+  plain->set_axial_period(0.0);
+  out.container = std::move(plain);
+  out.empty_reference_diameter = bed.empty_reference_diameter;
+  for (long k = static_cast<long>(std::floor(lo / H)) - 1; k * H <= hi + H; ++k)
+    for (std::size_t i = 0; i < bed.size(); ++i) {
+      const Eigen::Vector3d c = bed.centres[i] + Eigen::Vector3d(0.0, 0.0, static_cast<double>(k) * H);
+      if (c.z() >= lo && c.z() <= hi) out.centres.push_back(c), out.diameters.push_back(bed.diameters[i]);
+    }
+  return out;
+}
+
+// The treated solid of one period, as treat_contacts reports it for a bed: that of two periods
+// of the bed repeated less that of one, so that each contact (those across the period's ends
+// too) counts once.
+nlohmann::json one_period_treatment(const Bed& bed, const SurfaceParams& p) {
+  const double H = bed.container->axial_period(), inf = std::numeric_limits<double>::infinity();
+  auto treated = [&](int periods) {
+    return treat_contacts(repeated(bed, 0.0, std::nextafter(periods * H, 0.0)), p, {-inf, inf, false}).report;
+  };
+  const nlohmann::json one = treated(1), two = treated(2);
+  nlohmann::json out = two;
+  auto difference = [&](const nlohmann::json::json_pointer& at) { out[at] = two[at].get<double>() - one[at].get<double>(); };
+  for (const char* key : {"/contacts_treated/particle_particle", "/contacts_treated/particle_wall",
+                          "/contacts_treated/by_kind/bridge", "/contacts_treated/by_kind/cap",
+                          "/contacts_treated/by_kind/union"})
+    out[nlohmann::json::json_pointer(key)] =
+        two[nlohmann::json::json_pointer(key)].get<long>() - one[nlohmann::json::json_pointer(key)].get<long>();
+  difference(nlohmann::json::json_pointer("/solid_volume_change_m3"));
+  difference(nlohmann::json::json_pointer("/solid_volume_exact_m3"));
+  const double solid = out["solid_volume_exact_m3"].get<double>(), change = out["solid_volume_change_m3"].get<double>();
+  out["solid_volume_change_relative"] = change / (solid - change);
+  return out;
+}
+
+}  // namespace
+
+namespace {
+
+// How far below each plane the two parts of the section meet (m): beyond the cut's changes.
+double seam_depth(const SurfaceParams& p, double d) {
+  return std::max(kSeamDepthEdges * p.edge_length_d, kSeamDepthMinD) * d;
+}
+
+}  // namespace
+
+void check_periodic_cut(const Container& container, const SurfaceParams& p, double d) {
+  if (dynamic_cast<const Box*>(&container))
+    throw InputError("contacts.at_periodic_planes = \"cut\" in a box: its flat sides are not cut alike at the two "
+                     "planes yet; allowed: \"open\", or a cylinder or annulus");
+  const double H = container.axial_period(), m = seam_depth(p, d);
+  if (!(H >= 2.0 * m))
+    throw InputError(fmt::format(
+        "container.period_z_d = {:.4g} with contacts.at_periodic_planes = \"cut\": the section is joined {:.3g} d "
+        "below each plane ({} edges of surface.edge_length_d = {}, at least {} d) and needs a period of twice that; "
+        "allowed: a period of at least {:.3g} d, a shorter surface edge, or \"open\"",
+        H / d, m / d, kSeamDepthEdges, p.edge_length_d, kSeamDepthMinD, 2.0 * m / d));
+}
+
+bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p) {
+  return p.cut_at_periodic_planes && bed.container->axial_period() > 0.0 && opens_contacts_at_periodic_planes(p) &&
+         !dynamic_cast<const Box*>(bed.container.get());
+}
+
+FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
+  const double H = bed.container->axial_period(), d = reference_diameter(bed), edge = p.edge_length_d * d;
+  // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends, its
+  // circles widest apart), a height the STL keeps as it is; the seam m below each.
+  const UnwrappedSection section = unwrap_periodic_section(bed, p);
+  const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
+  check_periodic_cut(*bed.container, p, d);
+  const double m = seam_depth(p, d), s = z0 - m;
+
+  // 2. The bed repeated over a clip window that keeps its own planes piece_margin_d (and the
+  // slack they may move by) from both seams; its walls ringed at the seams and the planes.
+  const double margin = (piece_margin_d(bed, p) + kWindowPlaneSlack_d) * d;
+  const Bed laid = repeated(bed, s - margin - largest_diameter(bed), z1 + margin + largest_diameter(bed));
+  FluidSurface whole = build_fluid_surface(
+      laid, window_cut_at_rings(p, (s - margin) / d, (z1 + margin) / d, {s / d, z0 / d, (s + H) / d, z1 / d}));
+
+  // 3. Cut at the lower plane: the fluid above it and below it, one face between them.
+  PlaneCut cut = [&] {
+    try {
+      return cut_by_plane(whole.fluid, z0, plane_cut_params(p, d));
+    } catch (const CutConflict& e) {
+      throw InputError(fmt::format("the periodic section's lower plane: {}; allowed: a shorter "
+                                   "surface.contact_edge_length_d or another treatment",
+                                   e.what()));
+    }
+  }();
+  whole.fluid = TriangleMesh();
+  const TriangleMesh& above = cut.above;
+  const TriangleMesh& below = cut.below;
+  auto centroid_z = [](const TriangleMesh& t, std::size_t k) {
+    return (t.points[t.triangles[k][0]].z() + t.points[t.triangles[k][1]].z() + t.points[t.triangles[k][2]].z()) / 3.0;
+  };
+
+  // 4. The section: the triangles above z0 below the upper seam, and those below z0 above the
+  // lower seam moved up a period. Vertices of the part moved up keep their doubles plus H; the
+  // upper seam's vertices of the part above take them (the same points, up to the rounding of
+  // the layout's own repeat, checked below).
+  FluidSurface out;
+  TriangleMesh& f = out.fluid;
+  std::vector<int> from_above(above.points.size(), -1);
+  auto add_point = [&f](const Eigen::Vector3d& x) {
+    f.points.push_back(x);
+    return static_cast<int>(f.points.size()) - 1;
+  };
+  std::vector<char> kept(above.triangles.size(), 0);
+  for (std::size_t t = 0; t < above.triangles.size(); ++t) {
+    if (!(centroid_z(above, t) < s + H)) continue;
+    kept[t] = 1;
+    std::array<int, 3> tri;
+    for (int k = 0; k < 3; ++k) {
+      int& v = from_above[above.triangles[t][k]];
+      if (v < 0) v = add_point(above.points[above.triangles[t][k]]);
+      tri[k] = v;
+    }
+    f.triangles.push_back(tri);
+    f.patch.push_back(f.patch_index(above.patches[above.patch[t]]));
+  }
+  // The upper seam's vertices: those of kept triangles that a dropped one shares, found by their
+  // point a period down among the part below's.
+  std::vector<char> on_seam(above.points.size(), 0);
+  for (std::size_t t = 0; t < above.triangles.size(); ++t)
+    if (!kept[t])
+      for (int v : above.triangles[t])
+        if (from_above[v] >= 0) on_seam[v] = 1;
+  const double tolerance = 1e-7 * d;
+  PointsByCell seam_grid(1e3 * tolerance);
+  std::vector<int> seam_vertex;  // index in `above`
+  for (std::size_t v = 0; v < above.points.size(); ++v)
+    if (on_seam[v]) {
+      seam_grid.add(above.points[v] - Eigen::Vector3d(0.0, 0.0, H), static_cast<int>(seam_vertex.size()));
+      seam_vertex.push_back(static_cast<int>(v));
+    }
+  std::vector<int> from_below(below.points.size(), -1);
+  const int outlet = f.patch_index("outlet");
+  for (std::size_t t = 0; t < below.triangles.size(); ++t) {
+    if (!(centroid_z(below, t) > s)) continue;
+    std::array<int, 3> tri;
+    for (int k = 0; k < 3; ++k) {
+      const int b = below.triangles[t][k];
+      int& v = from_below[b];
+      if (v < 0) {
+        const Eigen::Vector3d x = below.points[b];
+        int twin = -1;
+        seam_grid.near(x, [&](int i) {
+          if ((above.points[seam_vertex[i]] - Eigen::Vector3d(0.0, 0.0, H) - x).norm() < tolerance) twin = seam_vertex[i];
+        });
+        const Eigen::Vector3d up(x.x(), x.y(), x.z() + H);
+        if (twin >= 0)
+          v = from_above[twin], f.points[v] = up;
+        else
+          v = add_point(up);
+      }
+      tri[k] = v;
+    }
+    f.triangles.push_back(tri);
+    const std::string& name = below.patches[below.patch[t]];
+    f.patch.push_back(name == "outlet" ? outlet : f.patch_index(name));
+  }
+
+  // 5. The seam closed: every edge in two triangles, once each way.
+  std::unordered_map<std::uint64_t, int> uses;  // +1 per a -> b with a < b, -1 the other way; +/-100 once seen twice
+  std::unordered_map<std::uint64_t, int> count;
+  for (const auto& t : f.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      const std::uint64_t e = edge_key(a, b);
+      uses[e] += a < b ? 1 : -1;
+      ++count[e];
+    }
+  long open = 0;
+  Eigen::Vector3d first_open = Eigen::Vector3d::Zero();
+  for (const auto& [e, c] : count)
+    if (c != 2 || uses[e] != 0) {
+      if (open++ == 0) first_open = f.points[static_cast<int>(e >> 32)];
+    }
+  if (open > 0)
+    throw std::runtime_error(fmt::format(
+        "periodic section: the bed repeated a period on does not repeat its surface at the seam {:.4f} d below the "
+        "planes ({} edges unmatched, the first at ({:.6g}, {:.6g}, {:.6g}) m); please report it with the bed",
+        m / d, open, first_open.x(), first_open.y(), first_open.z()));
+
+  // 6. What the surface stage reports of it.
+  for (std::size_t t = 0; t < f.triangles.size(); ++t)
+    if (f.patches[f.patch[t]] == "particles") {
+      std::array<int, 3> tri = f.triangles[t];
+      std::swap(tri[1], tri[2]);
+      const int first = static_cast<int>(out.bed.points.size());
+      for (int k = 0; k < 3; ++k) out.bed.points.push_back(f.points[tri[k]]);
+      out.bed.triangles.push_back({first, first + 1, first + 2});
+      out.bed.patch.push_back(out.bed.patch_index("particles"));
+    }
+  out.bed.weld();
+  SurfacePiece all;
+  all.first = 0, all.last = f.triangles.size();
+  out.pieces.push_back(all);
+  out.report = whole.report;
+  for (const char* key : {"clip", "domain_m", "triangles", "min_angle_deg", "min_edge_d", "max_edge_d"}) out.report.erase(key);
+  nlohmann::json period = one_period_treatment(bed, p);
+  for (auto& [key, value] : period.items()) out.report[key] = value;
+  const double domain = bed.container->cross_section_area() * H;
+  out.exact_volume_m3 = domain - out.report["solid_volume_exact_m3"].get<double>();
+  out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
+  out.report["void_fraction_bed_section_change"] = -out.report["solid_volume_change_m3"].get<double>() / domain;
+  out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
+  out.report["periodic_planes_m"] = {{"lower", z0},
+                                     {"upper", z1},
+                                     {"clearance_d", section.clearance / d},
+                                     {"narrowest_gap_d", section.narrowest_gap / d},
+                                     {"contacts_opened", 0},
+                                     {"seam_depth_d", m / d},
+                                     {"cut",
+                                      {{"loops", cut.loops},
+                                       {"plane_triangles", cut.plane_triangles},
+                                       {"vertices_snapped", cut.vertices_snapped},
+                                       {"vertices_cleared", cut.vertices_cleared},
+                                       {"edges_flipped", cut.edges_flipped},
+                                       {"edges_split", cut.edges_split},
+                                       {"left_to_recover", cut.left_to_recover}}}};
+  const MeshQuality quality = mesh_quality(f);
+  out.report["triangles"] = f.triangles.size();
+  out.report["min_angle_deg"] = quality.min_angle_deg;
+  out.report["min_edge_d"] = quality.min_edge / d;
+  out.report["max_edge_d"] = quality.max_edge / d;
+  return out;
+}
+
+}  // namespace bedforge::meshing
