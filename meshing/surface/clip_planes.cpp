@@ -143,7 +143,7 @@ bool opens_contacts_at_periodic_planes(const SurfaceParams& p) {
   return treated(p.treatment) || treated(p.wall_treatment);
 }
 
-UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p) {
+UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p, const std::vector<double>& keep_clear) {
   using Treatment = SurfaceParams::Treatment;
   if (bed.size() > 0) refuse_treatments_across_periodic_planes(p);
   const double H = bed.container->axial_period(), d = reference_diameter(bed);
@@ -157,16 +157,28 @@ UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p)
   for (std::size_t i = 0; i < bed.size(); ++i)
     for (double r : {radius(i), opens ? 0.5 * p.shrink_factor * bed.diameters[i] : radius(i)})
       for (double e : {bed.centres[i].z() - r, bed.centres[i].z() + r}) ends.push_back(e - H * std::floor(e / H));
-  std::sort(ends.begin(), ends.end());
-  std::vector<std::pair<double, double>> candidates;  // clearance, height
-  for (std::size_t k = 0; k < ends.size(); ++k) {
-    const double next = k + 1 < ends.size() ? ends[k + 1] : ends.front() + H;
-    const double z = 0.5 * (ends[k] + next);
-    candidates.push_back({0.5 * (next - ends[k]), z >= H ? z - H : z});
+  // The 64 widest intervals between `ends` (heights over one period, sorted here), widest first.
+  auto widest = [H](std::vector<double> ends) {
+    std::sort(ends.begin(), ends.end());
+    std::vector<std::pair<double, double>> candidates;  // clearance, height
+    for (std::size_t k = 0; k < ends.size(); ++k) {
+      const double next = k + 1 < ends.size() ? ends[k + 1] : ends.front() + H;
+      const double z = 0.5 * (ends[k] + next);
+      candidates.push_back({0.5 * (next - ends[k]), z >= H ? z - H : z});
+    }
+    if (candidates.empty()) candidates.push_back({0.5 * H, 0.0});
+    std::sort(candidates.begin(), candidates.end(), std::greater<>());
+    candidates.resize(std::min<std::size_t>(candidates.size(), 64));
+    return candidates;
+  };
+  std::vector<std::pair<double, double>> candidates = widest(ends);
+  // Clear of `keep_clear` too where some height is that clear of both.
+  if (!keep_clear.empty()) {
+    std::vector<double> all = ends;
+    for (double z : keep_clear) all.push_back(z - H * std::floor(z / H));
+    if (std::vector<std::pair<double, double>> clearer = widest(all); clearer.front().first >= p.clip_clearance_d * d)
+      candidates = std::move(clearer);
   }
-  if (candidates.empty()) candidates.push_back({0.5 * H, 0.0});
-  std::sort(candidates.begin(), candidates.end(), std::greater<>());
-  candidates.resize(std::min<std::size_t>(candidates.size(), 64));
   if (!(candidates.front().first >= p.clip_clearance_d * d))
     throw InputError(fmt::format("surface.clip_clearance_d = {}: no height of the periodic section lies that clear of "
                                  "every sphere's top and bottom (at best {:.3g} d); allowed: a smaller clearance",

@@ -99,6 +99,9 @@ struct UnwrappedSection {
   double clearance = 0.0;      // of the planes from the nearest sphere end (m)
   double narrowest_gap = 0.0;  // between the cut circles on the planes, and from them to the walls (m)
 };
-UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p);
+// `keep_clear` (m, any period): more heights the planes keep clear of (the rims of treated
+// contacts, for a cut through them) where some height lies surface.clip_clearance_d clear of
+// them and of the spheres' ends; else the spheres' ends alone.
+UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p, const std::vector<double>& keep_clear = {});
 
 }  // namespace bedforge::meshing

@@ -37,6 +37,27 @@ Bed repeated(const Bed& bed, double lo, double hi) {
   return out;
 }
 
+// The highest and lowest point of every loop where treated contacts meet a sphere (bridges' and
+// caps' rims, at the wall too) over one period (m): where a plane passes near one, the rim
+// meets the plane nearly tangent and the cut leaves slivers (cells failing checkMesh's skewness
+// beside the seed-2 slice's rims 0.0002 and 0.003 d from its plane, docs/findings.md, 2026-12-01).
+std::vector<double> rim_heights(const Bed& bed, const SurfaceParams& p) {
+  const double H = bed.container->axial_period(), reach = largest_diameter(bed),
+               inf = std::numeric_limits<double>::infinity();
+  const Bed around = repeated(bed, -reach, H + reach);
+  const TreatedBed treated = treat_contacts(around, p, {-inf, inf, false});
+  std::vector<double> out;
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    if (around.centres[i].z() < 0.0 || around.centres[i].z() >= H) continue;  // each sphere once
+    for (const SphereCut& cut : treated.cuts[i]) {
+      const auto [lo, hi] = std::minmax_element(cut.loop.begin(), cut.loop.end(),
+                                                [](const auto& a, const auto& b) { return a.z() < b.z(); });
+      if (lo != cut.loop.end()) out.push_back(lo->z()), out.push_back(hi->z());
+    }
+  }
+  return out;
+}
+
 // The treated solid of one period, as treat_contacts reports it for a bed: that of two periods
 // of the bed repeated less that of one, so that each contact (those across the period's ends
 // too) counts once.
@@ -93,7 +114,7 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
   const double H = bed.container->axial_period(), d = reference_diameter(bed), edge = p.edge_length_d * d;
   // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends, its
   // circles widest apart), a height the STL keeps as it is; the seam m below each.
-  const UnwrappedSection section = unwrap_periodic_section(bed, p);
+  const UnwrappedSection section = unwrap_periodic_section(bed, p, rim_heights(bed, p));
   const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
   check_periodic_cut(*bed.container, p, d);
   const double m = seam_depth(p, d), s = z0 - m;

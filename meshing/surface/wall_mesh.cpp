@@ -421,12 +421,22 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
   };
   for (const auto& hole : holes) {
     polygons.emplace_back(), loops.emplace_back();
-    for (const auto& p : hole.loop) {
-      const Eigen::Vector2d q = local(p);
+    const double spacing = std::min(hole.spacing, edge);
+    for (std::size_t k = 0; k < hole.loop.size(); ++k) {
+      const Eigen::Vector2d q = local(hole.loop[k]), next = local(hole.loop[(k + 1) % hole.loop.size()]);
       if (!in_region(q)) throw CutConflict(fmt::format("a hole (particle {}) reaches the edge of the {}", hole.particle, patch));
       polygons.back().push_back(q);
       loops.back().push_back(static_cast<int>(uv.size()));
-      add_vertex(p, q, std::min(hole.spacing, edge));
+      add_vertex(hole.loop[k], q, spacing);
+      // Samples every half spacing along an edge longer than the loop's spacing (a plane cut's
+      // loops are uneven), or a site could land a hair beside its middle: a sliver of 1 deg on
+      // a = 5's seed-3 slice (docs/findings.md, 2026-12-01).
+      const int parts = static_cast<int>(std::ceil((next - q).norm() / (0.5 * spacing)));
+      if (parts > 2)
+        for (int j = 1; j < parts; ++j) {
+          const Eigen::Vector2d at = q + (next - q) * (static_cast<double>(j) / parts);
+          spaced.add(Eigen::Vector3d(at.x(), at.y(), 0.0), spacing);
+        }
     }
   }
   const PolygonIndex hole_index(polygons);

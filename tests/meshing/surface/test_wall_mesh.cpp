@@ -200,3 +200,44 @@ TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
   holes[1].loop = circle_loop(Frame::along({0.5, 0.95, 0.5}, Eigen::Vector3d::UnitX()), 0.1, 21);
   EXPECT_THROW(plane_mesh(f, {boundary}, 0.1, holes, 1.5, true, "wall"), CutConflict);
 }
+
+// A hole whose loop has edges much longer than its spacing (a plane cut's loops are uneven: the
+// surface's vertices snapped onto the plane): no free vertex lands beside the middle of such an
+// edge, where it would make a sliver with the edge's ends (1 deg on a periodic slice's plane,
+// docs/findings.md, 2026-12-01). The loop: a circle of radius 0.3 in steps of 0.03, every
+// vertex but every eighth left out over half of it, and a field asking for 0.02 (finer than
+// the loop). A vertex excludes sites within 0.4 x the sum of the two spacings, and a long edge
+// is sampled every half spacing, so sites keep sqrt(0.4^2 - 0.25^2) = 0.31 of the loop's
+// spacing from it, less their jitter: at least a quarter.
+TEST(PlaneMesh, NoVertexLandsBesideALongEdgeOfAHole) {
+  const Frame f = Frame::along({0.5, 0.0, 0.0}, Eigen::Vector3d::UnitX());
+  std::vector<Eigen::Vector3d> boundary;
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  for (double turn : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7}) {
+    const double rho = 0.3, spacing = 0.03;
+    const int n = ring_points(rho, spacing);
+    std::vector<Eigen::Vector3d> loop;
+    for (int k = 0; k < n; ++k)
+      if (k < n / 2 || k % 8 == 0) {
+        const double a = 2.0 * kPi * k / n + turn;
+        loop.push_back({0.5, 0.1 + rho * std::cos(a), 0.5 + rho * std::sin(a)});
+      }
+    const WallMesh m = plane_mesh(f, {boundary}, 0.1, {{loop, spacing, 0}}, 1.5, true, "wall",
+                                  {[](const Eigen::Vector3d&) { return 0.02; }, 0.02});
+    double nearest = HUGE_VAL;
+    for (const Eigen::Vector3d& q : m.outside.points) {
+      bool on_loop = false;
+      for (const auto& l : loop) on_loop = on_loop || (l - q).norm() == 0.0;
+      if (on_loop) continue;
+      for (std::size_t k = 0; k < loop.size(); ++k) {
+        const Eigen::Vector3d a = loop[k], b = loop[(k + 1) % loop.size()];
+        const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        nearest = std::min(nearest, (a + t * (b - a) - q).norm());
+      }
+    }
+    EXPECT_GE(nearest, 0.25 * spacing) << "turned by " << turn;
+  }
+}
