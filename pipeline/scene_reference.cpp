@@ -54,7 +54,7 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "accelerated soft-sphere packer, which compresses a longer period down to this one without gravity and "
         "taps them where they jam first, or stops with an error naming the void fraction it jammed at; meshed as a "
         "cyclic case, its spheres cut by the periodic planes (bridges and caps the planes cross are opened, their "
-        "spheres shrunk by `contacts.shrink_factor`, not cut through yet; not enlarge)"}},
+        "spheres shrunk by `contacts.shrink_factor`, or cut through: `contacts.at_periodic_planes`; not enlarge)"}},
       {"container.period_z_m", {"the same in metres"}},
       // [particles]
       {"particles.count",
