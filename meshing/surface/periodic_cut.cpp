@@ -81,10 +81,6 @@ nlohmann::json one_period_treatment(const Bed& bed, const SurfaceParams& p) {
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 // How far below each plane the two parts of the section meet (m): beyond the cut's changes.
 double seam_depth(const SurfaceParams& p, double d) {
   return std::max(kSeamDepthEdges * p.edge_length_d, kSeamDepthMinD) * d;
@@ -112,11 +108,12 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p) {
 
 FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
   const double H = bed.container->axial_period(), d = reference_diameter(bed), edge = p.edge_length_d * d;
-  // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends, its
-  // circles widest apart), a height the STL keeps as it is; the seam m below each.
+  check_periodic_cut(*bed.container, p, d);
+  // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends and,
+  // where it can be, of the contacts' rims; its circles widest apart), a height the STL keeps as
+  // it is; the seam m below each.
   const UnwrappedSection section = unwrap_periodic_section(bed, p, rim_heights(bed, p));
   const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
-  check_periodic_cut(*bed.container, p, d);
   const double m = seam_depth(p, d), s = z0 - m;
 
   // 2. The bed repeated over a clip window that keeps its own planes piece_margin_d (and the
