@@ -169,6 +169,16 @@ double area(const TriangleMesh& m, const Eigen::Vector3d& normal) {
   return a;
 }
 
+// The boundary of a 2 x 1 face in the plane x = 0.5 (y from -1 to 1, z from 0 to 1), in steps of 0.1.
+std::vector<Eigen::Vector3d> face_boundary() {
+  std::vector<Eigen::Vector3d> boundary;
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
+  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
+  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  return boundary;
+}
+
 }  // namespace
 
 TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
@@ -176,11 +186,7 @@ TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
   // outside and inside cover the face, the inside is exactly the holes' polygons, every triangle
   // faces +w.
   const Frame f = Frame::along({0.5, 0.0, 0.0}, Eigen::Vector3d::UnitX());
-  std::vector<Eigen::Vector3d> boundary;
-  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
-  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
-  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
-  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  const std::vector<Eigen::Vector3d> boundary = face_boundary();
   std::vector<WallHole> holes;
   double hole_area = 0.0;
   for (auto [y, z, rho] : {std::tuple{-0.4, 0.5, 0.3}, std::tuple{0.5, 0.198, 0.196}}) {
@@ -211,11 +217,7 @@ TEST(PlaneMesh, HolesAreCutExactlyAndTheFaceIsCovered) {
 // spacing from it, less their jitter: at least a quarter.
 TEST(PlaneMesh, NoVertexLandsBesideALongEdgeOfAHole) {
   const Frame f = Frame::along({0.5, 0.0, 0.0}, Eigen::Vector3d::UnitX());
-  std::vector<Eigen::Vector3d> boundary;
-  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, -1.0 + 0.1 * k, 0.0});
-  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, 1.0, 0.1 * k});
-  for (int k = 0; k < 20; ++k) boundary.push_back({0.5, 1.0 - 0.1 * k, 1.0});
-  for (int k = 0; k < 10; ++k) boundary.push_back({0.5, -1.0, 1.0 - 0.1 * k});
+  const std::vector<Eigen::Vector3d> boundary = face_boundary();
   for (double turn : {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7}) {
     const double rho = 0.3, spacing = 0.03;
     const int n = ring_points(rho, spacing);
