@@ -837,7 +837,8 @@ TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
 
 // With contacts.at_periodic_planes = "cut" the same plane cuts those contacts through instead:
 // none opened, no sphere shrunk (the fluid volume is the bridged or capped bed's, its contacts'
-// change as treat_contacts gives it for one period), and the plane's section is what the
+// change and count as treat_contacts gives them for the bed unwrapped, a contact across the
+// period's ends among them), and the plane's section is what the
 // treatment made: bridged, the pair is one hole and the sphere bridged to the wall is part of
 // the wall's loop, so 2 loops where opening leaves 4 (the wall and three circles); capped, the
 // caps' gaps keep the 4 apart. The surface is closed, its volume within the facets' deviation of the exact one,
@@ -845,8 +846,15 @@ TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
 TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked) {
   auto tube = std::make_shared<Cylinder>(1.5);
   tube->set_axial_period(3.0);
-  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15}});
-  Bed tall = column(std::make_shared<Cylinder>(1.5), b.centres);
+  // The last sphere touches the one at z = 0.15 across the period's ends (its image at -0.45,
+  // 0.8 away sideways); its ends keep 0.5 from z = 1.5 as the others' do.
+  const double side = 0.8 / std::sqrt(2.0);
+  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15},
+                              {side, -0.75 + side, 2.55}});
+  // The same contacts in a tube without a period: that sphere a period down.
+  std::vector<Eigen::Vector3d> unwrapped = b.centres;
+  unwrapped.back().z() -= 3.0;
+  Bed tall = column(std::make_shared<Cylinder>(1.5), unwrapped);
   const double inf = std::numeric_limits<double>::infinity();
   for (Treatment t : {Treatment::bridge, Treatment::cap}) {
     SurfaceParams p;
@@ -860,11 +868,15 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked)
     EXPECT_EQ(fs.report["periodic_planes_m"]["contacts_opened"].get<long>(), 0) << treatment_name(t);
     EXPECT_EQ(fs.report["periodic_planes_m"]["cut"]["loops"].get<long>(), t == Treatment::bridge ? 2 : 4)
         << treatment_name(t);
-    const double change = treat_contacts(tall, p, {-inf, inf, false}).report["solid_volume_change_m3"].get<double>();
+    const nlohmann::json treated = treat_contacts(tall, p, {-inf, inf, false}).report;
+    const double change = treated["solid_volume_change_m3"].get<double>();
+    for (const char* kind : {"particle_particle", "particle_wall"})
+      EXPECT_EQ(fs.report["contacts_treated"][kind].get<long>(), treated["contacts_treated"][kind].get<long>())
+          << treatment_name(t) << " " << kind;
     EXPECT_GT(std::abs(change), 0.0) << treatment_name(t);
-    const double exact = std::numbers::pi * 1.5 * 1.5 * 3.0 - 5.0 * 4.0 / 3.0 * std::numbers::pi * 0.125 - change;
+    const double exact = std::numbers::pi * 1.5 * 1.5 * 3.0 - 6.0 * 4.0 / 3.0 * std::numbers::pi * 0.125 - change;
     EXPECT_NEAR(fs.exact_volume_m3, exact, 1e-12) << treatment_name(t);
-    const double added = fs.report["chordal_deviation_d"].get<double>() * 5.0 * std::numbers::pi,
+    const double added = fs.report["chordal_deviation_d"].get<double>() * 6.0 * std::numbers::pi,
                  taken = fs.report["wall_sagitta_d"].get<double>() * 2.0 * std::numbers::pi * 1.5 * 3.0 * 2.0;
     EXPECT_GT(k.volume, exact - taken) << treatment_name(t);
     EXPECT_LT(k.volume, exact + added) << treatment_name(t);
