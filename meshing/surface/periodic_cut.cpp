@@ -68,14 +68,16 @@ nlohmann::json one_period_treatment(const Bed& bed, const SurfaceParams& p) {
   };
   const nlohmann::json one = treated(1), two = treated(2);
   nlohmann::json out = two;
-  auto difference = [&](const nlohmann::json::json_pointer& at) { out[at] = two[at].get<double>() - one[at].get<double>(); };
   for (const char* key : {"/contacts_treated/particle_particle", "/contacts_treated/particle_wall",
                           "/contacts_treated/by_kind/bridge", "/contacts_treated/by_kind/cap",
-                          "/contacts_treated/by_kind/union"})
-    out[nlohmann::json::json_pointer(key)] =
-        two[nlohmann::json::json_pointer(key)].get<long>() - one[nlohmann::json::json_pointer(key)].get<long>();
-  difference(nlohmann::json::json_pointer("/solid_volume_change_m3"));
-  difference(nlohmann::json::json_pointer("/solid_volume_exact_m3"));
+                          "/contacts_treated/by_kind/union"}) {
+    const nlohmann::json::json_pointer at(key);
+    out[at] = two[at].get<long>() - one[at].get<long>();
+  }
+  for (const char* key : {"/solid_volume_change_m3", "/solid_volume_exact_m3"}) {
+    const nlohmann::json::json_pointer at(key);
+    out[at] = two[at].get<double>() - one[at].get<double>();
+  }
   const double solid = out["solid_volume_exact_m3"].get<double>(), change = out["solid_volume_change_m3"].get<double>();
   out["solid_volume_change_relative"] = change / (solid - change);
   return out;
@@ -243,7 +245,8 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
   all.first = 0, all.last = f.triangles.size();
   out.pieces.push_back(all);
   out.report = whole.report;
-  for (const char* key : {"clip", "domain_m", "triangles", "min_angle_deg", "min_edge_d", "max_edge_d"}) out.report.erase(key);
+  for (const char* key : {"clip", "domain_m", "triangles", "min_angle_deg", "min_edge_d", "max_edge_d"})
+    out.report.erase(key);
   nlohmann::json period = one_period_treatment(bed, p);
   for (auto& [key, value] : period.items()) out.report[key] = value;
   const double domain = bed.container->cross_section_area() * H;
