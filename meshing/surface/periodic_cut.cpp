@@ -5,9 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
-#include "core/edge_key.hpp"
 #include "core/error.hpp"
 #include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/contacts.hpp"
@@ -15,6 +13,7 @@
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/spaced_points.hpp"
 #include "meshing/surface/stl_io.hpp"
+#include "meshing/surface/surface_checks.hpp"
 
 namespace bedforge::meshing {
 
@@ -208,27 +207,12 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
     f.patch.push_back(name == "outlet" ? outlet : f.patch_index(name));
   }
 
-  // 5. The seam closed: every edge in two triangles, once each way.
-  std::unordered_map<std::uint64_t, int> uses;  // +1 per a -> b with a < b, -1 the other way; +/-100 once seen twice
-  std::unordered_map<std::uint64_t, int> count;
-  for (const auto& t : f.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = t[k], b = t[(k + 1) % 3];
-      const std::uint64_t e = edge_key(a, b);
-      uses[e] += a < b ? 1 : -1;
-      ++count[e];
-    }
-  long open = 0;
-  Eigen::Vector3d first_open = Eigen::Vector3d::Zero();
-  for (const auto& [e, c] : count)
-    if (c != 2 || uses[e] != 0) {
-      if (open++ == 0) first_open = f.points[static_cast<int>(e >> 32)];
-    }
-  if (open > 0)
+  // 5. The seam closed (its topology alone; the surface stage's own check follows).
+  if (const SurfaceCheck closed = check_surface(f, SelfIntersectionTest::skip); !closed.closed || !closed.manifold)
     throw std::runtime_error(fmt::format(
         "periodic section: the bed repeated a period on does not repeat its surface at the seam {:.4f} d below the "
-        "planes ({} edges unmatched, the first at ({:.6g}, {:.6g}, {:.6g}) m); please report it with the bed",
-        m / d, open, first_open.x(), first_open.y(), first_open.z()));
+        "planes ({} edges unmatched, first at{}); please report it with the bed",
+        m / d, closed.defects.size(), describe_defects(closed)));
 
   // 6. What the surface stage reports of it.
   for (std::size_t t = 0; t < f.triangles.size(); ++t)
@@ -260,14 +244,7 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
                                      {"narrowest_gap_d", section.narrowest_gap / d},
                                      {"contacts_opened", 0},
                                      {"seam_depth_d", m / d},
-                                     {"cut",
-                                      {{"loops", cut.loops},
-                                       {"plane_triangles", cut.plane_triangles},
-                                       {"vertices_snapped", cut.vertices_snapped},
-                                       {"vertices_cleared", cut.vertices_cleared},
-                                       {"edges_flipped", cut.edges_flipped},
-                                       {"edges_split", cut.edges_split},
-                                       {"left_to_recover", cut.left_to_recover}}}};
+                                     {"cut", to_json(cut)}};
   const MeshQuality quality = mesh_quality(f);
   out.report["triangles"] = f.triangles.size();
   out.report["min_angle_deg"] = quality.min_angle_deg;

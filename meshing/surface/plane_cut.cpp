@@ -162,6 +162,16 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
   return flips;
 }
 
+nlohmann::json to_json(const PlaneCut& c) {
+  return {{"loops", c.loops},
+          {"vertices_snapped", c.vertices_snapped},
+          {"vertices_cleared", c.vertices_cleared},
+          {"plane_triangles", c.plane_triangles},
+          {"edges_flipped", c.edges_flipped},
+          {"edges_split", c.edges_split},
+          {"left_to_recover", c.left_to_recover}};
+}
+
 PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
   return {.edge = s.edge_length_d * d, .growth = s.growth, .cells_per_gap = s.cells_per_gap,
           .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};

@@ -92,6 +92,9 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
 
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
 
+// What a report says of a cut: its counts (loops, plane triangles, vertices snapped, ...).
+nlohmann::json to_json(const PlaneCut& c);
+
 // The cut's parameters from the surface stage's `s` (d: the reference diameter, m): the
 // surface's edge and its cells across gaps, down to the edge the gaps' spacing allows.
 PlaneCutParams plane_cut_params(const SurfaceParams& s, double d);

@@ -156,14 +156,9 @@ void write_msh22(const std::filesystem::path& path, const Joined& j) {
 
 // What a slab's report says of one of its plane cuts (at `plane_d`, d above the floor).
 nlohmann::json cut_json(const PlaneCut& c, double plane_d) {
-  return {{"plane_d", plane_d},
-          {"loops", c.loops},
-          {"vertices_snapped", c.vertices_snapped},
-          {"vertices_cleared", c.vertices_cleared},
-          {"plane_triangles", c.plane_triangles},
-          {"edges_flipped", c.edges_flipped},
-          {"edges_split", c.edges_split},
-          {"left_to_recover", c.left_to_recover}};
+  nlohmann::json j = to_json(c);
+  j["plane_d"] = plane_d;
+  return j;
 }
 
 // The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, sorted.
