@@ -128,12 +128,13 @@ double opening_reach(const Bed& bed, const SurfaceParams& p) {
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p) {
   using Treatment = SurfaceParams::Treatment;
   for (auto [t, key] : {std::pair{p.treatment, "contacts.treatment"}, std::pair{p.wall_treatment, "contacts.wall_treatment"}})
-    if (t == Treatment::enlarge)
-      throw InputError(fmt::format("{} = \"enlarge\" on a periodic section (container.period_z): the contacts a "
-                                   "periodic plane crosses are opened by shrinking their spheres, which their "
-                                   "enlarged neighbours would still overlap; allowed: \"bridge\", \"cap\", "
-                                   "\"shrink\" or \"none\" (or no surface: outputs without \"stl\", \"mesh\" and "
-                                   "\"case\")",
+    if (t == Treatment::enlarge && !p.cut_at_periodic_planes)
+      throw InputError(fmt::format("{} = \"enlarge\" on a periodic section (container.period_z) with "
+                                   "contacts.at_periodic_planes = \"open\": the contacts a periodic plane crosses "
+                                   "are opened by shrinking their spheres, which their enlarged neighbours would "
+                                   "still overlap; allowed: contacts.at_periodic_planes = \"cut\", or \"bridge\", "
+                                   "\"cap\", \"shrink\" or \"none\" (or no surface: outputs without \"stl\", "
+                                   "\"mesh\" and \"case\")",
                                    key));
 }
 
@@ -172,12 +173,22 @@ UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p,
     return candidates;
   };
   std::vector<std::pair<double, double>> candidates = widest(ends);
-  // Clear of `keep_clear` too where some height is that clear of both.
+  // For a cut through the contacts, of the 64 heights widest apart from `keep_clear` and the ends
+  // alike, the first whose ends keep clip_clearance_d: the plane then meets no rim or end nearly
+  // tangent where it can help it, and the circles' gaps on it are the treatment's, not narrow.
   if (!keep_clear.empty()) {
     std::vector<double> all = ends;
     for (double z : keep_clear) all.push_back(z - H * std::floor(z / H));
-    if (std::vector<std::pair<double, double>> clearer = widest(all); clearer.front().first >= p.clip_clearance_d * d)
-      candidates = std::move(clearer);
+    auto end_clearance = [&](double z) {
+      double c = HUGE_VAL;
+      for (double e : ends) c = std::min({c, std::abs(z - e), H - std::abs(z - e)});
+      return c;
+    };
+    for (const std::pair<double, double>& clearest : widest(all))
+      if (const double c = end_clearance(clearest.second); c >= p.clip_clearance_d * d) {
+        candidates = {{c, clearest.second}};
+        break;
+      }
   }
   if (!(candidates.front().first >= p.clip_clearance_d * d))
     throw InputError(fmt::format("surface.clip_clearance_d = {}: no height of the periodic section lies that clear of "

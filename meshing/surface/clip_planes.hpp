@@ -57,7 +57,8 @@ inline bool reaches_plane(const std::pair<double, double>& range, double z, doub
 }
 
 // InputError naming the key when `p` treats contacts in a way a periodic section cannot take
-// (enlarge: see treat_periodic_section); the scene reader calls it too, before any work.
+// (enlarge, unless contacts.at_periodic_planes = "cut": see treat_periodic_section); the scene
+// reader calls it too, before any work.
 void refuse_treatments_across_periodic_planes(const SurfaceParams& p);
 // True when `p` bridges or caps contacts (of pairs or walls): treat_periodic_section opens those
 // a periodic plane crosses (unless build_cut_periodic_surface cuts them through).
@@ -88,8 +89,8 @@ SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, doubl
 // a period into [z0, z0 + H), then a copy a period away of each sphere crossing a plane. The
 // bed's container has no period (the copies are its images); copies count in its Sauter mean.
 // twin[i]: for a sphere crossing the upper plane, the index of its copy crossing the lower one,
-// whose cut loop it takes (-1 for the others). Not enlarge (refuse_treatments_across_periodic_planes
-// names the key); with bridges or caps the heights keep clear of the spheres' ends at their
+// whose cut loop it takes (-1 for the others). Not enlarge unless cut through
+// (refuse_treatments_across_periodic_planes names the key); with bridges or caps the heights keep clear of the spheres' ends at their
 // radius and shrunk by contacts.shrink_factor alike. InputError when no height lies
 // surface.clip_clearance_d clear of every sphere's end.
 struct UnwrappedSection {
@@ -99,9 +100,10 @@ struct UnwrappedSection {
   double clearance = 0.0;      // of the planes from the nearest sphere end (m)
   double narrowest_gap = 0.0;  // between the cut circles on the planes, and from them to the walls (m)
 };
-// `keep_clear` (m, any period): more heights the planes keep clear of (the rims of treated
-// contacts, for a cut through them) where some height lies surface.clip_clearance_d clear of
-// them and of the spheres' ends; else the spheres' ends alone.
+// `keep_clear` (m, any period), for a cut through the contacts: more heights (the rims of treated
+// contacts, the treated spheres' ends) the plane keeps as clear of as it can: of the 64 widest
+// intervals between them and the ends, the middle of the widest that lies
+// surface.clip_clearance_d clear of the ends (else as without them).
 UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p, const std::vector<double>& keep_clear = {});
 
 }  // namespace bedforge::meshing

@@ -64,7 +64,7 @@ struct UnwrappedSection;  // clip_planes.hpp
 // a plane crosses (within surface.clip_clearance_d) is opened as a clip window opens it (its
 // spheres, and their images a period away, shrink by contacts.shrink_factor and it is left as a
 // gap); report "periodic_planes_m" counts them. (contacts.at_periodic_planes = "cut" cuts them
-// through instead: build_cut_periodic_surface, which this treatment then only sizes.)
+// through instead: build_cut_periodic_surface.)
 TreatedBed treat_periodic_section(const UnwrappedSection& section, const SurfaceParams& p);
 
 }  // namespace bedforge::meshing

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <future>
 #include <numbers>
 #include <optional>
@@ -181,6 +182,14 @@ struct LaidOut {
 LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
   if (bed.container->axial_period() > 0.0) {
     std::optional<UnwrappedSection> u = unwrap_periodic_section(bed, p);
+    if (cuts_contacts_at_periodic_planes(bed, p)) {
+      // Sized as cut through (build_cut_periodic_surface): every contact treated, a sphere that
+      // crosses a plane and its copy a period away each counted within the planes.
+      const double inf = std::numeric_limits<double>::infinity();
+      TreatedBed tb = treat_contacts(u->bed, p, {-inf, inf, false});
+      tb.planes = u->planes;
+      return {std::move(u), std::move(tb), bed};
+    }
     TreatedBed tb = treat_periodic_section(*u, p);
     return {std::move(u), std::move(tb), bed};
   }

@@ -37,7 +37,8 @@ Bed repeated(const Bed& bed, double lo, double hi) {
 }
 
 // The highest and lowest point of every loop where treated contacts meet a sphere (bridges' and
-// caps' rims, at the wall too) over one period (m): where a plane passes near one, the rim
+// caps' rims, at the wall too; enlarged spheres' unions) and the treated spheres' ends over one
+// period (m): where a plane passes near one, the rim
 // meets the plane nearly tangent and the cut leaves slivers (cells failing checkMesh's skewness
 // beside the seed-2 slice's rims 0.0002 and 0.003 d from its plane, docs/findings.md, 2026-12-01).
 std::vector<double> rim_heights(const Bed& bed, const SurfaceParams& p) {
@@ -53,6 +54,8 @@ std::vector<double> rim_heights(const Bed& bed, const SurfaceParams& p) {
                                                 [](const auto& a, const auto& b) { return a.z() < b.z(); });
       if (lo != cut.loop.end()) out.push_back(lo->z()), out.push_back(hi->z());
     }
+    // An enlarged sphere's ends, which the plane keeps clear of as of any sphere's.
+    for (double end : {-treated.radius[i], treated.radius[i]}) out.push_back(around.centres[i].z() + end);
   }
   return out;
 }
@@ -103,12 +106,14 @@ void check_periodic_cut(const Container& container, const SurfaceParams& p, doub
 }
 
 bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p) {
-  return p.cut_at_periodic_planes && bed.container->axial_period() > 0.0 && opens_contacts_at_periodic_planes(p) &&
+  using Treatment = SurfaceParams::Treatment;
+  const bool joins = opens_contacts_at_periodic_planes(p) || p.treatment == Treatment::enlarge;
+  return p.cut_at_periodic_planes && bed.container->axial_period() > 0.0 && joins &&
          !dynamic_cast<const Box*>(bed.container.get());
 }
 
 FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
-  const double H = bed.container->axial_period(), d = reference_diameter(bed), edge = p.edge_length_d * d;
+  const double H = bed.container->axial_period(), d = reference_diameter(bed);
   check_periodic_cut(*bed.container, p, d);
   // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends and,
   // where it can be, of the contacts' rims; its circles widest apart), a height the STL keeps as
@@ -117,12 +122,22 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
   const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
   const double m = seam_depth(p, d), s = z0 - m;
 
-  // 2. The bed repeated over a clip window that keeps its own planes piece_margin_d (and the
-  // slack they may move by) from both seams; its walls ringed at the seams and the planes.
-  const double margin = (piece_margin_d(bed, p) + kWindowPlaneSlack_d) * d;
-  const Bed laid = repeated(bed, s - margin - largest_diameter(bed), z1 + margin + largest_diameter(bed));
-  FluidSurface whole = build_fluid_surface(
-      laid, window_cut_at_rings(p, (s - margin) / d, (z1 + margin) / d, {s / d, z0 / d, (s + H) / d, z1 / d}));
+  // 2. The bed repeated a period apart, whole spheres from piece_margin_d below the lower seam
+  // to as far above the upper plane, laid out as an ordinary bed with an empty end either side
+  // (so no plane of its own cuts a contact: enlarged unions too), its walls ringed at the seams
+  // and the planes.
+  const double margin = piece_margin_d(bed, p) * d;
+  const Bed laid = repeated(bed, s - margin, z1 + margin);
+  double lowest = s - margin, highest = z1 + margin;
+  for (std::size_t i = 0; i < laid.size(); ++i) {
+    lowest = std::min(lowest, laid.centres[i].z() - laid.diameters[i]);
+    highest = std::max(highest, laid.centres[i].z() + laid.diameters[i]);
+  }
+  SurfaceParams whole_bed = p;
+  whole_bed.inlet_length_d = -lowest / d;
+  whole_bed.outlet_length_d = (highest - bed_height(laid)) / d;
+  whole_bed.wall_rings_d = {s / d, z0 / d, (s + H) / d, z1 / d};
+  FluidSurface whole = build_fluid_surface(laid, whole_bed);
 
   // 3. Cut at the lower plane: the fluid above it and below it, one face between them.
   PlaneCut cut = [&] {

@@ -181,6 +181,10 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   // period is shorter than twice the seam (an edge of 0.9 d: 4 edges, so 7.2 d).
   const std::string cut = "[contacts]\nat_periodic_planes = \"cut\"\n[outputs]\nfiles = [\"case\"]\n";
   EXPECT_TRUE(read(section + cut).surface.cut_at_periodic_planes);
+  // Enlarged, refused above with the planes opening, read when they cut through.
+  EXPECT_NE(enlarged.find("at_periodic_planes = \"cut\""), std::string::npos) << enlarged;
+  const std::string enlarged_cut = "[contacts]\ntreatment = \"enlarge\"\nat_periodic_planes = \"cut\"\n[outputs]\nfiles = [\"case\"]\n";
+  EXPECT_TRUE(read(section + enlarged_cut).surface.cut_at_periodic_planes);
   const std::string unperiodic = message("[container]\ndiameter_d = 5\n[particles]\ncount = 105\n" + cut);
   EXPECT_NE(unperiodic.find("contacts.at_periodic_planes = \"cut\" without container.period_z_d"), std::string::npos)
       << unperiodic;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/contacts.hpp"
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/stl_io.hpp"
@@ -835,13 +836,31 @@ TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
   }
 }
 
+// For a cut through the contacts the periodic plane takes the middle of the widest interval
+// between the spheres' ends and the heights it is to keep clear of (the rims): spheres with ends
+// at 0, 1, 1.5 and 2.5 in a period of 3 and rims at 0.3 and 1.9 leave 0.3-1 the widest (0.65,
+// 0.35 from the nearest end); without the rims the plane keeps to the ends alone.
+TEST(FluidSurface, APeriodicCutTakesTheHeightClearestOfRimsAndEnds) {
+  auto tube = std::make_shared<Cylinder>(1.5);
+  tube->set_axial_period(3.0);
+  const Bed b = column(tube, {{0.0, 0.0, 0.5}, {0.0, 0.5, 2.0}});
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::none;  // the ends at one radius (bridges add the shrunk one)
+  p.clip_clearance_d = 0.1;
+  const UnwrappedSection cut = unwrap_periodic_section(b, p, {0.3, 1.9 + 3.0});
+  EXPECT_NEAR(cut.planes.z0, 0.65, 1e-12);
+  EXPECT_NEAR(cut.clearance, 0.35, 1e-12);
+  const UnwrappedSection open = unwrap_periodic_section(b, p);
+  EXPECT_NEAR(open.clearance, 0.5, 1e-12) << open.planes.z0;
+}
+
 // With contacts.at_periodic_planes = "cut" the same plane cuts those contacts through instead:
 // none opened, no sphere shrunk (the fluid volume is the bridged or capped bed's, its contacts'
 // change and count as treat_contacts gives them for the bed unwrapped, a contact across the
 // period's ends among them), and the plane's section is what the
-// treatment made: bridged, the pair is one hole and the sphere bridged to the wall is part of
-// the wall's loop, so 2 loops where opening leaves 4 (the wall and three circles); capped, the
-// caps' gaps keep the 4 apart. The surface is closed, its volume within the facets' deviation of the exact one,
+// treatment made: bridged or enlarged (which opening cannot take), the pair is one hole and the
+// sphere joined to the wall is part of the wall's loop, so 2 loops where opening leaves 4 (the
+// wall and three circles); capped, the caps' gaps keep the 4 apart. The surface is closed, its volume within the facets' deviation of the exact one,
 // and the outlet is the inlet one period up, bit for bit in x and y.
 TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked) {
   auto tube = std::make_shared<Cylinder>(1.5);
@@ -856,7 +875,7 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked)
   unwrapped.back().z() -= 3.0;
   Bed tall = column(std::make_shared<Cylinder>(1.5), unwrapped);
   const double inf = std::numeric_limits<double>::infinity();
-  for (Treatment t : {Treatment::bridge, Treatment::cap}) {
+  for (Treatment t : {Treatment::bridge, Treatment::cap, Treatment::enlarge}) {
     SurfaceParams p;
     p.treatment = p.wall_treatment = t;
     p.clip_clearance_d = 0.4;
@@ -866,7 +885,7 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked)
     EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting) << treatment_name(t);
     EXPECT_NEAR(fs.report["domain_m"]["inlet_z"].get<double>(), 1.5, 1e-9) << treatment_name(t);
     EXPECT_EQ(fs.report["periodic_planes_m"]["contacts_opened"].get<long>(), 0) << treatment_name(t);
-    EXPECT_EQ(fs.report["periodic_planes_m"]["cut"]["loops"].get<long>(), t == Treatment::bridge ? 2 : 4)
+    EXPECT_EQ(fs.report["periodic_planes_m"]["cut"]["loops"].get<long>(), t == Treatment::cap ? 4 : 2)
         << treatment_name(t);
     const nlohmann::json treated = treat_contacts(tall, p, {-inf, inf, false}).report;
     const double change = treated["solid_volume_change_m3"].get<double>();
