@@ -16,10 +16,11 @@ struct Bed {
   std::vector<Eigen::Vector3d> centres;        // m, N
   std::vector<double> diameters;               // m, N
   std::shared_ptr<const Container> container;  // lengths in m
-  // An empty bed (the container alone, a run whose flow has an exact answer) has no spheres to
-  // take its reference diameter from: it keeps the scene's particle diameter (m), the unit of
-  // the scene's _d lengths. Unused when the bed has spheres.
-  double empty_reference_diameter = 0.0;
+  // The unit of the scene's _d lengths (m) where the bed's own spheres cannot give it: an empty
+  // bed (the container alone, a run whose flow has an exact answer) keeps the scene's particle
+  // diameter; a window of a larger bed (a slab's spheres, a periodic section repeated) that
+  // bed's, so that its lengths are the whole bed's. 0: the Sauter mean of its spheres.
+  double reference_diameter_m = 0.0;
 
   std::size_t size() const { return centres.size(); }
 };
@@ -31,14 +32,15 @@ inline double sauter_mean(const std::vector<double>& diameters) {
   return s2 > 0.0 ? s3 / s2 : 0.0;
 }
 
-// The bed's reference diameter (m): the Sauter mean of its spheres, or an empty bed's own.
+// The bed's reference diameter (m): the one it keeps (Bed::reference_diameter_m), else the
+// Sauter mean of its spheres.
 inline double reference_diameter(const Bed& bed) {
-  return bed.size() > 0 ? sauter_mean(bed.diameters) : bed.empty_reference_diameter;
+  return bed.reference_diameter_m > 0.0 || bed.size() == 0 ? bed.reference_diameter_m : sauter_mean(bed.diameters);
 }
 
 // The largest sphere's diameter (m); an empty bed's reference diameter.
 inline double largest_diameter(const Bed& bed) {
-  return bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) : bed.empty_reference_diameter;
+  return bed.size() > 0 ? *std::max_element(bed.diameters.begin(), bed.diameters.end()) : bed.reference_diameter_m;
 }
 
 // The spheres' total volume (m^3).

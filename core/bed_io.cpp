@@ -21,7 +21,7 @@ std::string header_lines(const Bed& bed, const Provenance& p, const char* prefix
   h += fmt::format("{}version: {}\n", prefix, p.version);
   if (p.seed) h += fmt::format("{}seed: {}\n", prefix, *p.seed);
   if (bed.container) h += fmt::format("{}container_m: {}\n", prefix, bed.container->to_json().dump());
-  if (bed.size() == 0) h += fmt::format("{}reference_diameter_m: {:.17g}\n", prefix, bed.empty_reference_diameter);
+  if (bed.size() == 0) h += fmt::format("{}reference_diameter_m: {:.17g}\n", prefix, bed.reference_diameter_m);
   if (!p.scene.is_null()) h += fmt::format("{}scene: {}\n", prefix, p.scene.dump());
   return h;
 }
@@ -85,7 +85,7 @@ ImportedBed read_bed_text(const std::filesystem::path& path, double to_metres) {
           if (std::string(key) == "container_m:") result.bed.container = container_from_json(nlohmann::json::parse(value));
           else if (std::string(key) == "scene:") result.header["scene"] = nlohmann::json::parse(value);
           else if (std::string(key) == "seed:") result.header["seed"] = std::stoull(value);
-          else if (std::string(key) == "reference_diameter_m:") result.bed.empty_reference_diameter = std::stod(value);
+          else if (std::string(key) == "reference_diameter_m:") result.bed.reference_diameter_m = std::stod(value);
           else result.header["version"] = value.substr(value.find_first_not_of(' '));
         } catch (const std::exception& e) {
           throw InputError(fmt::format("{}:{}: unreadable header entry '{}': {}", path.string(), line_no, key, e.what()));
@@ -125,7 +125,7 @@ ImportedBed read_bed_text(const std::filesystem::path& path, double to_metres) {
     result.bed.diameters.push_back(v[3] * to_metres);
   }
   // Only bedforge's own record of an empty container may have no rows.
-  if (result.bed.centres.empty() && !(result.bed.empty_reference_diameter > 0.0))
+  if (result.bed.centres.empty() && !(result.bed.reference_diameter_m > 0.0))
     throw InputError(fmt::format("{}: no sphere rows 'x y z d' found", path.string()));
   return result;
 }

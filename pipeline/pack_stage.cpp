@@ -63,7 +63,7 @@ PackStage pack_stage(const Scene& scene, const Console& console) {
                        overlaps["max_wall_overlap_d"].get<double>());
   } else if (scene.count == 0) {
     out.bed.container = scene.container;
-    out.bed.empty_reference_diameter = scene.sizes.sauter_mean();
+    out.bed.reference_diameter_m = scene.sizes.sauter_mean();
     out.report = {{"algorithm", "none: particles.count = 0, the empty container"}};
     line = "pack: no spheres (particles.count = 0): the empty container";
   } else {

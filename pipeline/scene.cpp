@@ -111,7 +111,8 @@ void check_pieces(const Scene& sc) {
 }
 
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
-// periodic planes, the bridges and caps they cross opened (not enlarge), one piece.
+// periodic planes, the bridges and caps they cross opened or cut through (enlarge only cut
+// through), one piece.
 void check_periodic_surface(const Scene& sc) {
   if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
   if (sc.surface.cut_at_periodic_planes) meshing::check_periodic_cut(*sc.container, sc.surface, sc.sizes.sauter_mean());

@@ -54,7 +54,8 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "accelerated soft-sphere packer, which compresses a longer period down to this one without gravity and "
         "taps them where they jam first, or stops with an error naming the void fraction it jammed at; meshed as a "
         "cyclic case, its spheres cut by the periodic planes (bridges and caps the planes cross are opened, their "
-        "spheres shrunk by `contacts.shrink_factor`, or cut through: `contacts.at_periodic_planes`; not enlarge)"}},
+        "spheres shrunk by `contacts.shrink_factor`, or cut through: `contacts.at_periodic_planes`; enlarge only cut "
+        "through)"}},
       {"container.period_z_m", {"the same in metres"}},
       // [particles]
       {"particles.count",
@@ -141,11 +142,11 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "", kWhyContacts}},
       {"contacts.wall_treatment", {"the same for sphere-wall contacts; `same` follows `treatment`"}},
       {"contacts.at_periodic_planes",
-       {"periodic section (container.period_z_d), bridges and caps: what its planes do to the treated contacts they "
-        "cross: `open` them (their spheres shrunk by shrink_factor, the contact left a gap) or `cut` them through as "
-        "treated (a surface built over two periods and cut at one plane; cylinder or annulus, a period of at least "
-        "twice max(4 edge_length_d, 0.5) d). `cut` left checkMesh failures at the planes where `open` left none "
-        "(docs/findings.md, 2026-12-01), so `open` is the default"}},
+       {"periodic section (container.period_z_d), bridges, caps and unions: what its planes do to the treated "
+        "contacts they cross: `open` them (their spheres shrunk by shrink_factor, the contact left a gap; not enlarge) "
+        "or `cut` them through as treated (a surface built over two periods and cut at one plane; cylinder or annulus, "
+        "a period of at least twice max(4 edge_length_d, 0.5) d; enlarge too). `cut` left 5-14 cells of 290 k failing "
+        "checkMesh at the planes where `open` left none (docs/findings.md, 2026-12-01), so `open` is the default"}},
       {"contacts.shrink_factor", {"shrink: sphere scale", "1"}},
       {"contacts.enlarge_factor", {"enlarge: sphere scale", "1"}},
       {"contacts.enlarge_join_gap_d",

@@ -77,8 +77,7 @@ ClipPlacement place_clip_planes(const Bed& bed, const SurfaceParams& p, DomainPl
     ClipHeight h = clip_height(*z, p.clip_shift_d * d, clearance, everything);
     const bool opens = !(h.clearance >= clearance) && can_open;
     if (opens) h = clip_height(*z, p.clip_shift_d * d, clearance, with_shrunk);
-    const bool clear_enough = h.clearance >= clearance || (p.clip_faces_cut_away && h.clearance > 0.0);
-    if (!clear_enough)
+    if (!(h.clearance >= clearance))
       throw InputError(fmt::format(
           "surface.clip_window_d: the {} clip plane at {:.4g} d finds no height within surface.clip_shift_d = {} d "
           "that keeps surface.clip_clearance_d = {} d clear of every sphere's top and bottom{} (at best {:.3g} d, at "
@@ -110,15 +109,45 @@ double piece_margin_d(const Bed& bed, const SurfaceParams& surface) {
          surface.clip_shift_d;
 }
 
-SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, double top_d, std::vector<double> rings_d) {
-  SurfaceParams q = p;
+std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const TreatedBed treated = treat_contacts(bed, p, {-inf, inf, false});
+  std::vector<double> out;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    for (const SphereCut& cut : treated.cuts[i]) {
+      const auto [lo, hi] = std::minmax_element(cut.loop.begin(), cut.loop.end(),
+                                                [](const auto& a, const auto& b) { return a.z() < b.z(); });
+      if (lo != cut.loop.end()) out.push_back(lo->z()), out.push_back(hi->z());
+    }
+    for (double end : {-treated.radius[i], treated.radius[i]}) out.push_back(bed.centres[i].z() + end);
+  }
+  return out;
+}
+
+CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d) {
+  const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
+  CutWindow out;
+  out.bed.container = bed.container;
+  out.bed.reference_diameter_m = d;
+  double lowest = inf, highest = -inf;
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    if (const double z = bed.centres[i].z(); z >= lo && z <= hi) {
+      out.bed.centres.push_back(bed.centres[i]);
+      out.bed.diameters.push_back(bed.diameters[i]);
+      lowest = std::min(lowest, z - 0.5 * bed.diameters[i]);
+      highest = std::max(highest, z + 0.5 * bed.diameters[i]);
+    }
+  const double pad = 0.5 * largest_diameter(bed);
+  SurfaceParams& q = out.surface;
+  q = p;
   q.clip = true;
-  q.clip_bottom_d = bottom_d;
-  q.clip_top_d = top_d;
-  q.clip_shift_d = std::max(q.clip_shift_d, kWindowPlaneSlack_d);
-  q.clip_faces_cut_away = true;
+  q.clip_bottom_d = std::isinf(lo) ? (p.clip ? p.clip_bottom_d : -p.inlet_length_d)
+                                   : (out.bed.size() > 0 ? lowest - pad : lo) / d;
+  q.clip_top_d = std::isinf(hi) ? (p.clip ? p.clip_top_d : bed_height(bed) / d + p.outlet_length_d)
+                                : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
-  return q;
+  q.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
+  return out;
 }
 
 double opening_reach(const Bed& bed, const SurfaceParams& p) {
@@ -228,7 +257,7 @@ UnwrappedSection unwrap_periodic_section(const Bed& bed, const SurfaceParams& p,
   std::unique_ptr<Container> plain = bed.container->scaled(1.0);
   plain->set_axial_period(0.0);
   out.bed.container = std::move(plain);
-  out.bed.empty_reference_diameter = bed.empty_reference_diameter;
+  out.bed.reference_diameter_m = reference_diameter(bed);
   for (std::size_t i = 0; i < bed.size(); ++i) {
     Eigen::Vector3d c = bed.centres[i];
     if (c.z() < z0) c.z() += H;

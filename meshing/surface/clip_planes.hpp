@@ -66,20 +66,34 @@ bool opens_contacts_at_periodic_planes(const SurfaceParams& p);
 
 // How far (d) a window is widened before its surface is cut at a plane through treated
 // contacts (a slab's, a periodic section's): a sphere crossing a plane, its neighbours (whose
-// contacts shape its cuts) and theirs (which the window's own clip planes may open, moved by up
-// to surface.clip_shift_d), and the surfaces its narrow-gap spacing sees (surface.cells_per_gap
-// edges): 3 largest diameters plus those two lengths. Within it both windows of a plane hold the
-// same spheres, contacts and cuts.
+// contacts shape its cuts) and theirs, and the surfaces its narrow-gap spacing sees
+// (surface.cells_per_gap edges): 3 largest diameters plus that length and surface.clip_shift_d.
+// Within it both windows of a plane hold the same spheres, contacts and cuts.
 double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
 
-// A window's own clip planes go with what lies beyond the cuts made in its surface: set
-// kWindowPlaneSlack_d beyond piece_margin_d and free to move that far, they stay piece_margin_d
-// away and find a height clear of the spheres' ends where surface.clip_shift_d does not (a = 14,
-// N = 1e4: at best 0.0032 of the 0.005 d clearance within 0.25 d), or else the clearest height.
-inline constexpr double kWindowPlaneSlack_d = 1.0;
-// `p` as such a window from `bottom_d` to `top_d` (d above the floor), its curved walls ringed at
-// `rings_d` (d), the heights its surface will be cut at.
-SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, double top_d, std::vector<double> rings_d);
+// The heights (m) a plane cut through `bed`'s treated contacts keeps as clear of as it can: the
+// highest and lowest point of every loop where a treated contact meets a sphere (bridges' and
+// caps' rims, at the wall too; enlarged spheres' unions) and the treated spheres' ends. Where a
+// plane passes near one, it meets the surface nearly tangent and the cut leaves slivers (cells
+// failing checkMesh's skewness beside a periodic slice's rims 0.0002 and 0.003 d from its plane,
+// docs/findings.md, 2026-12-01), or a wall ring there moves a loop's vertex.
+std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p);
+
+// A window of `bed` whose surface is cut at planes inside it through its treated contacts (a
+// slab's or a piece's, a periodic section's). Its own clip planes must cut no contact, which a
+// plane through a packed bed cannot promise (a bed of a = 14 had no height 0.005 d clear of
+// every sphere's end within 0.25 d, and the a = 5 bed enlarged none clear of its unions within
+// 1 d, which cannot be opened): so the window holds, whole, only the spheres whose centres lie
+// from `lo` to `hi` (m), and its planes lie half a largest diameter beyond their ends, where they
+// cut nothing; on a side where `lo` or `hi` is infinite, the plane is `p`'s own (the scene's
+// inlet or outlet, or its clip plane). Its lengths in d are the bed's (Bed::reference_diameter_m),
+// and its curved walls are ringed at `rings_d` (d above the floor) with the edge of the whole
+// bed's narrowest wall gap, so that every window of one bed rings a plane with the same vertices.
+struct CutWindow {
+  Bed bed;
+  SurfaceParams surface;
+};
+CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d);
 
 // A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
 // planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between
@@ -87,7 +101,7 @@ SurfaceParams window_cut_at_rings(const SurfaceParams& p, double bottom_d, doubl
 // surface.clip_clearance_d clear of them, the one whose cut circles keep the widest gap between
 // each other and to the walls (the periodic faces' triangles are as narrow); each centre moved by
 // a period into [z0, z0 + H), then a copy a period away of each sphere crossing a plane. The
-// bed's container has no period (the copies are its images); copies count in its Sauter mean.
+// bed's container has no period (the copies are its images); its reference diameter is the bed's.
 // twin[i]: for a sphere crossing the upper plane, the index of its copy crossing the lower one,
 // whose cut loop it takes (-1 for the others). Not enlarge unless cut through
 // (refuse_treatments_across_periodic_planes names the key); with bridges or caps the heights keep clear of the spheres' ends at their

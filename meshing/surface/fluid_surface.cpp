@@ -110,7 +110,6 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"clip_clearance_d", p.clip_clearance_d},
           {"min_angle_deg", p.min_angle_deg}};
   if (!p.wall_rings_d.empty()) j["wall_rings_d"] = p.wall_rings_d;
-  if (p.clip_faces_cut_away) j["clip_faces_cut_away"] = true;
   return j;
 }
 
@@ -265,9 +264,11 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // sphere. Where the spheres' edge is too long for that, the curved walls (a few thousand
   // triangles; an annulus's two share the end rings' meshes) take the longest edge whose
   // sagitta is 0.4 of the gap, down to the contact edge.
-  // With rings, the whole bed's gap: every window of the bed then rings its walls alike (the
-  // window's opened contacts lie beyond its pieces' planes, cut away).
-  const double wall_gap = p.wall_rings_d.empty() ? tb.min_concave_wall_gap : tb.bed_min_concave_wall_gap;
+  // With rings, the whole bed's gap: every window of the bed then rings its walls alike (a
+  // window's own spheres and opened contacts differ; window_for_cuts).
+  const double wall_gap = p.wall_rings_d.empty()   ? tb.min_concave_wall_gap
+                          : p.ring_wall_gap_m > 0.0 ? p.ring_wall_gap_m
+                                                    : tb.bed_min_concave_wall_gap;
   double wall_edge = edge;
   if (!box && ring_sagitta(R, edge) >= 0.5 * wall_gap) {
     wall_edge = wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * wall_gap) : 0.0;

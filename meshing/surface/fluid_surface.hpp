@@ -45,12 +45,11 @@ struct SurfaceParams {
   double clip_shift_d = 0.25;           // how far a clip plane may move to keep clear of the bed
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
   // Heights above the floor (d) where the curved walls get rings (wall_mesh), not from a scene:
-  // the planes a bed's pieces are cut at, so that each piece's window cuts the wall there alike.
+  // the planes a bed's pieces are cut at, so that each piece's window cuts the wall there alike;
+  // and the narrowest wall gap of the whole bed (m), whose edge the ringed walls take (0: this
+  // bed's; window_for_cuts sets both).
   std::vector<double> wall_rings_d;
-  // Set for a piece's window (not from a scene), whose clip faces the piece's cuts throw away: a
-  // clip plane that finds no height clip_clearance_d clear of the bed takes the clearest height
-  // it found instead of failing (a wide bed's spheres leave no such height within reach).
-  bool clip_faces_cut_away = false;
+  double ring_wall_gap_m = 0.0;
   // Quality gate: a surface with a smaller angle fails, its triangles written to
   // bad_triangles.vtp (0 turns the gate off).
   double min_angle_deg = 2.0;

@@ -27,36 +27,12 @@ Bed repeated(const Bed& bed, double lo, double hi) {
   std::unique_ptr<Container> plain = bed.container->scaled(1.0);
   plain->set_axial_period(0.0);
   out.container = std::move(plain);
-  out.empty_reference_diameter = bed.empty_reference_diameter;
+  out.reference_diameter_m = reference_diameter(bed);
   for (long k = static_cast<long>(std::floor(lo / H)) - 1; k * H <= hi + H; ++k)
     for (std::size_t i = 0; i < bed.size(); ++i) {
       const Eigen::Vector3d c = bed.centres[i] + Eigen::Vector3d(0.0, 0.0, static_cast<double>(k) * H);
       if (c.z() >= lo && c.z() <= hi) out.centres.push_back(c), out.diameters.push_back(bed.diameters[i]);
     }
-  return out;
-}
-
-// The highest and lowest point of every loop where treated contacts meet a sphere (bridges' and
-// caps' rims, at the wall too; enlarged spheres' unions) and the treated spheres' ends over one
-// period (m): where a plane passes near one, the rim
-// meets the plane nearly tangent and the cut leaves slivers (cells failing checkMesh's skewness
-// beside the seed-2 slice's rims 0.0002 and 0.003 d from its plane, docs/findings.md, 2026-12-01).
-std::vector<double> rim_heights(const Bed& bed, const SurfaceParams& p) {
-  const double H = bed.container->axial_period(), reach = largest_diameter(bed),
-               inf = std::numeric_limits<double>::infinity();
-  const Bed around = repeated(bed, -reach, H + reach);
-  const TreatedBed treated = treat_contacts(around, p, {-inf, inf, false});
-  std::vector<double> out;
-  for (std::size_t i = 0; i < around.size(); ++i) {
-    if (around.centres[i].z() < 0.0 || around.centres[i].z() >= H) continue;  // each sphere once
-    for (const SphereCut& cut : treated.cuts[i]) {
-      const auto [lo, hi] = std::minmax_element(cut.loop.begin(), cut.loop.end(),
-                                                [](const auto& a, const auto& b) { return a.z() < b.z(); });
-      if (lo != cut.loop.end()) out.push_back(lo->z()), out.push_back(hi->z());
-    }
-    // An enlarged sphere's ends, which the plane keeps clear of as of any sphere's.
-    for (double end : {-treated.radius[i], treated.radius[i]}) out.push_back(around.centres[i].z() + end);
-  }
   return out;
 }
 
@@ -115,29 +91,21 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p) {
 FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
   const double H = bed.container->axial_period(), d = reference_diameter(bed);
   check_periodic_cut(*bed.container, p, d);
-  // 1. The planes: z0 where a periodic section would have it (clear of the spheres' ends and,
-  // where it can be, of the contacts' rims; its circles widest apart), a height the STL keeps as
-  // it is; the seam m below each.
-  const UnwrappedSection section = unwrap_periodic_section(bed, p, rim_heights(bed, p));
+  // 1. The planes: z0 the height widest apart from the contacts' rims and the spheres' ends
+  // that keeps clip_clearance_d from the ends, a height the STL keeps as it is; the seam m below
+  // each.
+  const UnwrappedSection section = unwrap_periodic_section(
+      bed, p, treated_heights(repeated(bed, -largest_diameter(bed), H + largest_diameter(bed)), p));
   const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
   const double m = seam_depth(p, d), s = z0 - m;
 
   // 2. The bed repeated a period apart, whole spheres from piece_margin_d below the lower seam
-  // to as far above the upper plane, laid out as an ordinary bed with an empty end either side
-  // (so no plane of its own cuts a contact: enlarged unions too), its walls ringed at the seams
-  // and the planes.
+  // to as far above the upper plane, in a window whose own planes cut nothing (window_for_cuts),
+  // its walls ringed at the seams and the planes.
   const double margin = piece_margin_d(bed, p) * d;
   const Bed laid = repeated(bed, s - margin, z1 + margin);
-  double lowest = s - margin, highest = z1 + margin;
-  for (std::size_t i = 0; i < laid.size(); ++i) {
-    lowest = std::min(lowest, laid.centres[i].z() - laid.diameters[i]);
-    highest = std::max(highest, laid.centres[i].z() + laid.diameters[i]);
-  }
-  SurfaceParams whole_bed = p;
-  whole_bed.inlet_length_d = -lowest / d;
-  whole_bed.outlet_length_d = (highest - bed_height(laid)) / d;
-  whole_bed.wall_rings_d = {s / d, z0 / d, (s + H) / d, z1 / d};
-  FluidSurface whole = build_fluid_surface(laid, whole_bed);
+  const CutWindow window = window_for_cuts(laid, p, s - margin, z1 + margin, {s / d, z0 / d, (s + H) / d, z1 / d});
+  FluidSurface whole = build_fluid_surface(window.bed, window.surface);
 
   // 3. Cut at the lower plane: the fluid above it and below it, one face between them.
   PlaneCut cut = [&] {

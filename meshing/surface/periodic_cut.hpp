@@ -5,23 +5,26 @@
 namespace bedforge::meshing {
 
 // Whether build_fluid_surface cuts a periodic section of `bed` under `p` through its treated
-// contacts (build_cut_periodic_surface): contacts.at_periodic_planes = "cut", bridges or caps, in
-// a cylinder or annulus (a box's flat sides are not ringed; the scene reader refuses it).
+// contacts (build_cut_periodic_surface): contacts.at_periodic_planes = "cut", bridges, caps or
+// enlarge, in a cylinder or annulus (a box's flat sides are not ringed; the scene reader refuses
+// it).
 bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 
 // The fluid surface of `bed`, periodic along z (container.axial_period() = H > 0), between two
-// planes a period apart, z0 (unwrap_periodic_section's, rounded as an ASCII STL keeps it) and
-// z1 = z0 + H, with every bridge and cap the planes cross cut through as the treatment made it
-// (none opened), and the outlet's face the inlet's moved up a period, point for point.
+// planes a period apart, z0 (unwrap_periodic_section's with the rims and treated ends to keep
+// clear of, rounded as an ASCII STL keeps it) and z1 = z0 + H, with every bridge, cap and union
+// the planes cross cut through as the treatment made it (none opened), and the outlet's face
+// the inlet's moved up a period, point for point.
 //
-// How: the bed is repeated a period apart over a clip window from s - W to z1 + W (s = z0 - m,
-// the seam; W = piece_margin_d + kWindowPlaneSlack_d), its curved walls ringed at s, z0, s + H
-// and z1, and its surface built (build_fluid_surface) and cut at z0 (cut_by_plane). The section
-// is the part above z0 up to s + H, and the part below z0 from s up, moved up a period. The
-// cut's changes reach no seam (m is kSeamDepthEdges edges, at least kSeamDepthMinD d), and
-// there the repeated layout's surface repeats itself a period on: the spheres and contacts by
-// construction, the wall along its ring; the seam's vertices are taken from the part moved up,
-// so the two join bit for bit. A surface some three times the period's (the window's margins).
+// How: the spheres whose centres lie from s - W to z1 + W (s = z0 - m, the seam; W =
+// piece_margin_d) are laid out a period apart as an ordinary bed, whole, with an empty end half a
+// diameter deep each side (so no plane of its own cuts a contact), its curved walls ringed at s,
+// z0, s + H and z1, and its surface built (build_fluid_surface) and cut at z0 (cut_by_plane).
+// The section is the part above z0 up to s + H, and the part below z0 from s up, moved up a
+// period. The cut's changes reach no seam (m is kSeamDepthEdges edges, at least kSeamDepthMinD
+// d), and there the repeated layout's surface repeats itself a period on: the spheres and
+// contacts by construction, the wall along its ring; the seam's vertices are taken from the
+// part moved up, so the two join bit for bit. A surface some three times the period's.
 //   fluid  closed, patches inlet, outlet, wall (inner_wall), particles (m)
 //   bed    the particles' triangles, normals out of the solid: open where the planes cut them
 //   exact_volume_m3  A H less the treated solid of one period: the solid of two periods of the

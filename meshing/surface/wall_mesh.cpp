@@ -39,10 +39,25 @@ std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std
         moves.emplace_back(loop[k], to);
         loop[k] = to;
       };
+      const double near = kRingSnap * hole.spacing;
+      const auto [lowest, highest] = std::minmax_element(
+          loop.begin(), loop.end(), [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.z() < b.z(); });
+      if (n > 0 && !(lowest->z() < z && highest->z() > z)) {
+        // On one side (or touching it): the near vertices away from the ring, to `near`.
+        const double side = highest->z() > z ? 1.0 : -1.0;
+        for (std::size_t k = 0; k < n; ++k)
+          if (side * (loop[k].z() - z) < near) {
+            Eigen::Vector3d to = loop[k];
+            to.z() = z + side * near;
+            moves.emplace_back(loop[k], to);
+            loop[k] = to;
+          }
+        continue;
+      }
       // Vertices near the ring onto it (straight down or up), then the nearer end of each edge
       // still crossing it along that edge.
       for (std::size_t k = 0; k < n; ++k)
-        if (loop[k].z() != z && std::abs(loop[k].z() - z) < kRingSnap * hole.spacing) move(k, loop[k]);
+        if (loop[k].z() != z && std::abs(loop[k].z() - z) < near) move(k, loop[k]);
       for (std::size_t k = 0; k < n; ++k) {
         const std::size_t l = (k + 1) % n;
         const double a = loop[k].z() - z, b = loop[l].z() - z;

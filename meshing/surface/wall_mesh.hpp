@@ -30,7 +30,9 @@ inline constexpr double kRingSnap = 0.25;
 // Moves the vertices of `holes`' loops so that each ring height in `rings` (m) meets a loop only
 // at its vertices, as wall_mesh's rings need: a vertex within kRingSnap of the loop's spacing of
 // a ring onto it (in z only), then the nearer end of each loop edge still crossing it along that
-// edge (by at most half the edge). Returns each move as (from, to): the parts that share the
+// edge (by at most half the edge). A loop that lies on one side of a ring and comes that near it
+// has its near vertices moved away to that distance instead: snapped, the ring (and a plane cut
+// there) would touch the loop at one vertex. Returns each move as (from, to): the parts that share the
 // loops (a bridge's end, a sphere's cut) must move the same points alike.
 std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> snap_holes_to_rings(std::vector<WallHole>& holes,
                                                                              const std::vector<double>& rings);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
 
@@ -161,13 +162,17 @@ nlohmann::json cut_json(const PlaneCut& c, double plane_d) {
   return j;
 }
 
-// The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, sorted.
+// The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, and
+// where the slabs are cut through treated contacts the heights such a cut keeps clear of
+// (treated_heights), sorted.
 std::vector<double> sphere_ends_d(const Bed& bed, const SurfaceParams& s) {
   const double d = reference_diameter(bed);
   std::vector<double> ends;
   for (std::size_t i = 0; i < bed.size(); ++i)
     for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
       ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
+  if (!slabs_from_clip_windows(s))
+    for (double z : treated_heights(bed, s)) ends.push_back(z / d);
   std::sort(ends.begin(), ends.end());
   return ends;
 }
@@ -298,16 +303,17 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
                      bool release_memory) {
   const int slabs = static_cast<int>(planes.size()) + 1;
   const SurfaceParams asked = slab_surface(bed, surface, planes, k);
-  // Treated contacts: the window widened by piece_margin_d on each side and ringed at every
-  // plane, its surface then cut at the slab's own planes.
+  // Treated contacts: the spheres within piece_margin_d of the slab, ringed at every plane
+  // (window_for_cuts), their surface then cut at the slab's own planes.
   const bool cut = !slabs_from_clip_windows(surface);
-  SurfaceParams q = asked;
-  if (cut) {
-    const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
-    const double margin = piece_margin_d(bed, surface) + kWindowPlaneSlack_d;
-    q = window_cut_at_rings(asked, k > 0 ? std::max(whole.clip_bottom_d, planes[k - 1] - margin) : asked.clip_bottom_d,
-                            k + 1 < slabs ? std::min(whole.clip_top_d, planes[k] + margin) : asked.clip_top_d, planes);
-  }
+  const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
+  const double margin = piece_margin_d(bed, surface);
+  const CutWindow window =
+      cut ? window_for_cuts(bed, surface, k > 0 ? (planes[k - 1] - margin) * d : -inf,
+                            k + 1 < slabs ? (planes[k] + margin) * d : inf, planes)
+          : CutWindow{Bed(), asked};
+  const Bed& window_bed = cut ? window.bed : bed;
+  const SurfaceParams& q = window.surface;
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
   auto cannot = [&](const std::string& what) {
@@ -317,7 +323,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   };
   FluidSurface fs = [&] {
     try {
-      return build_fluid_surface(bed, q);
+      return build_fluid_surface(window_bed, q);
     } catch (const InputError& e) {
       throw cannot(e.what());
     }
@@ -325,7 +331,6 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   nlohmann::json planes_used = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};
   nlohmann::json cut_report = nlohmann::json::array();
   if (cut) {
-    const double d = reference_diameter(bed);
     for (const auto& [j, keep_above] : {std::pair{k - 1, true}, std::pair{k, false}}) {
       if (j < 0 || j + 1 >= slabs) continue;
       try {

@@ -53,18 +53,21 @@ TEST(BedIo, CsvRoundTripIsBitExactAndKeepsProvenance) {
 TEST(BedIo, AnEmptyBedKeepsItsReferenceDiameter) {
   Bed bed;
   bed.container = std::make_shared<Cylinder>(0.003);
-  bed.empty_reference_diameter = 0.0029999999999999996;
-  EXPECT_EQ(reference_diameter(bed), bed.empty_reference_diameter);
-  EXPECT_EQ(largest_diameter(bed), bed.empty_reference_diameter);
+  bed.reference_diameter_m = 0.0029999999999999996;
+  EXPECT_EQ(reference_diameter(bed), bed.reference_diameter_m);
+  EXPECT_EQ(largest_diameter(bed), bed.reference_diameter_m);
   const fs::path p = temp_dir() / "empty_bed.csv";
   write_file_atomically(p, bed_to_csv(bed, {"9.9.9", 1ULL, nullptr}));
   const ImportedBed back = read_bed_text(p, 1.0);
   EXPECT_EQ(back.bed.size(), 0u);
-  EXPECT_EQ(reference_diameter(back.bed), bed.empty_reference_diameter);
+  EXPECT_EQ(reference_diameter(back.bed), bed.reference_diameter_m);
   ASSERT_TRUE(back.bed.container);
-  // With spheres, the reference is theirs and no such header line is written.
+  // With spheres, the reference is theirs unless the bed keeps one (a window of a larger bed), and
+  // no such header line is written.
   bed.centres = {{0.0, 0.0, 0.001}};
   bed.diameters = {0.002};
+  EXPECT_EQ(reference_diameter(bed), 0.0029999999999999996);
+  bed.reference_diameter_m = 0.0;
   EXPECT_EQ(reference_diameter(bed), 0.002);
   EXPECT_EQ(bed_to_csv(bed, {"9.9.9", 1ULL, nullptr}).find("reference_diameter_m"), std::string::npos);
 }

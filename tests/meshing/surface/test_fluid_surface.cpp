@@ -629,24 +629,6 @@ TEST(FluidSurface, AClipPlaneWithNoRoomOpensTheContactsItCuts) {
   }
 }
 
-TEST(FluidSurface, APieceWindowsClipPlaneTakesTheClearestHeightWhereNoneIsClear) {
-  // As above, the outlet asked at 2.004 d with room to move 0.01 d, but 0.02 d clearance wanted:
-  // the spheres' ends at 1.995, 2.0 and 2.005 d (either radius) leave at most 0.009 d, at the
-  // range's end 2.014 d. A scene's clip window is refused; a piece's window, whose clip faces are
-  // cut away (clip_faces_cut_away), takes that height and says how clear it is.
-  SurfaceParams p;
-  p.clip = true;
-  p.clip_bottom_d = 0.9;
-  p.clip_top_d = 2.004;
-  p.clip_shift_d = 0.01;
-  p.clip_clearance_d = 0.02;
-  EXPECT_THROW(build_fluid_surface(box_stack(4), p), InputError);
-  p.clip_faces_cut_away = true;
-  const FluidSurface fs = valid_surface(box_stack(4), p, "a piece window's clearest clip height");
-  EXPECT_NEAR(fs.report["domain_m"]["outlet_z"].get<double>(), 2.014, 1e-12);
-  EXPECT_NEAR(fs.report["clip"]["outlet"]["clearance_d"].get<double>(), 0.009, 1e-12);
-}
-
 namespace {
 // Longest edge of the six triangles of `patch` whose centroids lie nearest to `at`.
 double longest_edge_near(const TriangleMesh& m, const std::string& patch, const Eigen::Vector3d& at) {

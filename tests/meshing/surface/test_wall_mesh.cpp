@@ -97,6 +97,29 @@ TEST(WallMesh, HolesAtEveryAngleStillCloseAcrossTheSeam) {
   EXPECT_NEAR(k.volume, kPi * R * R * height, 0.005 * kPi * R * R * height);
 }
 
+// A hole that comes within kRingSnap of its spacing of a ring without crossing it (its lowest
+// vertex 0.002 above a ring, the spacing 0.025) is not snapped onto it, which would leave the
+// ring (and a plane cut there) touching the loop at one vertex: its near vertices move away to
+// that distance, the others stay, and every move is reported.
+TEST(WallMesh, AHoleBesideARingIsMovedOffItNotOntoIt) {
+  std::vector<WallHole> holes{radial_hole(1.0, 0.3, 2.0, 0.08, 0.025)};
+  const WallHole before = holes[0];
+  const double lowest = std::min_element(before.loop.begin(), before.loop.end(), [](const auto& a, const auto& b) {
+                          return a.z() < b.z();
+                        })->z();
+  const double ring = lowest - 0.002, near = kRingSnap * before.spacing;
+  ASSERT_LT(0.002, near);
+  const auto moves = snap_holes_to_rings(holes, {ring});
+  EXPECT_FALSE(moves.empty());
+  for (std::size_t k = 0; k < before.loop.size(); ++k) {
+    const double was = before.loop[k].z() - ring, is = holes[0].loop[k].z() - ring;
+    EXPECT_GE(is, near * (1.0 - 1e-12)) << k;
+    if (was >= near) {
+      EXPECT_EQ(is, was) << k;
+    }
+  }
+}
+
 // Rings, as pieces of one bed cut from two windows need them: holes on a helix (so some cross
 // each ring, one across the seam) are snapped to the rings, and then no wall triangle crosses a
 // ring, the wall still closes with what the holes cut out, and two windows of other heights

@@ -187,16 +187,21 @@ TEST(SlabMesh, ASlabFailingTheGateIsTriedAgainWithThePlanesMovedAndTheErrorNames
 // volume and the particles' area within 1e-3: the cuts only move vertices onto the planes along
 // the surface (measured on 2026-11-30, tube and box: volume +3.5e-4 and +2.5e-4, area -3.3e-4
 // and -3.8e-4); one sphere left out, or the contacts near a plane opened by shrinking its
-// spheres, would take 1e-2 or more.
+// spheres, would take 1e-2 or more. Enlarged, the unions cut alike: on the tube's seed-3 bed,
+// whose windows found no plane of their own clear of the unions before their planes were laid
+// beyond the spheres they hold (window_for_cuts), and whose wall ring touched a union's loop
+// before a loop beside a ring was moved off it.
 TEST(SlabMesh, BridgedBedsAreCutIntoSlabsThroughTheirBridges) {
   Progress quiet("mesh", false);
-  const Bed tube = test_support::packed_bed(80, 4.0, 1);
+  using Treatment = SurfaceParams::Treatment;
+  const Bed tube = test_support::packed_bed(80, 4.0, 1), other = test_support::packed_bed(80, 4.0, 3);
   Bed box = tube;
   box.container = std::make_shared<Box>(4.2, 4.2, false, false);
-  for (const Bed* b : {&tube, static_cast<const Bed*>(&box)}) {
-    SCOPED_TRACE(b->container->kind());
+  for (const auto& [b, treatment] : {std::pair{&tube, Treatment::bridge}, std::pair{static_cast<const Bed*>(&box), Treatment::bridge},
+                                     std::pair{&other, Treatment::enlarge}}) {
+    SCOPED_TRACE(b->container->kind() + " " + std::string(treatment_name(treatment)));
     SurfaceParams sp;
-    sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::bridge;
+    sp.treatment = sp.wall_treatment = treatment;
     sp.edge_length_d = 0.15;
     const FluidSurface whole = build_fluid_surface(*b, sp);
     VolumeMeshParams p;
