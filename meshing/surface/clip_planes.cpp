@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <regex>
+#include <string>
 
 #include "core/error.hpp"
 
@@ -134,6 +136,7 @@ CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, dou
     if (const double z = bed.centres[i].z(); z >= lo && z <= hi) {
       out.bed.centres.push_back(bed.centres[i]);
       out.bed.diameters.push_back(bed.diameters[i]);
+      out.numbers.push_back(i);
       lowest = std::min(lowest, z - 0.5 * bed.diameters[i]);
       highest = std::max(highest, z + 0.5 * bed.diameters[i]);
     }
@@ -147,6 +150,20 @@ CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, dou
                                 : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
   q.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
+  return out;
+}
+
+std::string in_bed_numbers(const CutWindow& window, const std::string& message) {
+  static const std::regex named(R"((sphere|particle) (\d+))");
+  std::string out;
+  auto last = message.cbegin();
+  for (std::sregex_iterator it(message.begin(), message.end(), named), end; it != end; ++it) {
+    const std::size_t k = std::stoul((*it)[2].str());
+    out.append(last, (*it)[0].first);
+    out += (*it)[1].str() + " " + std::to_string(k < window.numbers.size() ? window.numbers[k] : k);
+    last = (*it)[0].second;
+  }
+  out.append(last, message.cend());
   return out;
 }
 

@@ -92,8 +92,12 @@ std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p);
 struct CutWindow {
   Bed bed;
   SurfaceParams surface;
+  std::vector<std::size_t> numbers;  // per sphere of the window: its index in `bed`
 };
 CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d);
+// `message` (an error of the window's surface) with each "sphere K" and "particle K" numbered
+// as in the bed the window was taken from, so that it names the spheres a user can find.
+std::string in_bed_numbers(const CutWindow& window, const std::string& message);
 
 // A bed periodic along z (container.axial_period() = H > 0) laid out for meshing between two
 // planes a period apart, z0 and z0 + H: z0 is, of the middles of the 64 widest intervals between

@@ -311,7 +311,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   const CutWindow window =
       cut ? window_for_cuts(bed, surface, k > 0 ? (planes[k - 1] - margin) * d : -inf,
                             k + 1 < slabs ? (planes[k] + margin) * d : inf, planes)
-          : CutWindow{Bed(), asked};
+          : CutWindow{Bed(), asked, {}};
   const Bed& window_bed = cut ? window.bed : bed;
   const SurfaceParams& q = window.surface;
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
@@ -325,7 +325,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     try {
       return build_fluid_surface(window_bed, q);
     } catch (const InputError& e) {
-      throw cannot(e.what());
+      throw cannot(cut ? in_bed_numbers(window, e.what()) : std::string(e.what()));
     }
   }();
   nlohmann::json planes_used = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};

@@ -818,6 +818,21 @@ TEST(FluidSurface, APeriodicPlaneOpensTheBridgesAndCapsItCrosses) {
   }
 }
 
+// A window for cuts holds the spheres whose centres lie in its range, whole, its own planes half
+// a diameter beyond them, the bed's reference diameter, and names its spheres as the bed does.
+TEST(FluidSurface, AWindowForCutsHoldsItsSpheresWholeAndNamesThemAsTheBedDoes) {
+  Bed b = column(std::make_shared<Cylinder>(1.5), {{0, 0, 0.6}, {0, 0, 1.6}, {0, 0, 2.6}, {0, 0, 3.6}});
+  b.diameters[3] = 0.5;  // the reference diameter then differs between the bed and a window without it
+  SurfaceParams p;
+  const CutWindow w = window_for_cuts(b, p, 1.0, 3.0, {2.1});
+  ASSERT_EQ(w.numbers, (std::vector<std::size_t>{1, 2}));
+  EXPECT_EQ(reference_diameter(w.bed), reference_diameter(b));
+  EXPECT_NEAR(w.surface.clip_bottom_d * reference_diameter(b), 1.1 - 0.5, 1e-12);
+  EXPECT_NEAR(w.surface.clip_top_d * reference_diameter(b), 3.1 + 0.5, 1e-12);
+  EXPECT_EQ(in_bed_numbers(w, "sphere 0 (cuts: union with sphere 1), near particle 1"),
+            "sphere 1 (cuts: union with sphere 2), near particle 2");
+}
+
 // For a cut through the contacts the periodic plane takes the middle of the widest interval
 // between the spheres' ends and the heights it is to keep clear of (the rims): spheres with ends
 // at 0, 1, 1.5 and 2.5 in a period of 3 and rims at 0.3 and 1.9 leave 0.3-1 the widest (0.65,
