@@ -293,8 +293,15 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   std::vector<std::array<int, 3>> seeds;  // of the points added by the last round: the face whose gap each fills
   std::size_t added_from = 0;
   for (int round = 0;; ++round) {
+    // A loop vertex that a wall ring moved off the sphere (snap_holes_to_rings moves it along
+    // z or along a chord) may fall inside the hull of its neighbours: the hull is taken of it
+    // moved radially back onto the sphere, the mesh keeps it where its other owners have it.
     kp.clear();
-    for (const auto& p : pts.points) kp.emplace_back(p.x(), p.y(), p.z());
+    for (std::size_t v = 0; v < pts.points.size(); ++v) {
+      Eigen::Vector3d p = pts.points[v];
+      if (owner[v] >= 0 && std::abs((p - c).norm() - r) > 1e-9 * r) p = c + r * (p - c).normalized();
+      kp.emplace_back(p.x(), p.y(), p.z());
+    }
     // After the first round, the points the refinement added go into the last hull one by one;
     // the hull is taken afresh when that fails. CGAL's hull is over the points' indices (its
     // adapter reads each point through the map), so its vertices come out as indices into

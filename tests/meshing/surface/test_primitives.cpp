@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -120,6 +121,29 @@ TEST(Primitives, APartSmallerThanAHemisphereMeshesAtEveryHeight) {
       for (const auto& q : m.points) beyond += n.dot(q - a) > 1e-12;
     }
     EXPECT_EQ(beyond, 0u) << "h = " << h;
+  }
+}
+
+// A wall ring moves the loop vertices of a sphere's union with the wall onto itself along z
+// (snap_holes_to_rings), off the sphere: the lowest vertex of a small loop moved up by a quarter
+// of its spacing lies inside the sphere by some 15 times the sagitta of the loop's edges, and
+// so inside the hull of its neighbours (a = 4, N = 120, seed 2, enlarged, in 3 slabs: "a cut's
+// loop is not an edge path", 2026-12-01). The loop is still an edge path of the mesh, the
+// vertex where the wall has it, and every face still faces out.
+TEST(Primitives, ALoopVertexMovedOffTheSphereStaysOnTheLoop) {
+  const Eigen::Vector3d c(1.0, 2.0, 3.0);
+  const double r = 0.5, s = 0.0125;
+  SphereCut cut = plane(c, r, Eigen::Vector3d::UnitX(), 0.49, s);
+  auto lowest = std::min_element(cut.loop.begin(), cut.loop.end(), [](const auto& a, const auto& b) { return a.z() < b.z(); });
+  lowest->z() += 0.25 * s;
+  const Eigen::Vector3d moved = *lowest;
+  ASSERT_GT(r - (moved - c).norm(), 10.0 * s * s / (8.0 * r));  // inside by more than 10 sagittas of its edges
+  TriangleMesh m;
+  ASSERT_NO_THROW(m = sphere_mesh(c, r, {cut}, 0.05, 1.3, true, "p"));
+  EXPECT_EQ(std::count(m.points.begin(), m.points.end(), moved), 1);
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d &a = m.points[t[0]], &b = m.points[t[1]], &q = m.points[t[2]];
+    EXPECT_GT((b - a).cross(q - a).dot((a + b + q) / 3.0 - c), 0.0);
   }
 }
 
