@@ -77,6 +77,8 @@ periodic_slice: issue 56's z-periodic slice: scenes/default.toml's bed (a = 5, N
         each bed's finest dp/L, extrapolation, GCI and cells; the slices' mean against the full beds' spread.
 pieces: issue 58's case in pieces: the default bed with shrink in one piece, then in P pieces on P ranks (each of
         --pieces-ranks): each rank's peak and time, checkMesh in parallel, dp/L on 2 ranks against one piece's.
+pieces_bridge: the same with the default scene's bridges, cut through at each rank's planes (issue 58's "every
+        contact treatment"), the same ranks.
 pieces_large: the same bed 3 times longer (--pieces-large-spheres spheres), the case written, not solved, in P pieces
         for each of --pieces-large-ranks (from 2: one rank's whole piece of 1500 spheres fell back to gmsh's
         slow Delaunay): the per-rank peak against 2/P of 2 ranks' on a bed whose pieces hold more than the 62
@@ -113,7 +115,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice", "pieces", "pieces_large", "weak_scaling", "projection", "pieces_1e4", "weak_scaling_1e4",
+            "periodic_slice", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4", "weak_scaling_1e4",
             "projection_1e4"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
@@ -697,10 +699,10 @@ def periodic_target_lines(v):
             "least 1.5.", "", *lines, ""]
 
 
-def pieces_scene(count, solve, spheres=None):
-    """scenes/default.toml (a = 5, N = 500 or `spheres`, seed 1) with shrink, one mesh, and the case in
+def pieces_scene(count, solve, spheres=None, treatment="shrink"):
+    """scenes/default.toml (a = 5, N = 500 or `spheres`, seed 1) with `treatment`, one mesh, and the case in
     `count` pieces (0: one piece), solved when `solve`."""
-    text = default_scene_with(1, "shrink", spheres)
+    text = default_scene_with(1, treatment, spheres)
     for pattern, replacement in [(r"^levels = \d+", "levels = 0"), (r'^algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'),
                                  (r"^run = true", f"run = {'true' if solve else 'false'}")]:
         text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
@@ -751,24 +753,26 @@ def one_rank_piece(path, env):
     return time.time() - t0
 
 
-def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=()):
+def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=(),
+           treatment="shrink"):
     """Issue 58 on one machine: the default bed with shrink (`spheres` of them) in one piece (mesh stage,
     then the case stage's dual, and the solve when 0 is in `solved`), then in P pieces on P ranks
     (`[mesh] pieces = P`, mpirun oversubscribed where P exceeds the cores): each rank's peak and time,
     the run's wall time, dp/L where P is in `solved` against one piece's. P = 1 is one rank's piece of
     the one-piece run's case (`bedforge piece`). The one-piece run is left out when `one_piece` is false
     (by default when `solved` is empty). `make_scene(count, solve, spheres)` gives the scene (pieces_scene,
-    bed_1e4_scene); for P in `reconstruct` the pieces are joined (reconstructParMesh) and checked whole."""
+    bed_1e4_scene); for P in `reconstruct` the pieces are joined (reconstructParMesh) and checked whole.
+    `treatment` is recorded with each row (the section says it); make_scene must apply it."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
     rows = []
     one_run = bool(solved) if one_piece is None else one_piece
     for p in ([0] if one_run else []) + ranks:
         # P = 1 takes the one-piece run's case when there is one, not a second run of it.
-        path = os.path.join(tmp, f"pieces_{spheres}_{0 if p == 1 and one_run else p}")
+        path = os.path.join(tmp, f"pieces_{treatment}_{spheres}_{0 if p == 1 and one_run else p}")
         wall = 0.0 if p == 1 and one_run else timed_run(path, make_scene(p if p > 1 else 0, p in solved, spheres), env)
         rep = json.load(open(os.path.join(path, "report.json")))
         case = rep["stages"]["case"]
-        row = {"pieces": p, "spheres": spheres, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
+        row = {"pieces": p, "spheres": spheres, "treatment": treatment, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
                "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
         if "flow" in case:
             row["dp_pa_m"] = case["flow"]["pressure_gradient_bed_pa_m"]
@@ -939,12 +943,19 @@ def pieces_lines(rows):
     """Issue 58's section: one piece (when run) against P pieces on P ranks, and its targets as far as measured."""
     one = next((r for r in rows if r["pieces"] == 0), None)
     spheres = rows[0].get("spheres", 500)  # rows before the bed size was recorded: the default bed's
-    title = ("## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)" if one else
+    treatment = rows[0].get("treatment", "shrink")  # rows before it was recorded: shrink
+    cut = treatment in ("bridge", "cap", "enlarge")
+    title = ((f"## A case in pieces, one per rank, {treatment} contacts cut through at the planes: memory, time and "
+              "the pressure drop (issue 58)" if cut else
+              "## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)") if one else
              f"## A case in pieces on a bed of {spheres} spheres: the memory per rank (issue 58)")
+    how = {"shrink": "contacts shrunk (the only treatment pieces could cut when this section was first made)",
+           "none": "contacts untreated"}.get(treatment, f"contacts.treatment = \"{treatment}\" (each rank's window "
+                                                         "holds its spheres whole and cuts them, and the contacts, "
+                                                         "at its planes)")
     lines = [title, "",
              f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = {spheres}, seed 1, "
-             "0.15 d, 4 cells per gap) with contacts shrunk (the only treatment pieces could cut when this section "
-             "was first made), one mesh. " +
+             f"0.15 d, 4 cells per gap) with {how}, one mesh. " +
              ("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if one else
               "The case written, not solved. ") +
              "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
@@ -1494,7 +1505,8 @@ def write(results):
         lines += verification_lines(v, "case", "verification_periodic.png")
         lines += periodic_target_lines(v)
         plot_verification(v, "verification_periodic.png", "periodic sections (cyclic)", "exact", "")
-    for key, section_lines in (("periodic_slice", slice_lines), ("pieces", pieces_lines), ("pieces_large", pieces_lines),
+    for key, section_lines in (("periodic_slice", slice_lines), ("pieces", pieces_lines),
+                               ("pieces_bridge", pieces_lines), ("pieces_large", pieces_lines),
                                ("weak_scaling", weak_scaling_lines), ("projection", projection_lines),
                                ("pieces_1e4", pieces_1e4_lines), ("weak_scaling_1e4", weak_scaling_lines),
                                ("projection_1e4", projection_lines)):
@@ -1685,6 +1697,10 @@ def main():
             write(results)
         if "pieces" in args.only:
             results["pieces"] = pieces(tmp, args.pieces_ranks)
+            write(results)
+        if "pieces_bridge" in args.only:
+            results["pieces_bridge"] = pieces(tmp, args.pieces_ranks, treatment="bridge",
+                                              make_scene=lambda n, solve, spheres: pieces_scene(n, solve, spheres, "bridge"))
             write(results)
         if "pieces_large" in args.only:
             results["pieces_large"] = pieces(tmp, args.pieces_large_ranks, args.pieces_large_spheres, solved=())
