@@ -755,8 +755,9 @@ def one_rank_piece(path, env):
 
 def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=(),
            treatment="shrink"):
-    """Issue 58 on one machine: the default bed with shrink (`spheres` of them) in one piece (mesh stage,
-    then the case stage's dual, and the solve when 0 is in `solved`), then in P pieces on P ranks
+    """Issue 58 on one machine: the default bed (`spheres` of them; shrunk unless make_scene treats its
+    contacts otherwise) in one piece (mesh stage, then the case stage's dual, and the solve when 0 is
+    in `solved`), then in P pieces on P ranks
     (`[mesh] pieces = P`, mpirun oversubscribed where P exceeds the cores): each rank's peak and time,
     the run's wall time, dp/L where P is in `solved` against one piece's. P = 1 is one rank's piece of
     the one-piece run's case (`bedforge piece`). The one-piece run is left out when `one_piece` is false
