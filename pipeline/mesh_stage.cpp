@@ -1,10 +1,12 @@
 #include "pipeline/mesh_stage.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "meshing/surface/fluid_surface.hpp"
@@ -36,7 +38,11 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
       "max aspect ratio {:.1f}, volume error {:.2e}",
       j["algorithm"].get<std::string>(),
       std::string(j["optimiser"] == "hxt" ? ", its own optimiser" : "") +
-          (slabs > 1 ? fmt::format(", {} slabs", slabs) : std::string()),
+          (slabs > 1 ? fmt::format(", {} slabs", slabs) : std::string()) +
+          (j.contains("planes_moved") ? fmt::format(" between planes moved to {:.3f} d as the first failed (the "
+                                                    "report's planes_moved says why)",
+                                                    fmt::join(j["planes_moved"]["to_d"].get<std::vector<double>>(), ", "))
+                                      : std::string()),
       vm->mesh.cells,
       q.max_non_orthogonality_deg, q.mean_non_orthogonality_deg, q.faces_over_70_deg, q.max_skewness,
       q.max_aspect_ratio, volume_error);

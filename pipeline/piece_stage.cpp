@@ -122,8 +122,13 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   }
   if (slab.mesh.cells == 0) {
     progress.update(fmt::format("piece {} of {}: surface and cells", piece + 1, pieces));
-    slab = meshing::mesh_slab(bed, surface, planes, piece, d, mesh,
-                              case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
+    try {
+      slab = meshing::mesh_slab(bed, surface, planes, piece, d, mesh,
+                                case_dir / fmt::format("bad_cells_piece{}.vtk", piece), true);
+    } catch (const meshing::SlabCutError& e) {
+      throw meshing::SlabCutError(fmt::format("{}; allowed: other planes (piece --planes-d), or another mesh.pieces",
+                                              e.what()));
+    }
     if (case_params.polyhedra) {
       meshing::PlaneLayer all = meshing::whole_slab(slab.mesh);
       all.tag = cells_key;
@@ -238,18 +243,18 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   CasePieces out;
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
-  // The ranks are given `planes` (d; empty: their own, meshing::slab_planes_d's), each try its log.
-  const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir, const std::vector<double>& planes) {
-    const fs::path self = fs::read_symlink("/proc/self/exe"),
-                   log = case_dir / (planes.empty() ? "log.pieces" : "log.pieces_planes_moved");
+  // The ranks are given `planes` (d), each try its log (`log_name`).
+  const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir,
+                                                                    const std::vector<double>& planes,
+                                                                    const std::string& log_name) {
+    const fs::path self = fs::read_symlink("/proc/self/exe"), log = case_dir / log_name;
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
     // Open MPI refuses root unless told (containers, CI), as in Allrun.
     const std::string cmd = fmt::format(
         "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; "
-        "mpirun -np {} '{}' --quiet --no-progress piece '{}'{}{} > '{}' 2>&1",
-        pieces, self.string(), run_dir.string(), planes.empty() ? "" : " --planes-d ", fmt::join(planes, " "),
-        log.string());
+        "mpirun -np {} '{}' --quiet --no-progress piece '{}' --planes-d {} > '{}' 2>&1", pieces, self.string(),
+        run_dir.string(), fmt::join(planes, " "), log.string());
     const int status = std::system(cmd.c_str());
     progress.finish();
     if (status == 0) return;
@@ -264,8 +269,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     // Which piece stopped first, with its heights: a rank's own message may not say.
     std::string which = "a rank";
     if (said.failed_rank >= 0 && said.failed_rank < pieces) {
-      const std::vector<double> at = planes.empty() ? meshing::slab_planes_d(bed, surface, pieces) : planes;
-      const meshing::SurfaceParams slab = meshing::slab_surface(bed, surface, at, said.failed_rank);
+      const meshing::SurfaceParams slab = meshing::slab_surface(bed, surface, planes, said.failed_rank);
       which = fmt::format("piece {} of {} ({:.2f}-{:.2f} d above the floor, rank {})", said.failed_rank + 1, pieces,
                           slab.clip_bottom_d, slab.clip_top_d, said.failed_rank);
     }
@@ -284,27 +288,30 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     const std::string what = fmt::format("the case's pieces: mpirun -np {} {} piece failed ({}{}); see {}", pieces,
                                          self.filename().string(), which == "a rank" ? "" : which + ": ",
                                          said.message.empty() ? "no rank said why" : said.message, log.string());
-    if (said.message.rfind("bedforge: error: ", 0) == 0) throw InputError(what);
+    if (said.message.rfind("bedforge: error: ", 0) == 0) {
+      if (said.message.find(meshing::kSlabCutPhrase) != std::string::npos) throw meshing::SlabCutError(what);
+      throw InputError(what);
+    }
     if (said.message.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
     throw std::runtime_error(what);
   };
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
-    try {
-      run_ranks(info.directory, {});
-    } catch (const ConvergenceError& first) {
-      // A piece that fails the gate where the whole mesh passes has its planes to blame (as in
-      // meshing::build_slabbed_volume_mesh): the ranks try once more with the planes moved.
-      const std::vector<double> planes = meshing::slab_planes_d(bed, surface, pieces),
-                                moved = meshing::moved_slab_planes_d(bed, surface, planes);
-      console.line(fmt::format("pieces: {}; meshing them again with the planes moved from {:.3f} to {:.3f} d",
-                               first.what(), fmt::join(planes, ", "), fmt::join(moved, ", ")));
-      try {
-        run_ranks(info.directory, moved);
-      } catch (const ConvergenceError& second) {
-        throw ConvergenceError(fmt::format("{}; and with the planes moved from {:.3f} to {:.3f} d: {}", first.what(),
-                                           fmt::join(planes, ", "), fmt::join(moved, ", "), second.what()));
-      }
-    }
+    // A piece that cannot be cut, or fails the gate, where the whole mesh passes has its planes
+    // to blame (as in meshing::build_slabbed_volume_mesh): the ranks try once more with them moved.
+    // The planes as a rank makes its own (piece_directory), from the profile of its estimate.
+    const std::vector<double> planes = meshing::slab_planes_d(
+        bed, surface, meshing::slab_profile(bed, surface, pieces, kEstimateVolumePerCell), pieces);
+    bool moved = false;
+    meshing::attempt_with_planes_moved(
+        bed, surface, planes, "mesh.pieces",
+        [&](const std::vector<double>& at) {
+          run_ranks(info.directory, at, moved ? "log.pieces_planes_moved" : "log.pieces");
+        },
+        [&console, &moved](const meshing::PlanesMoved& m) {
+          moved = true;
+          console.line(fmt::format("pieces: {}; meshing them again with the planes moved from {:.3f} to {:.3f} d",
+                                   m.because, fmt::join(m.from_d, ", "), fmt::join(m.to_d, ", ")));
+        });
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
     long cells = 0;
     double fluid = 0.0, void_fraction = 0.0;

@@ -32,7 +32,7 @@ namespace bedforge::pipeline {
 // memory.
 // InputError, before any work, when case_dir/0 is not there, prism layers are asked for or the
 // treatments cannot be cut in pieces (meshing::slabs_possible, pieces_possible), or a piece on polyhedra made alone finds no neighbour's layer;
-// the errors of mesh_slab otherwise, naming the piece.
+// the errors of mesh_slab otherwise, naming the piece (meshing::SlabCutError when it cannot be cut).
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
                            const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, int piece, int pieces,
@@ -61,9 +61,10 @@ RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 // case/log.pieces; when a rank fails, its message, as InputError or ConvergenceError when it was
 // one (std::runtime_error otherwise), naming the piece that stopped first and its heights; a rank
 // killed by signal 9 as InputError naming mesh.pieces (the kernel's out-of-memory killer, most
-// likely). When a rank's piece fails the gate, the ranks run once
-// more with the planes moved (meshing::moved_slab_planes_d, given as `piece --planes-d`; their
-// output in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files (case/piece_layers) are removed once all
+// likely). The ranks are given the planes (`piece --planes-d`) as piece_directory would make
+// them. When a rank's piece cannot be cut (meshing::SlabCutError, known by its message) or fails
+// the gate, the ranks run once more with the planes moved (meshing::attempt_with_planes_moved;
+// their output in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files (case/piece_layers) are removed once all
 // have succeeded; a failed run leaves them for the next, which remakes only the failed pieces.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
 // need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.

@@ -208,14 +208,14 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "bridge, cap or enlarge each is cut, through the contacts the planes cross, from the surface of the spheres "
         "within a few diameters of its slab, held whole (in a box: from the whole surface); the planes keep clear of "
         "the contacts' rims where they can. No "
-        "prism layers (a plane would cut them open). Slabs that fail the quality gate are meshed once more with their "
-        "planes moved to other gaps between the spheres' ends",
+        "prism layers (a plane would cut them open). Slabs that cannot be cut from the bed or fail the quality gate are "
+        "meshed once more with their planes moved to other gaps between the spheres' ends",
         "", kWhySlabs}},
       {"mesh.pieces",
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
         "piece`, started by the run) as `case/processorK` with processor patches, and solved on as many processes "
         "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise; pieces that "
-        "fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Every "
+        "cannot be cut or fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Every "
         "contact treatment in a cylinder or annulus (bridges, caps and unions cut by the planes from each rank's "
         "widened window, its walls ringed there), shrink or none in a box; no prism layers, no snappyHexMesh, no "
         "`stl` or `mesh` output (there is no whole surface or mesh)"}},

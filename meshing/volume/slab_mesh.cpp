@@ -11,6 +11,7 @@
 #include <fstream>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include "core/error.hpp"
@@ -275,6 +276,11 @@ std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, 
   return moved;
 }
 
+void throw_slabs_failed(bool cut, const std::string& key, const std::string& what) {
+  if (cut) throw InputError(fmt::format("{}: {}; allowed: another value of {}, or {} = 1", key, what, key, key));
+  throw ConvergenceError(what);
+}
+
 void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int slabs,
                           const std::string& name) {
   const SurfaceParams whole = slab_surface(bed, surface, {}, 0);
@@ -317,9 +323,8 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
   auto cannot = [&](const std::string& what) {
-    return InputError(fmt::format("mesh.slabs: slab {} of {} ({:.2f}-{:.2f} d above the floor) cannot be cut from the "
-                                  "bed: {}; allowed: another number of slabs, or mesh.slabs = 1",
-                                  k + 1, slabs, asked.clip_bottom_d, asked.clip_top_d, what));
+    return SlabCutError(fmt::format("slab {} of {} ({:.2f}-{:.2f} d above the floor) {}: {}", k + 1, slabs,
+                                    asked.clip_bottom_d, asked.clip_top_d, kSlabCutPhrase, what));
   };
   FluidSurface fs = [&] {
     try {
@@ -360,23 +365,15 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
   if (!pieces_possible(surface, *bed.container) && whole == nullptr)
     throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts in a box need the whole surface to cut slabs from");
-  const std::vector<double> planes = slab_planes_d(bed, surface, slabs);
-  try {
-    return mesh_and_join_slabs(bed, surface, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
-  } catch (const ConvergenceError& first) {
-    // The planes are where the slabs differ from one mesh of the whole domain: tried once more
-    // with each moved to another interval between the spheres' ends.
-    const std::vector<double> moved = moved_slab_planes_d(bed, surface, planes);
-    try {
-      VolumeMesh out = mesh_and_join_slabs(bed, surface, whole, moved, d_ref, p, msh_path, bad_cells_path, progress);
-      out.report["planes_moved"] = {{"from_d", planes}, {"to_d", moved}, {"because", first.what()}};
-      return out;
-    } catch (const ConvergenceError& second) {
-      throw ConvergenceError(fmt::format("{}; and with the planes between the slabs moved from {:.3f} to {:.3f} d: {}",
-                                         first.what(), fmt::join(planes, ", "), fmt::join(moved, ", "),
-                                         second.what()));
-    }
-  }
+  std::optional<PlanesMoved> moved;
+  VolumeMesh out = attempt_with_planes_moved(
+      bed, surface, slab_planes_d(bed, surface, slabs), "mesh.slabs",
+      [&](const std::vector<double>& planes) {
+        return mesh_and_join_slabs(bed, surface, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
+      },
+      [&moved](const PlanesMoved& m) { moved = m; });
+  if (moved) out.report["planes_moved"] = {{"from_d", moved->from_d}, {"to_d", moved->to_d}, {"because", moved->because}};
+  return out;
 }
 
 namespace {
@@ -412,9 +409,8 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
           cut_report.push_back(cut_json(c, planes[k]));
           own = std::move(c.below), above = std::move(c.above);
         } catch (const CutConflict& e) {
-          throw InputError(fmt::format("mesh.slabs: the plane at {:.3f} d above the floor cannot be cut from the bed's "
-                                       "surface: {}; allowed: another number of slabs, or mesh.slabs = 1",
-                                       planes[k], e.what()));
+          throw SlabCutError(fmt::format("the plane at {:.3f} d above the floor {}'s surface: {}", planes[k],
+                                         kSlabCutPhrase, e.what()));
         }
       }
       slab = mesh_slab_surface(own, bed, d_ref, p, bad_cells_path, false, k, slabs, {q.clip_bottom_d, q.clip_top_d});

@@ -1,9 +1,14 @@
 #pragma once
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "core/bed.hpp"
+#include "core/error.hpp"
 #include "core/progress.hpp"
 #include "meshing/surface/fluid_surface.hpp"
 #include "meshing/volume/volume_mesh.hpp"
@@ -51,10 +56,62 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, const FluidDomainProfile& profile,
                                   int slabs);
-// Where `planes` (d) go when the slabs between them fail the quality gate: each to the middle
-// of the widest interval between the spheres' ends within surface.clip_shift_d of it, other than
-// the interval it lies in (where it stays when there is no other).
+// Where `planes` (d) go when the slabs between them fail the quality gate or cannot be cut: each
+// to the middle of the widest interval between the spheres' ends within surface.clip_shift_d of
+// it, other than the interval it lies in (where it stays when there is no other).
 std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes);
+
+// A slab that cannot be cut from the bed between its planes (its clip planes find no height
+// clear of the spheres, or a plane's cut meets another cut): like a slab failing the gate, the
+// planes' place is to blame, so the slab routes try once more with them moved. An InputError
+// where nothing retries; what() names the slab or plane and its heights but no scene key, and
+// holds kSlabCutPhrase, by which a rank's message is known for one (pipeline/piece_stage).
+struct SlabCutError : InputError {
+  using InputError::InputError;
+};
+inline constexpr const char* kSlabCutPhrase = "cannot be cut from the bed";
+
+// The planes an attempt was retried with and why (attempt_with_planes_moved).
+struct PlanesMoved {
+  std::vector<double> from_d, to_d;
+  std::string because;  // the first attempt's error
+};
+// The error of slabs that failed, `what` saying why: InputError naming `key` (the scene key or
+// option that set their count) when one could not be cut (`cut`), else ConvergenceError.
+[[noreturn]] void throw_slabs_failed(bool cut, const std::string& key, const std::string& what);
+// `attempt(planes)` (planes in d), and when it throws ConvergenceError or SlabCutError,
+// `on_retry` then `attempt(moved)`, moved by moved_slab_planes_d; returns what the attempt that
+// succeeded returned. The error when both fail names both attempts (throw_slabs_failed, by the
+// second's kind); when the planes have nowhere else to go, the first's, not tried again.
+template <class Attempt>
+auto attempt_with_planes_moved(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
+                               const std::string& key, Attempt&& attempt,
+                               const std::function<void(const PlanesMoved&)>& on_retry) {
+  PlanesMoved moved;
+  bool cut = false;
+  try {
+    return attempt(planes);
+  } catch (const ConvergenceError& e) {
+    moved.because = e.what();
+  } catch (const SlabCutError& e) {
+    moved.because = e.what(), cut = true;
+  }
+  moved.from_d = planes, moved.to_d = moved_slab_planes_d(bed, surface, planes);
+  if (moved.to_d == planes) throw_slabs_failed(cut, key, moved.because);
+  on_retry(moved);
+  const auto both = [&](const char* second) {
+    return fmt::format("{}; and with the planes moved from {:.3f} to {:.3f} d: {}", moved.because,
+                       fmt::join(moved.from_d, ", "), fmt::join(moved.to_d, ", "), second);
+  };
+  try {
+    return attempt(moved.to_d);
+  } catch (const ConvergenceError& e) {
+    throw_slabs_failed(false, key, both(e.what()));
+  } catch (const SlabCutError& e) {
+    throw_slabs_failed(true, key, both(e.what()));
+  }
+}
+
 // InputError naming `name` (the option or key that gave them) unless `planes` are slabs - 1
 // heights (d above the floor), increasing, inside the fluid domain of `bed` under `surface`.
 void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int slabs,
@@ -76,8 +133,8 @@ SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const s
 // "plane_cut" lists each cut); its surface and build_volume_mesh with
 // `params` (`params.layers` off), quietly; `release_memory` as there (off when more slabs follow
 // in the same process, whose gmsh runs reuse what this one freed). Its report adds "heights_d" (asked), "planes_d"
-// (where the surface stage put them), "surface_triangles" and "cells". InputError naming
-// mesh.slabs when the slab cannot be cut from the bed; ConvergenceError naming the slab when
+// (where the surface stage put them), "surface_triangles" and "cells". SlabCutError when
+// the slab cannot be cut from the bed; ConvergenceError naming the slab when
 // its cells fail the gate (written to `bad_cells_path`).
 VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k,
                      double d_ref, const VolumeMeshParams& params, const std::filesystem::path& bad_cells_path,
@@ -93,11 +150,11 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
 // flipped and split, and the triangles left for gmsh to recover).
 // Writes the joined mesh (MSH 2.2: physical groups per patch and `fluid`) to `msh_path` when
 // not empty. std::runtime_error when two slabs' shared plane is not triangulated alike (a
-// defect of ours); InputError naming mesh.slabs when a slab cannot be cut from the bed;
-// ConvergenceError naming the slab when one fails the gate, or naming the cells at the joins
-// when the joined mesh does, after writing them to `bad_cells_path`. On such a failure the
-// slabs are meshed once more between planes moved by moved_slab_planes_d (the report then says
-// so under "planes_moved": from_d, to_d and the first failure); the error names both attempts.
+// defect of ours). When a slab cannot be cut from the bed (SlabCutError) or fails the gate, or
+// the joined mesh fails it at the joins (its cells written to `bad_cells_path`), the slabs are
+// meshed once more between planes moved by moved_slab_planes_d (the report then says so under
+// "planes_moved": from_d, to_d and the first failure); the error names both attempts
+// (attempt_with_planes_moved: InputError naming mesh.slabs, or ConvergenceError).
 VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surface, const TriangleMesh* whole,
                                      int slabs, double d_ref, const VolumeMeshParams& params,
                                      const std::filesystem::path& msh_path,

@@ -305,6 +305,30 @@ TEST(PieceStage, APieceFailingTheGateIsMeshedAgainWithThePlanesMovedAndTheErrorN
   EXPECT_FALSE(fs::exists(dir / "case/processor0/constant/polyMesh/owner"));
 }
 
+// A piece that cannot be cut from the bed (its clip planes may move 0.05 d, and need a gap of
+// 0.2 d between the spheres' ends for the clearance asked, where this bed has some 30 per d)
+// has its planes to blame too: the ranks try again with the planes moved, and the run stops
+// (exit 2) naming mesh.pieces and both attempts; no processor directory holds cells.
+TEST(PieceStage, APieceThatCannotBeCutIsTriedAgainWithThePlanesMovedAndTheErrorNamesBoth) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (mpirun) not on PATH";
+  const fs::path dir = fresh_dir("piece_cut"), scene = fresh_dir("piece_cut_scene");
+  fs::create_directories(scene);
+  std::string text = kScene;
+  text.replace(text.find("edge_length_d = 0.2"), 19, "edge_length_d = 0.2\nclip_shift_d = 0.05\nclip_clearance_d = 0.1");
+  std::ofstream(scene / "s.toml") << text << "run = false\n[mesh]\npieces = 2\n";
+  const Result r = cli_test::bedforge("run " + (scene / "s.toml").string() + " -o " + dir.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("bedforge: error: mesh.pieces: the case's pieces: "), std::string::npos) << r.output;
+  const auto moved = r.output.find("; and with the planes moved from ");
+  ASSERT_NE(moved, std::string::npos) << r.output;
+  EXPECT_LT(r.output.find("cannot be cut from the bed"), moved) << r.output;
+  EXPECT_GT(r.output.rfind("cannot be cut from the bed"), moved) << r.output;
+  EXPECT_NE(r.output.find("meshing them again with the planes moved"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "case/log.pieces_planes_moved"));
+  EXPECT_FALSE(fs::exists(dir / "case/processor0/constant/polyMesh/owner"));
+  EXPECT_FALSE(fs::exists(dir / "case/processor1/constant/polyMesh/owner"));
+}
+
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
 // no case to write into, pieces beyond the machine's memory, planes that do not fit the pieces,
 // a piece on polyhedra made without its neighbours, and contacts a plane would cut open; no

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -158,12 +159,13 @@ TEST(SlabMesh, GivenPlanesAreRefusedUnlessIncreasingInsideTheDomainAndOneFewerTh
 // error names both attempts (a gate no tetrahedral mesh of a bed passes: 10 deg).
 TEST(SlabMesh, ASlabFailingTheGateIsTriedAgainWithThePlanesMovedAndTheErrorNamesBoth) {
   Progress quiet("mesh", false);
-  const Bed b = test_support::packed_bed(30, 3.0, 1);
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
   SurfaceParams sp;  // shrink
   sp.edge_length_d = 0.3;
   VolumeMeshParams p;
   p.gate.max_non_orthogonality_deg = 10.0;
   p.fallback = false, p.max_optimize_passes = 1;  // to fail fast
+  ASSERT_NE(moved_slab_planes_d(b, sp, slab_planes_d(b, sp, 2)), slab_planes_d(b, sp, 2)) << "nowhere to move";
   const fs::path dir = test_support::fresh_dir("slabs_moved", true);
   try {
     build_slabbed_volume_mesh(b, sp, nullptr, 2, 1.0, p, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
@@ -177,6 +179,109 @@ TEST(SlabMesh, ASlabFailingTheGateIsTriedAgainWithThePlanesMovedAndTheErrorNames
     EXPECT_LT(what.find(" of 2 ("), what.find(moved)) << what;
     EXPECT_GT(what.rfind(" of 2 ("), what.find(moved)) << what;
   }
+}
+
+// The retry's rule, apart from any mesh: an attempt whose planes cannot be cut (SlabCutError) or
+// fail the gate (ConvergenceError) is made once more between the moved planes, and what that
+// one returns is returned; when it fails too, the error names both, as an InputError naming the
+// key (not a SlabCutError, which a caller would retry again) or as a ConvergenceError.
+TEST(SlabMesh, AnAttemptThatCannotBeCutOrFailsTheGateIsMadeOnceMoreWithThePlanesMoved) {
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  const SurfaceParams sp;
+  const std::vector<double> planes = slab_planes_d(b, sp, 2), moved = moved_slab_planes_d(b, sp, planes);
+  ASSERT_NE(planes, moved);
+  std::vector<std::vector<double>> tried;
+  std::vector<PlanesMoved> told;
+  const auto tell = [&told](const PlanesMoved& m) { told.push_back(m); };
+  const auto cut_fails_at_first = [&](const std::vector<double>& at) {
+    tried.push_back(at);
+    if (at == planes) throw SlabCutError("slab 1 of 2 cannot be cut from the bed: the first reason");
+    return 7;
+  };
+  EXPECT_EQ(attempt_with_planes_moved(b, sp, planes, "mesh.slabs", cut_fails_at_first, tell), 7);
+  ASSERT_EQ(tried, (std::vector<std::vector<double>>{planes, moved}));
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].from_d, planes);
+  EXPECT_EQ(told[0].to_d, moved);
+  EXPECT_EQ(told[0].because, "slab 1 of 2 cannot be cut from the bed: the first reason");
+  // Planes with nowhere else to go (none may move) are not tried again.
+  SurfaceParams fixed = sp;
+  fixed.clip_shift_d = 0.0;
+  tried.clear(), told.clear();
+  try {
+    attempt_with_planes_moved(b, fixed, planes, "mesh.slabs", cut_fails_at_first, tell);
+    ADD_FAILURE() << "the planes could not move, yet it returned";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("mesh.slabs: slab 1 of 2 cannot be cut from the bed: the first reason; "
+                                          "allowed: another value of mesh.slabs, or mesh.slabs = 1",
+                                          0),
+              0u)
+        << e.what();
+  }
+  EXPECT_EQ(tried.size(), 1u);
+  EXPECT_TRUE(told.empty());
+  // Both fail: the second attempt's kind decides the error's.
+  for (const bool second_cut : {true, false}) {
+    const auto both_fail = [&](const std::vector<double>& at) -> int {
+      if (at == planes) throw ConvergenceError("the first reason");
+      if (second_cut) throw SlabCutError("the second reason");
+      throw ConvergenceError("the second reason");
+    };
+    try {
+      attempt_with_planes_moved(b, sp, planes, "mesh.slabs", both_fail, tell);
+      ADD_FAILURE() << "both attempts failed, yet it returned";
+    } catch (const ConvergenceError& e) {
+      EXPECT_FALSE(second_cut) << e.what();
+      EXPECT_NE(std::string(e.what()).find(fmt::format("the first reason; and with the planes moved from {:.3f} to "
+                                                       "{:.3f} d: the second reason",
+                                                       planes[0], moved[0])),
+                std::string::npos)
+          << e.what();
+    } catch (const InputError& e) {
+      EXPECT_TRUE(second_cut) << e.what();
+      EXPECT_EQ(dynamic_cast<const SlabCutError*>(&e), nullptr) << "would be retried again: " << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("mesh.slabs: the first reason; and with the planes moved", 0), 0u)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("allowed: another value of mesh.slabs, or mesh.slabs = 1"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+// A slab whose clip planes find no height clear of the spheres (here they may move 0.05 d, and
+// no gap between the spheres' ends near the plane is as wide as the 0.2 d the clearance asked
+// needs) cannot be cut from the bed: the slabs are tried between moved planes, and the error, an
+// InputError naming mesh.slabs, names both attempts' slabs, before any slab was meshed.
+TEST(SlabMesh, ASlabThatCannotBeCutIsTriedAgainWithThePlanesMovedAndTheErrorNamesMeshSlabs) {
+  Progress quiet("mesh", false);
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  SurfaceParams sp;  // shrink
+  sp.clip_shift_d = 0.05, sp.clip_clearance_d = 0.1;
+  const double plane = slab_planes_d(b, sp, 2)[0];
+  ASSERT_NE(moved_slab_planes_d(b, sp, {plane})[0], plane);
+  // This bed's part: the spheres' ends (at their own radius) within 0.3 d of the plane, which
+  // holds both attempts' reach, leave no gap of 0.2 d.
+  std::vector<double> ends = {plane - 0.3, plane + 0.3};
+  for (std::size_t i = 0; i < b.size(); ++i)
+    for (double end : {b.centres[i].z() - 0.5, b.centres[i].z() + 0.5})
+      if (std::abs(end - plane) < 0.3) ends.push_back(end);
+  std::sort(ends.begin(), ends.end());
+  for (std::size_t j = 0; j + 1 < ends.size(); ++j) ASSERT_LT(ends[j + 1] - ends[j], 0.2) << "a gap at " << ends[j];
+  const fs::path dir = test_support::fresh_dir("slabs_cut_moved", true);
+  try {
+    build_slabbed_volume_mesh(b, sp, nullptr, 2, 1.0, VolumeMeshParams{}, dir / "fluid.msh", dir / "bad_cells.vtk", quiet);
+    ADD_FAILURE() << "a plane no height clear of the spheres was cut";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("mesh.slabs: slab ", 0), 0u) << what;
+    const auto moved = what.find("; and with the planes moved from ");
+    ASSERT_NE(moved, std::string::npos) << what;
+    EXPECT_LT(what.find(kSlabCutPhrase), moved) << what;
+    EXPECT_GT(what.rfind(kSlabCutPhrase), moved) << what;
+    EXPECT_NE(what.find("surface.clip_clearance_d = 0.1 d"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(fs::exists(dir / "fluid.msh"));
 }
 
 // Bridged contacts, which a clip window would open, cut through the bridges the planes cross
