@@ -298,9 +298,9 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
     // A piece that cannot be cut, or fails the gate, where the whole mesh passes has its planes
     // to blame (as in meshing::build_slabbed_volume_mesh): the ranks try once more with them moved.
-    // The planes as a rank makes its own (piece_directory), from the profile of its estimate.
-    const std::vector<double> planes = meshing::slab_planes_d(
-        bed, surface, meshing::slab_profile(bed, surface, pieces, kEstimateVolumePerCell), pieces);
+    // The planes a rank would make (piece_directory: its profile's weights do not depend on
+    // the volume per cell of its estimate).
+    const std::vector<double> planes = meshing::slab_planes_d(bed, surface, pieces);
     bool moved = false;
     meshing::attempt_with_planes_moved(
         bed, surface, planes, "mesh.pieces",
