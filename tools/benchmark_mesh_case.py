@@ -95,6 +95,7 @@ stages' and of OpenFOAM's processes. (/usr/bin/time would see only the last stag
 resets the kernel's high-water mark at each stage start, and the rusage peak with it.)
 """
 import argparse
+import functools
 import glob
 import json
 import math
@@ -753,8 +754,7 @@ def one_rank_piece(path, env):
     return time.time() - t0
 
 
-def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=(),
-           treatment="shrink"):
+def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=()):
     """Issue 58 on one machine: the default bed (`spheres` of them; shrunk unless make_scene treats its
     contacts otherwise) in one piece (mesh stage, then the case stage's dual, and the solve when 0 is
     in `solved`), then in P pieces on P ranks
@@ -763,8 +763,9 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
     the one-piece run's case (`bedforge piece`). The one-piece run is left out when `one_piece` is false
     (by default when `solved` is empty). `make_scene(count, solve, spheres)` gives the scene (pieces_scene,
     bed_1e4_scene); for P in `reconstruct` the pieces are joined (reconstructParMesh) and checked whole.
-    `treatment` is recorded with each row (the section says it); make_scene must apply it."""
+    Each row records the scene's contacts.treatment (the section says it)."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
+    treatment = re.search(r'^treatment = "(\w+)"', make_scene(2, False, spheres), re.M).group(1)
     rows = []
     one_run = bool(solved) if one_piece is None else one_piece
     for p in ([0] if one_run else []) + ranks:
@@ -1702,8 +1703,8 @@ def main():
             results["pieces"] = pieces(tmp, args.pieces_ranks)
             write(results)
         if "pieces_bridge" in args.only:
-            results["pieces_bridge"] = pieces(tmp, args.pieces_ranks, treatment="bridge",
-                                              make_scene=lambda n, solve, spheres: pieces_scene(n, solve, spheres, "bridge"))
+            results["pieces_bridge"] = pieces(tmp, args.pieces_ranks,
+                                              make_scene=functools.partial(pieces_scene, treatment="bridge"))
             write(results)
         if "pieces_large" in args.only:
             results["pieces_large"] = pieces(tmp, args.pieces_large_ranks, args.pieces_large_spheres, solved=())
