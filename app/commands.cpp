@@ -103,6 +103,7 @@ int run_command_line(int argc, char** argv) {
   // process takes its piece from Open MPI's rank unless told.
   int piece = -1, pieces = 0;
   std::vector<double> planes_d;
+  double wall_gap_m = 0.0;
   CLI::App* piece_cmd =
       on_directory("piece",
                    "mesh one axial piece of DIR/bed.csv and write it as DIR/case/processorK with processor patches "
@@ -117,6 +118,10 @@ int run_command_line(int argc, char** argv) {
   piece_cmd->add_option("--planes-d", planes_d,
                         "numbers: the heights of the planes between the pieces, d above the floor, one fewer than the "
                         "pieces (default: at about equal cells by the mesh estimate)");
+  piece_cmd->add_option("--wall-gap-m", wall_gap_m,
+                        "number, m: the whole bed's narrowest gap at a curved wall, whose edge every piece rings its "
+                        "walls with (default: found by treating the whole bed)")
+      ->check(CLI::PositiveNumber);
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   CLI::App* case_cmd = on_directory("case",
@@ -176,7 +181,7 @@ int run_command_line(int argc, char** argv) {
     from_mpi(pieces, "--pieces", "OMPI_COMM_WORLD_SIZE");
     if (piece >= pieces)
       throw InputError(fmt::format("--piece {}: allowed: 0 to {} (--pieces {})", piece, pieces - 1, pieces));
-    pipeline::piece_directory(dir, flags.overrides(), piece, pieces, planes_d, console);
+    pipeline::piece_directory(dir, flags.overrides(), piece, pieces, planes_d, wall_gap_m, console);
   }
 #endif
 #ifdef BEDFORGE_HAVE_GMSH

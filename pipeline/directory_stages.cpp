@@ -142,26 +142,34 @@ void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides,
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
 void piece_directory(const fs::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
-                     const std::vector<double>& planes_d, const Console& console) {
+                     const std::vector<double>& planes_d, double wall_gap_m, const Console& console) {
   Directory d = open_directory(dir, overrides);
-  const meshing::SurfaceParams surface = read_surface_sections(d.scene);
+  meshing::SurfaceParams surface = read_surface_sections(d.scene);
   const meshing::VolumeMeshParams mesh = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
   // Before any meshing: the planes given must lie inside the fluid domain, and this machine's
-  // ranks' pieces must fit in its memory. The estimate and the planes between the pieces come
-  // from one sampling of the bed's gaps.
+  // ranks' pieces must fit in its memory. Given the planes and the wall gap (as a run gives
+  // them), the rank treats only its piece's window; else the whole bed, once, for both.
   if (!planes_d.empty()) meshing::check_given_planes_d(d.bed, surface, planes_d, pieces, "--planes-d");
-  const meshing::FluidDomainProfile profile = meshing::slab_profile(d.bed, surface, pieces, kEstimateVolumePerCell);
+  std::vector<double> planes = planes_d;
+  if (planes.empty() || !(wall_gap_m > 0.0)) {
+    const meshing::FluidDomainProfile profile = meshing::slab_profile(d.bed, surface, pieces, 1.0);
+    if (planes.empty()) planes = meshing::slab_planes_d(d.bed, surface, profile, pieces);
+    if (!(wall_gap_m > 0.0)) wall_gap_m = profile.bed_wall_gap_m;
+  }
+  surface.ring_wall_gap_m = wall_gap_m;
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-  refuse_pieces_beyond_memory(estimate_mesh(surface, mesh, params, profile.size, reference_diameter(d.bed)), pieces,
-                              local ? std::atoi(local) : 1, available_memory_bytes());
+  refuse_piece_beyond_memory(estimate_mesh(surface, mesh, params,
+                                           meshing::slab_domain_size(d.bed, surface, planes, piece, kEstimateVolumePerCell),
+                                           reference_diameter(d.bed)),
+                             piece, pieces, local ? std::atoi(local) : 1, available_memory_bytes());
   // The seed from bed.csv: a run starts its ranks before it writes report.json.
   const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());
   const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", kVersion,
                                        seed.is_number() ? std::to_string(seed.get<unsigned long long>()) : "none",
                                        piece, pieces);
   const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface,
-                                       planes_d.empty() ? meshing::slab_planes_d(d.bed, surface, profile, pieces) : planes_d,
+                                       planes,
                                        mesh, params, piece, pieces, dir / "case", note, console);
   console.line(fmt::format("piece {} of {}: {} cells in {}{}", piece, pieces, r["cells"].get<long>(),
                            (dir / "case" / fmt::format("processor{}", piece)).string(),

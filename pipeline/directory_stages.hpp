@@ -28,10 +28,14 @@ void mesh_directory(const std::filesystem::path& dir, const std::vector<Override
 // Piece `piece` of `pieces` of DIR/bed.csv's fluid domain as DIR/case/processor<piece>
 // (piece_stage.hpp), the case written into DIR/case first, between `planes_d` (d above the floor;
 // empty: meshing::slab_planes_d's; InputError naming --planes-d when they are not pieces - 1
-// increasing heights inside the domain). Every piece's report goes beside its cells, not into
-// DIR/report.json, which the ranks would race for.
+// increasing heights inside the domain), its walls ringed with the edge of the whole bed's
+// narrowest wall gap `wall_gap_m` (m; 0: found by treating the whole bed). Given both, the rank
+// treats only its piece's window, sizing it for the memory check too (meshing::slab_domain_size;
+// InputError naming mesh.pieces when the piece will not fit in this rank's share of memory).
+// Every piece's report goes beside its cells, not into DIR/report.json, which the ranks would
+// race for.
 void piece_directory(const std::filesystem::path& dir, const std::vector<Override>& overrides, int piece, int pieces,
-                     const std::vector<double>& planes_d, const Console& console);
+                     const std::vector<double>& planes_d, double wall_gap_m, const Console& console);
 #endif
 
 #ifdef BEDFORGE_HAVE_GMSH

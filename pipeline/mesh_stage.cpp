@@ -192,16 +192,15 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
       s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_not_run(e)));
 }
 
-void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes) {
-  const double per_piece = e.mesh_peak_bytes / pieces;
-  if (per_piece <= available_bytes) return;
+void refuse_piece_beyond_memory(const MeshEstimate& e, int piece, int pieces, int ranks_here, double available_bytes) {
+  if (e.mesh_peak_bytes <= available_bytes) return;
   throw InputError(fmt::format(
-      "mesh.pieces = {}: a piece would take at least {:.1f} GB to mesh ({:.3g} million cells of the whole bed shared "
-      "among the pieces, an estimate that errs low), and a rank may take {:.1f} GB here ({} rank{} on this "
-      "machine sharing its memory); allowed: {}",
-      pieces, per_piece / 1e9, e.cells / 1e6, available_bytes / 1e9, ranks_here, ranks_here == 1 ? "" : "s",
-      pieces_memory_remedies(
-          fmt::format("mesh.pieces >= {}", static_cast<int>(std::ceil(e.mesh_peak_bytes / available_bytes))))));
+      "mesh.pieces = {}: piece {} would take at least {:.1f} GB to mesh ({:.3g} million cells, an estimate that "
+      "errs low), and a rank may take {:.1f} GB here ({} rank{} on this machine sharing its memory); allowed: {}",
+      pieces, piece + 1, e.mesh_peak_bytes / 1e9, e.cells / 1e6, available_bytes / 1e9, ranks_here,
+      ranks_here == 1 ? "" : "s",
+      pieces_memory_remedies(fmt::format("mesh.pieces >= {}",
+                                         static_cast<int>(std::ceil(pieces * e.mesh_peak_bytes / available_bytes))))));
 }
 
 std::string pieces_memory_remedies(const std::string& more_pieces) {

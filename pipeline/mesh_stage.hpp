@@ -92,14 +92,14 @@ void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
 // narrow gaps' cells are what does not fit. Returns the estimate.
 MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes);
 
-// One rank's piece of `pieces` (piece_stage), with `ranks_here` ranks on this machine
-// (OMPI_COMM_WORLD_LOCAL_SIZE, said in the message): InputError naming mesh.pieces and the count
-// that would fit when its piece, a 1/pieces share of e.mesh_peak_bytes (the pieces are cut to
-// about equal estimated cells), needs more than `available_bytes`, this rank's share of the
-// machine's memory (available_memory_bytes()). Errs
-// towards trying: one rank with the whole default bed peaked at 4329 MB where its mesh stage
-// took 3060 MB (docs/mesh_case_benchmark.md, pieces).
-void refuse_pieces_beyond_memory(const MeshEstimate& e, int pieces, int ranks_here, double available_bytes);
+// Piece `piece` (from 0) of `pieces` (piece_stage), estimated alone as `e` (from
+// meshing::slab_domain_size), with `ranks_here` ranks on this machine (OMPI_COMM_WORLD_LOCAL_SIZE,
+// said in the message): InputError naming mesh.pieces and the count that would fit (the pieces
+// are cut to about equal estimated cells) when e.mesh_peak_bytes exceeds `available_bytes`, this
+// rank's share of the machine's memory (available_memory_bytes()). Errs towards trying: one
+// rank with the whole default bed peaked at 4329 MB where its mesh stage took 3060 MB
+// (docs/mesh_case_benchmark.md, pieces).
+void refuse_piece_beyond_memory(const MeshEstimate& e, int piece, int pieces, int ranks_here, double available_bytes);
 
 // What a user may change when the pieces' ranks lack memory, for the "allowed:" of a message;
 // `more_pieces` says how many pieces (e.g. "mesh.pieces >= 6").

@@ -243,18 +243,20 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   CasePieces out;
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
-  // The ranks are given `planes` (d), each try its log (`log_name`).
+  // The ranks are given `planes` (d) and the whole bed's wall gap (`wall_gap_m`, m), each try its log (`log_name`).
   const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir,
                                                                     const std::vector<double>& planes,
-                                                                    const std::string& log_name) {
+                                                                    double wall_gap_m, const std::string& log_name) {
     const fs::path self = fs::read_symlink("/proc/self/exe"), log = case_dir / log_name;
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
     // Open MPI refuses root unless told (containers, CI), as in Allrun.
     const std::string cmd = fmt::format(
         "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; "
-        "mpirun -np {} '{}' --quiet --no-progress piece '{}' --planes-d {} > '{}' 2>&1", pieces, self.string(),
-        run_dir.string(), fmt::join(planes, " "), log.string());
+        "mpirun -np {} '{}' --quiet --no-progress piece '{}' --planes-d {}{} > '{}' 2>&1", pieces, self.string(),
+        run_dir.string(), fmt::join(planes, " "),
+        std::isfinite(wall_gap_m) && wall_gap_m > 0.0 ? fmt::format(" --wall-gap-m {:.17g}", wall_gap_m) : "",
+        log.string());
     const int status = std::system(cmd.c_str());
     progress.finish();
     if (status == 0) return;
@@ -296,16 +298,16 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     throw std::runtime_error(what);
   };
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
-    // A piece that cannot be cut, or fails the gate, where the whole mesh passes has its planes
-    // to blame (as in meshing::build_slabbed_volume_mesh): the ranks try once more with them moved.
-    // The planes a rank would make (piece_directory: its profile's weights do not depend on
-    // the volume per cell of its estimate).
-    const std::vector<double> planes = meshing::slab_planes_d(bed, surface, pieces);
+    // The planes and the whole bed's wall gap from one treatment of it, here, so that each rank
+    // treats only its piece's window (piece_directory).
+    const meshing::FluidDomainProfile profile = meshing::slab_profile(bed, surface, pieces, 1.0);
+    const std::vector<double> planes = meshing::slab_planes_d(bed, surface, profile, pieces);
+    release_free_memory();  // the treatment's, kept by the allocator, from the ranks started on this machine
     bool moved = false;
     meshing::attempt_with_planes_moved(
         bed, surface, planes, "mesh.pieces",
         [&](const std::vector<double>& at) {
-          run_ranks(info.directory, at, moved ? "log.pieces_planes_moved" : "log.pieces");
+          run_ranks(info.directory, at, profile.bed_wall_gap_m, moved ? "log.pieces_planes_moved" : "log.pieces");
         },
         [&console, &moved](const meshing::PlanesMoved& m) {
           moved = true;

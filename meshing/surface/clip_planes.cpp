@@ -149,9 +149,10 @@ CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, dou
   q.clip_top_d = std::isinf(hi) ? (p.clip ? p.clip_top_d : bed_height(bed) / d + p.outlet_length_d)
                                 : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
-  // The whole bed's narrowest wall gap: a window of every sphere (the periodic cut's) finds it in
-  // its own survey, so the bed is treated for it only when spheres were left out.
-  if (out.bed.size() < bed.size()) q.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
+  // The whole bed's narrowest wall gap, unless given: a window of every sphere (the periodic
+  // cut's) finds it in its own survey, so the bed is treated for it only when spheres were left out.
+  if (out.bed.size() < bed.size() && !(p.ring_wall_gap_m > 0.0))
+    q.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
   return out;
 }
 

@@ -201,7 +201,7 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   const LaidOut laid = lay_out(given, p);
   const Bed& bed = laid.bed();
   const TreatedBed& tb = laid.treated;
-  FluidDomainProfile out{{}, tb.planes.z0, tb.planes.z1, {}};
+  FluidDomainProfile out{{}, tb.planes.z0, tb.planes.z1, {}, {}, {}, tb.bed_min_concave_wall_gap};
   out.size.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
   const double d = reference_diameter(bed), edge = p.edge_length_d * d, height = (out.z1 - out.z0) / bins;
   const double per_volume = 1.0 / (edge * edge * edge);
@@ -209,6 +209,8 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   // the walls' and the spheres' zones (2 pi r times the zone's height).
   const double per_area = kCellsPerSurfaceEdgeSquared / (edge * edge);
   out.cells.assign(bins, (bed.container->cross_section_area() * per_volume + bed.container->wall_perimeter() * per_area) * height);
+  out.fluid_m3.assign(bins, bed.container->cross_section_area() * height);
+  out.gap_cells.assign(bins, 0.0);
   for (std::size_t i = 0; i < bed.size(); ++i) {
     if (!tb.kept[i]) continue;
     const double r = tb.radius[i], zc = bed.centres[i].z();
@@ -216,8 +218,9 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
     const int last = std::min(bins - 1, static_cast<int>((zc + r - out.z0) / height));
     for (int b = first; b <= last; ++b) {
       const double lo = std::max(out.z0 + b * height, zc - r), hi = std::min(out.z0 + (b + 1) * height, zc + r);
-      out.cells[b] += (2.0 * std::numbers::pi * r * std::max(0.0, hi - lo)) * per_area -
-                      sphere_slab_volume(r, zc, lo, hi) * per_volume;
+      const double solid = sphere_slab_volume(r, zc, lo, hi);
+      out.cells[b] += (2.0 * std::numbers::pi * r * std::max(0.0, hi - lo)) * per_area - solid * per_volume;
+      out.fluid_m3[b] -= solid;
     }
   }
   // A loop's spacing is the contact edge (or less, on a short loop): graded from it up to `edge`,
@@ -239,7 +242,10 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   if (gaps) {
     // The added cells go as one over the volume per cell (GapSpacing::added_cells_profile).
     const std::vector<double> added = gaps->added_cells_profile(1.0, out.z0, out.z1, bins);
-    for (int b = 0; b < bins; ++b) out.cells[b] += added[b], out.size.gap_cells += added[b] / volume_per_cell;
+    for (int b = 0; b < bins; ++b) {
+      out.cells[b] += added[b], out.gap_cells[b] = added[b] / volume_per_cell;
+      out.size.gap_cells += out.gap_cells[b];
+    }
   }
   return out;
 }

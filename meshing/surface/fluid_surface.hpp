@@ -107,6 +107,12 @@ struct FluidDomainProfile {
   FluidDomainSize size;
   double z0 = 0.0, z1 = 0.0;  // m
   std::vector<double> cells;  // bins
+  // Bins: the fluid's volume (m^3; the spheres' slices taken out, their contacts' parts not) and
+  // the cells the narrow gaps add (at the volume per cell asked), for a share of the size.
+  std::vector<double> fluid_m3, gap_cells;
+  // The whole bed's narrowest gap at a curved wall (m; infinite without one): the edge every
+  // window of the bed rings its walls with (SurfaceParams::ring_wall_gap_m, window_for_cuts).
+  double bed_wall_gap_m = 0.0;
 };
 FluidDomainProfile fluid_domain_profile(const Bed& bed, const SurfaceParams& p, double volume_per_cell, int bins);
 

@@ -243,6 +243,36 @@ FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& s, int slab
   return fluid_domain_profile(bed, s, volume_per_cell, bins);
 }
 
+FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes, int k,
+                                 double volume_per_cell) {
+  const int slabs = static_cast<int>(planes.size()) + 1;
+  const double d = reference_diameter(bed), margin = piece_margin_d(bed, s), inf = std::numeric_limits<double>::infinity();
+  const double lo = k > 0 ? planes[k - 1] * d : -inf, hi = k + 1 < slabs ? planes[k] * d : inf;
+  // The gap of the window's rings does not change its profile: any will do, and spares treating the bed.
+  SurfaceParams given = s;
+  if (!(given.ring_wall_gap_m > 0.0)) given.ring_wall_gap_m = inf;
+  const CutWindow w = window_for_cuts(bed, given, lo - margin * d, hi + margin * d, {});
+  const FluidDomainProfile profile = slab_profile(w.bed, w.surface, 1, volume_per_cell);
+  // The share of a binned quantity between the slab's planes, bins cut by a plane in proportion.
+  const double height = (profile.z1 - profile.z0) / static_cast<double>(profile.cells.size());
+  auto share = [&](const std::vector<double>& bins) {
+    double inside = 0.0, all = 0.0;
+    for (std::size_t b = 0; b < bins.size(); ++b) {
+      const double z = profile.z0 + static_cast<double>(b) * height;
+      inside += bins[b] * std::clamp((std::min(hi, z + height) - std::max(lo, z)) / height, 0.0, 1.0);
+      all += bins[b];
+    }
+    return all > 0.0 ? inside / all : 0.0;
+  };
+  FluidDomainSize out = profile.size;
+  out.volume_m3 *= share(profile.fluid_m3);
+  out.gap_cells *= share(profile.gap_cells);
+  // The contacts' loops and thin gaps are not binned: as the cells are shared.
+  const double cells = share(profile.cells);
+  out.contact_loop_edges *= cells, out.thin_gap_contacts *= cells;
+  return out;
+}
+
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int slabs) {
   return slabs < 2 ? std::vector<double>{} : slab_planes_d(bed, s, slab_profile(bed, s, slabs, 1.0), slabs);
 }
@@ -365,11 +395,15 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
   if (!pieces_possible(surface, *bed.container) && whole == nullptr)
     throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts in a box need the whole surface to cut slabs from");
+  // One treatment of the whole bed for the planes and the gap every slab's window rings its walls with.
+  const FluidDomainProfile profile = slab_profile(bed, surface, slabs, 1.0);
+  SurfaceParams ringed = surface;
+  ringed.ring_wall_gap_m = profile.bed_wall_gap_m;
   std::optional<PlanesMoved> moved;
   VolumeMesh out = attempt_with_planes_moved(
-      bed, surface, slab_planes_d(bed, surface, slabs), "mesh.slabs",
+      bed, surface, slab_planes_d(bed, surface, profile, slabs), "mesh.slabs",
       [&](const std::vector<double>& planes) {
-        return mesh_and_join_slabs(bed, surface, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
+        return mesh_and_join_slabs(bed, ringed, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
       },
       [&moved](const PlanesMoved& m) { moved = m; });
   if (moved) out.report["planes_moved"] = {{"from_d", moved->from_d}, {"to_d", moved->to_d}, {"because", moved->because}};

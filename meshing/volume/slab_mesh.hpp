@@ -119,6 +119,13 @@ void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const st
 // The fluid domain's profile (fluid_domain_profile, its size at `volume_per_cell`) in bins fine
 // enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab.
 FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, int slabs, double volume_per_cell);
+// The size of slab `k`'s fluid domain between `planes` (d) at `volume_per_cell` (m^3), from the
+// spheres within piece_margin_d of it only (its window, window_for_cuts), so that a rank sizes
+// its piece without treating the whole bed: the window's size, each part times its share between
+// the slab's planes (the fluid volume's and the gaps' cells by their own profiles, the rest by
+// the cells'). Sums over the slabs to about the whole domain's size.
+FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
+                                 int k, double volume_per_cell);
 
 // The surface parameters of slab `k` (from 0, bottom up) between `planes` (slab_planes_d): a clip
 // window from the plane below it to the plane above it, the whole domain's ends (or the scene's
