@@ -126,33 +126,41 @@ std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p) {
   return out;
 }
 
-CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d) {
-  const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
+CutWindow spheres_between(const Bed& bed, const SurfaceParams& p, double lo, double hi) {
+  const double inf = std::numeric_limits<double>::infinity();
   CutWindow out;
   out.bed.container = bed.container;
-  out.bed.reference_diameter_m = d;
-  double lowest = inf, highest = -inf;
+  out.bed.reference_diameter_m = reference_diameter(bed);
   for (std::size_t i = 0; i < bed.size(); ++i)
     if (const double z = bed.centres[i].z(); z >= lo && z <= hi) {
       out.bed.centres.push_back(bed.centres[i]);
       out.bed.diameters.push_back(bed.diameters[i]);
       out.numbers.push_back(i);
-      lowest = std::min(lowest, z - 0.5 * bed.diameters[i]);
-      highest = std::max(highest, z + 0.5 * bed.diameters[i]);
     }
+  out.surface = p;
+  // The whole bed's narrowest wall gap, unless given: a window of every sphere (the periodic
+  // cut's) finds it in its own survey, so the bed is treated for it only when spheres were left out.
+  if (out.bed.size() < bed.size() && !(p.ring_wall_gap_m > 0.0))
+    out.surface.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
+  return out;
+}
+
+CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d) {
+  const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
+  CutWindow out = spheres_between(bed, p, lo, hi);
+  double lowest = inf, highest = -inf;
+  for (std::size_t i = 0; i < out.bed.size(); ++i) {
+    lowest = std::min(lowest, out.bed.centres[i].z() - 0.5 * out.bed.diameters[i]);
+    highest = std::max(highest, out.bed.centres[i].z() + 0.5 * out.bed.diameters[i]);
+  }
   const double pad = 0.5 * largest_diameter(bed);
   SurfaceParams& q = out.surface;
-  q = p;
   q.clip = true;
   q.clip_bottom_d = std::isinf(lo) ? (p.clip ? p.clip_bottom_d : -p.inlet_length_d)
                                    : (out.bed.size() > 0 ? lowest - pad : lo) / d;
   q.clip_top_d = std::isinf(hi) ? (p.clip ? p.clip_top_d : bed_height(bed) / d + p.outlet_length_d)
                                 : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
-  // The whole bed's narrowest wall gap, unless given: a window of every sphere (the periodic
-  // cut's) finds it in its own survey, so the bed is treated for it only when spheres were left out.
-  if (out.bed.size() < bed.size() && !(p.ring_wall_gap_m > 0.0))
-    q.ring_wall_gap_m = treat_contacts(bed, p, {-inf, inf, false}).min_concave_wall_gap;
   return out;
 }
 

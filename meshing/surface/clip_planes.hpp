@@ -97,6 +97,10 @@ struct CutWindow {
   std::vector<std::size_t> numbers;  // per sphere of the window: its index in `bed`
 };
 CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d);
+// The spheres of `bed` whose centres lie from `lo` to `hi` (m), whole and in their order, as a
+// window of it (window_for_cuts without its planes and rings): surface `p` with the whole bed's
+// narrowest wall gap in ring_wall_gap_m, as given or found by treating the whole bed.
+CutWindow spheres_between(const Bed& bed, const SurfaceParams& p, double lo, double hi);
 // `message` (an error of the window's surface) with each "sphere K" and "particle K" numbered
 // as in the bed the window was taken from, so that it names the spheres a user can find.
 std::string in_bed_numbers(const CutWindow& window, const std::string& message);

@@ -272,9 +272,10 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // sagitta is 0.4 of the gap, down to the contact edge.
   // With rings, the whole bed's gap: every window of the bed then rings its walls alike (a
   // window's own spheres and opened contacts differ; window_for_cuts).
-  const double wall_gap = p.wall_rings_d.empty()   ? tb.min_concave_wall_gap
-                          : p.ring_wall_gap_m > 0.0 ? p.ring_wall_gap_m
-                                                    : tb.bed_min_concave_wall_gap;
+  // Without rings, given the whole bed's (a slab made from the spheres near it): the narrower.
+  const double wall_gap = !p.wall_rings_d.empty()    ? (p.ring_wall_gap_m > 0.0 ? p.ring_wall_gap_m : tb.bed_min_concave_wall_gap)
+                          : p.ring_wall_gap_m > 0.0 ? std::min(tb.min_concave_wall_gap, p.ring_wall_gap_m)
+                                                    : tb.min_concave_wall_gap;
   double wall_edge = edge;
   if (!box && ring_sagitta(R, edge) >= 0.5 * wall_gap) {
     wall_edge = wall_gap > 0.0 ? ring_edge_for_sagitta(R, 0.4 * wall_gap) : 0.0;

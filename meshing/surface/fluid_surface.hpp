@@ -46,8 +46,9 @@ struct SurfaceParams {
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
   // Heights above the floor (d) where the curved walls get rings (wall_mesh), not from a scene:
   // the planes a bed's pieces are cut at, so that each piece's window cuts the wall there alike;
-  // and the narrowest wall gap of the whole bed (m), whose edge the ringed walls take (0: this
-  // bed's; window_for_cuts sets both).
+  // and the narrowest wall gap of the whole bed (m), whose edge the ringed walls take, and walls
+  // without rings when narrower than this bed's (0: this bed's; window_for_cuts sets both, and
+  // spheres_between the gap).
   std::vector<double> wall_rings_d;
   double ring_wall_gap_m = 0.0;
   // Quality gate: a surface with a smaller angle fails, its triangles written to

@@ -344,11 +344,13 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
   const bool cut = !slabs_from_clip_windows(surface);
   const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
   const double margin = piece_margin_d(bed, surface);
+  // Shrink or none: the spheres within the margin of the slab's clip window, so that its survey
+  // of the contacts reads no more of the bed.
   const CutWindow window =
       cut ? window_for_cuts(bed, surface, k > 0 ? (planes[k - 1] - margin) * d : -inf,
                             k + 1 < slabs ? (planes[k] + margin) * d : inf, planes)
-          : CutWindow{Bed(), asked, {}};
-  const Bed& window_bed = cut ? window.bed : bed;
+          : spheres_between(bed, asked, (asked.clip_bottom_d - margin) * d, (asked.clip_top_d + margin) * d);
+  const Bed& window_bed = window.bed;
   const SurfaceParams& q = window.surface;
   // The slab's clip planes may find no height clear of the spheres, or cut one too close to
   // another cut: say which slab, since the scene set no clip window.
@@ -360,7 +362,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     try {
       return build_fluid_surface(window_bed, q);
     } catch (const InputError& e) {
-      throw cannot(cut ? in_bed_numbers(window, e.what()) : std::string(e.what()));
+      throw cannot(in_bed_numbers(window, e.what()));
     }
   }();
   nlohmann::json planes_used = {fs.report["clip"]["inlet"]["used_d"], fs.report["clip"]["outlet"]["used_d"]};

@@ -134,7 +134,9 @@ FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& surface, c
 SurfaceParams slab_surface(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int k);
 
 // Slab `k` between `planes` meshed on its own, needing no other slab's surface: from its clip
-// window (slabs_from_clip_windows), or under treated contacts from its window widened by
+// window (slabs_from_clip_windows) over the spheres within piece_margin_d of it (spheres_between:
+// the whole bed's wall gap in surface.ring_wall_gap_m, else found by treating the whole bed),
+// or under treated contacts from its window widened by
 // piece_margin_d + 1 d (its own clip planes free to move 1 d, so they stay at least
 // piece_margin_d away), ringed at every plane and cut at its own (cut_by_plane; the report's
 // "plane_cut" lists each cut); its surface and build_volume_mesh with

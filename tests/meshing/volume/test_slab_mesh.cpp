@@ -168,6 +168,39 @@ TEST(SlabMesh, PiecesSizedFromTheirWindowsSumToTheWholeDomainAndTheGivenWallGapI
   }
 }
 
+// A shrunk slab is made from the spheres within the margin of its clip window, handed the whole
+// bed's wall gap (spheres_between), so that a rank's survey of the contacts reads no more of the
+// bed: its surface is the one made from the whole bed, point for point, where the wall's edge
+// follows that gap (a = 3 at 0.3 d: the wall facets' sagitta would pass half the gap), which
+// lies outside the top slab's window.
+TEST(SlabMesh, AShrunkSlabFromTheSpheresNearItIsTheWholeBedsSlabPointForPoint) {
+  Bed b = test_support::packed_bed(160, 3.0, 1);
+  // The lowest sphere at the wall pushed 0.003 d into it: the bed's narrowest wall gap, far below
+  // the top slab, some 0.002 d once shrunk against the 0.005 d of the spheres touching it.
+  const double R = dynamic_cast<const Cylinder&>(*b.container).radius();
+  std::size_t low = b.size();
+  for (std::size_t i = 0; i < b.size(); ++i)
+    if (R - b.centres[i].head<2>().norm() - 0.5 < 1e-3 && (low == b.size() || b.centres[i].z() < b.centres[low].z()))
+      low = i;
+  ASSERT_LT(low, b.size());
+  b.centres[low].head<2>() *= (b.centres[low].head<2>().norm() + 0.003) / b.centres[low].head<2>().norm();
+  SurfaceParams sp;  // shrink
+  sp.edge_length_d = 0.3;
+  const std::vector<double> planes = slab_planes_d(b, sp, 3);
+  const SurfaceParams asked = slab_surface(b, sp, planes, 2);
+  const double d = reference_diameter(b), margin = piece_margin_d(b, sp);
+  const CutWindow near = spheres_between(b, asked, (asked.clip_bottom_d - margin) * d, (asked.clip_top_d + margin) * d);
+  ASSERT_LT(near.bed.size(), b.size());
+  const FluidSurface whole = build_fluid_surface(b, asked), part = build_fluid_surface(near.bed, near.surface);
+  // The whole bed's narrowest wall gap lies outside this window, which alone would take a wider one.
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_GT(treat_contacts(near.bed, asked, {-inf, inf, false}).min_concave_wall_gap, 2.0 * near.surface.ring_wall_gap_m);
+  ASSERT_EQ(part.fluid.points.size(), whole.fluid.points.size());
+  EXPECT_TRUE(part.fluid.points == whole.fluid.points);
+  EXPECT_TRUE(part.fluid.triangles == whole.fluid.triangles);
+  EXPECT_EQ(part.exact_volume_m3, whole.exact_volume_m3);
+}
+
 // Moved planes: each to another interval between the spheres' ends (both radii, as the surface
 // stage keeps clear of), no farther than clip_shift_d, and clear of every end.
 TEST(SlabMesh, MovedPlanesLieInAnotherIntervalBetweenTheSpheresEnds) {
