@@ -111,17 +111,41 @@ double piece_margin_d(const Bed& bed, const SurfaceParams& surface) {
          surface.clip_shift_d;
 }
 
-std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p) {
+std::vector<double> survey_stretches(const Bed& bed, std::size_t spheres) {
   const double inf = std::numeric_limits<double>::infinity();
-  const TreatedBed treated = treat_contacts(bed, p, {-inf, inf, false});
+  std::vector<double> out{-inf};
+  if (spheres > 0 && bed.size() > 2 * spheres) {
+    std::vector<double> z;
+    for (const Eigen::Vector3d& c : bed.centres) z.push_back(c.z());
+    std::sort(z.begin(), z.end());
+    for (std::size_t k = spheres; k + spheres <= z.size(); k += spheres)
+      if (z[k] > out.back()) out.push_back(z[k]);
+  }
+  out.push_back(inf);
+  return out;
+}
+
+std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p, std::size_t spheres_per_window) {
+  const double inf = std::numeric_limits<double>::infinity(), d = reference_diameter(bed);
+  const double margin = piece_margin_d(bed, p) * d;
+  // The windows' rings are not made: their gap need not be found.
+  SurfaceParams unringed = p;
+  unringed.ring_wall_gap_m = inf;
+  const std::vector<double> stretches = survey_stretches(bed, spheres_per_window);
   std::vector<double> out;
-  for (std::size_t i = 0; i < bed.size(); ++i) {
-    for (const SphereCut& cut : treated.cuts[i]) {
-      const auto [lo, hi] = std::minmax_element(cut.loop.begin(), cut.loop.end(),
-                                                [](const auto& a, const auto& b) { return a.z() < b.z(); });
-      if (lo != cut.loop.end()) out.push_back(lo->z()), out.push_back(hi->z());
+  for (std::size_t s = 0; s + 1 < stretches.size(); ++s) {
+    const double lo = stretches[s], hi = stretches[s + 1];
+    const CutWindow w = window_for_cuts(bed, unringed, lo - margin, hi + margin, {});
+    const TreatedBed treated = treat_contacts(w.bed, p, {-inf, inf, false});
+    for (std::size_t i = 0; i < w.bed.size(); ++i) {
+      if (const double z = w.bed.centres[i].z(); !(z >= lo && z < hi)) continue;  // another stretch's
+      for (const SphereCut& cut : treated.cuts[i]) {
+        const auto [low, high] = std::minmax_element(cut.loop.begin(), cut.loop.end(),
+                                                     [](const auto& a, const auto& b) { return a.z() < b.z(); });
+        if (low != cut.loop.end()) out.push_back(low->z()), out.push_back(high->z());
+      }
+      for (double end : {-treated.radius[i], treated.radius[i]}) out.push_back(w.bed.centres[i].z() + end);
     }
-    for (double end : {-treated.radius[i], treated.radius[i]}) out.push_back(bed.centres[i].z() + end);
   }
   return out;
 }

@@ -71,13 +71,23 @@ bool opens_contacts_at_periodic_planes(const SurfaceParams& p);
 // Within it both windows of a plane hold the same spheres, contacts and cuts.
 double piece_margin_d(const Bed& bed, const SurfaceParams& surface);
 
+// A long bed is surveyed window by window, so that no process treats all its contacts at once
+// (the launching process of a run in pieces: 16 MB per 1000 spheres with bridges, docs/findings.md
+// 2026-12-01): the heights (m), from -inf to +inf, between which about `spheres` sphere centres
+// lie each (just -inf and +inf on a bed of no more than twice that). Each stretch is treated with
+// the spheres within piece_margin_d of it (window_for_cuts), which hold every contact of its own.
+inline constexpr std::size_t kSpheresPerSurveyWindow = 4000;
+std::vector<double> survey_stretches(const Bed& bed, std::size_t spheres);
+
 // The heights (m) a plane cut through `bed`'s treated contacts keeps as clear of as it can: the
 // highest and lowest point of every loop where a treated contact meets a sphere (bridges' and
 // caps' rims, at the wall too; enlarged spheres' unions) and the treated spheres' ends. Where a
 // plane passes near one, it meets the surface nearly tangent and the cut leaves slivers (cells
 // failing checkMesh's skewness beside a periodic slice's rims 0.0002 and 0.003 d from its plane,
 // docs/findings.md, 2026-12-01), or a wall ring there moves a loop's vertex.
-std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p);
+// Treated window by window (survey_stretches) on a bed of more than twice `spheres_per_window`.
+std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p,
+                                    std::size_t spheres_per_window = kSpheresPerSurveyWindow);
 
 // A window of `bed` whose surface is cut at planes inside it through its treated contacts (a
 // slab's or a piece's, a periodic section's). Its own clip planes must cut no contact, which a

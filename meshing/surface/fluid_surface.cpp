@@ -197,11 +197,13 @@ LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
 
 }  // namespace
 
-FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p, double volume_per_cell, int bins) {
+FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p, double volume_per_cell, int bins,
+                                        const std::optional<std::array<double, 2>>& grid) {
   const LaidOut laid = lay_out(given, p);
   const Bed& bed = laid.bed();
   const TreatedBed& tb = laid.treated;
-  FluidDomainProfile out{{}, tb.planes.z0, tb.planes.z1, {}, {}, {}, tb.bed_min_concave_wall_gap};
+  FluidDomainProfile out{{}, grid ? (*grid)[0] : tb.planes.z0, grid ? (*grid)[1] : tb.planes.z1, {}, {}, {}, {},
+                         tb.bed_min_concave_wall_gap};
   out.size.volume_m3 = bed.container->cross_section_area() * (tb.planes.z1 - tb.planes.z0) - tb.solid_volume;
   const double d = reference_diameter(bed), edge = p.edge_length_d * d, height = (out.z1 - out.z0) / bins;
   const double per_volume = 1.0 / (edge * edge * edge);
@@ -225,17 +227,22 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   }
   // A loop's spacing is the contact edge (or less, on a short loop): graded from it up to `edge`,
   // in full up to a contact edge of half the edge, taken to fall linearly to none at the edge.
+  // Each loop binned by its first point.
+  out.loop_edges.assign(bins, 0.0);
   if (p.contact_edge_length_d < p.edge_length_d) {
     const double graded = 0.5 * (p.contact_edge_length_d + p.edge_length_d) * d;
-    double edges = 0.0;
+    const double weight = std::min(2.0 * (1.0 - p.contact_edge_length_d / p.edge_length_d), 1.0);
+    auto add = [&](const auto& loop, double spacing) {
+      if (!(spacing < graded) || loop.empty()) return;
+      const int b = std::clamp(static_cast<int>(std::floor((loop.front().z() - out.z0) / height)), 0, bins - 1);
+      out.loop_edges[b] += weight * static_cast<double>(loop.size());
+      out.size.contact_loop_edges += weight * static_cast<double>(loop.size());
+    };
     for (std::size_t i = 0; i < bed.size(); ++i)
       if (tb.kept[i])
-        for (const SphereCut& c : tb.cuts[i])
-          if (c.spacing < graded) edges += static_cast<double>(c.loop.size());
+        for (const SphereCut& c : tb.cuts[i]) add(c.loop, c.spacing);
     for (const auto& holes : tb.wall_holes)
-      for (const WallHole& h : holes)
-        if (h.spacing < graded) edges += static_cast<double>(h.loop.size());
-    out.size.contact_loop_edges = edges * std::min(2.0 * (1.0 - p.contact_edge_length_d / p.edge_length_d), 1.0);
+      for (const WallHole& h : holes) add(h.loop, h.spacing);
   }
   out.size.thin_gap_contacts = static_cast<double>(tb.thin_gap_contacts);
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, *bed.container);

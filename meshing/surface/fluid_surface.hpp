@@ -1,4 +1,5 @@
 #pragma once
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -108,14 +109,18 @@ struct FluidDomainProfile {
   FluidDomainSize size;
   double z0 = 0.0, z1 = 0.0;  // m
   std::vector<double> cells;  // bins
-  // Bins: the fluid's volume (m^3; the spheres' slices taken out, their contacts' parts not) and
-  // the cells the narrow gaps add (at the volume per cell asked), for a share of the size.
-  std::vector<double> fluid_m3, gap_cells;
+  // Bins: the fluid's volume (m^3; the spheres' slices taken out, their contacts' parts not), the
+  // cells the narrow gaps add (at the volume per cell asked) and the graded loops' edges (each
+  // loop in the bin of its first point), for a share of the size.
+  std::vector<double> fluid_m3, gap_cells, loop_edges;
   // The whole bed's narrowest gap at a curved wall (m; infinite without one): the edge every
   // window of the bed rings its walls with (SurfaceParams::ring_wall_gap_m, window_for_cuts).
   double bed_wall_gap_m = 0.0;
 };
-FluidDomainProfile fluid_domain_profile(const Bed& bed, const SurfaceParams& p, double volume_per_cell, int bins);
+// `grid` (m, its bottom and top): the bins over it instead of from z0 to z1 (a window's profile
+// on the whole bed's bins, slab_profile's); the size stays the window's.
+FluidDomainProfile fluid_domain_profile(const Bed& bed, const SurfaceParams& p, double volume_per_cell, int bins,
+                                        const std::optional<std::array<double, 2>>& grid = std::nullopt);
 
 struct FluidSurface {
   TriangleMesh fluid;  // closed: container between inlet and outlet, minus the treated spheres (m)

@@ -236,11 +236,42 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const Volu
   return std::max(1, static_cast<int>(std::ceil(static_cast<double>(surface_triangles) / kSurfaceTrianglesPerSlab)));
 }
 
-FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& s, int slabs, double volume_per_cell) {
+FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& s, int slabs, double volume_per_cell,
+                                std::size_t spheres_per_window) {
+  const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
   const double span_d = (s.clip ? s.clip_top_d - s.clip_bottom_d
-                                : bed_height(bed) / reference_diameter(bed) + s.inlet_length_d + s.outlet_length_d);
+                                : bed_height(bed) / d + s.inlet_length_d + s.outlet_length_d);
   const int bins = std::clamp(static_cast<int>(std::ceil(span_d / 0.02)), 100 * std::max(slabs, 1), 1 << 22);
-  return fluid_domain_profile(bed, s, volume_per_cell, bins);
+  const std::vector<double> stretches = survey_stretches(bed, spheres_per_window);
+  // A clip window's planes move clear of the contacts near them, which its whole survey places.
+  if (stretches.size() == 2 || s.clip) return fluid_domain_profile(bed, s, volume_per_cell, bins);
+  // Window by window on the whole domain's bins, each stretch's bins from its own window.
+  const std::array<double, 2> grid{-s.inlet_length_d * d, bed_height(bed) + s.outlet_length_d * d};
+  const double height = (grid[1] - grid[0]) / bins, margin = piece_margin_d(bed, s) * d;
+  SurfaceParams unringed = s;  // the windows' rings are not made: their gap need not be found
+  unringed.ring_wall_gap_m = inf;
+  const std::vector<double> none(bins, 0.0);
+  FluidDomainProfile out{{}, grid[0], grid[1], none, none, none, none, inf};
+  for (std::size_t k = 0; k + 1 < stretches.size(); ++k) {
+    const double lo = stretches[k], hi = stretches[k + 1];
+    const CutWindow w = window_for_cuts(bed, unringed, lo - margin, hi + margin, {});
+    const FluidDomainProfile part = fluid_domain_profile(w.bed, w.surface, volume_per_cell, bins, grid);
+    double own = 0.0, all = 0.0;  // the window's cells in its stretch, and in all
+    for (int b = 0; b < bins; ++b) {
+      all += part.cells[b];
+      if (const double z = grid[0] + (b + 0.5) * height; !(z >= lo && z < hi)) continue;
+      out.cells[b] = part.cells[b], out.fluid_m3[b] = part.fluid_m3[b], out.gap_cells[b] = part.gap_cells[b];
+      out.loop_edges[b] = part.loop_edges[b];
+      own += part.cells[b];
+      out.size.volume_m3 += part.fluid_m3[b], out.size.gap_cells += part.gap_cells[b];
+      out.size.contact_loop_edges += part.loop_edges[b];
+    }
+    // The thin gaps are not binned: the stretch's share as its cells'.
+    out.size.thin_gap_contacts += (all > 0.0 ? own / all : 0.0) * part.size.thin_gap_contacts;
+    // Each window's survey holds its spheres' wall gaps as the whole bed's does.
+    out.bed_wall_gap_m = std::min(out.bed_wall_gap_m, part.bed_wall_gap_m);
+  }
+  return out;
 }
 
 FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes, int k,
@@ -267,9 +298,8 @@ FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& s, const s
   FluidDomainSize out = profile.size;
   out.volume_m3 *= share(profile.fluid_m3);
   out.gap_cells *= share(profile.gap_cells);
-  // The contacts' loops and thin gaps are not binned: as the cells are shared.
-  const double cells = share(profile.cells);
-  out.contact_loop_edges *= cells, out.thin_gap_contacts *= cells;
+  out.contact_loop_edges *= share(profile.loop_edges);
+  out.thin_gap_contacts *= share(profile.cells);  // not binned: as the cells are shared
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include "core/bed.hpp"
 #include "core/error.hpp"
 #include "core/progress.hpp"
+#include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/fluid_surface.hpp"
 #include "meshing/volume/volume_mesh.hpp"
 
@@ -117,13 +118,18 @@ auto attempt_with_planes_moved(const Bed& bed, const SurfaceParams& surface, con
 void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes, int slabs,
                           const std::string& name);
 // The fluid domain's profile (fluid_domain_profile, its size at `volume_per_cell`) in bins fine
-// enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab.
-FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, int slabs, double volume_per_cell);
+// enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab. On a bed of more
+// than twice `spheres_per_window` spheres (and no clip window) made window by window
+// (survey_stretches), each stretch's bins from its own window, so that no process treats the
+// whole bed at once: the same bins (to rounding) and wall gap; the size's fluid volume then
+// leaves the contacts' parts out, and its thin gaps are shared as the cells are.
+FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& surface, int slabs, double volume_per_cell,
+                                std::size_t spheres_per_window = kSpheresPerSurveyWindow);
 // The size of slab `k`'s fluid domain between `planes` (d) at `volume_per_cell` (m^3), from the
 // spheres within piece_margin_d of it only (its window, window_for_cuts), so that a rank sizes
 // its piece without treating the whole bed: the window's size, each part times its share between
-// the slab's planes (the fluid volume's and the gaps' cells by their own profiles, the rest by
-// the cells'). Sums over the slabs to about the whole domain's size.
+// the slab's planes (the fluid volume, the gaps' cells and the loops' edges by their own
+// profiles, the thin gaps by the cells'). Sums over the slabs to about the whole domain's size.
 FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
                                  int k, double volume_per_cell);
 
