@@ -128,14 +128,11 @@ std::vector<double> survey_stretches(const Bed& bed, std::size_t spheres) {
 std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p, std::size_t spheres_per_window) {
   const double inf = std::numeric_limits<double>::infinity(), d = reference_diameter(bed);
   const double margin = piece_margin_d(bed, p) * d;
-  // The windows' rings are not made: their gap need not be found.
-  SurfaceParams unringed = p;
-  unringed.ring_wall_gap_m = inf;
   const std::vector<double> stretches = survey_stretches(bed, spheres_per_window);
   std::vector<double> out;
   for (std::size_t s = 0; s + 1 < stretches.size(); ++s) {
     const double lo = stretches[s], hi = stretches[s + 1];
-    const CutWindow w = window_for_cuts(bed, unringed, lo - margin, hi + margin, {});
+    const CutWindow w = survey_window(bed, p, lo - margin, hi + margin);
     const TreatedBed treated = treat_contacts(w.bed, p, {-inf, inf, false});
     for (std::size_t i = 0; i < w.bed.size(); ++i) {
       if (const double z = w.bed.centres[i].z(); !(z >= lo && z < hi)) continue;  // another stretch's
@@ -186,6 +183,12 @@ CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, dou
                                 : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
   return out;
+}
+
+CutWindow survey_window(const Bed& bed, const SurfaceParams& p, double lo, double hi) {
+  SurfaceParams unringed = p;
+  unringed.ring_wall_gap_m = std::numeric_limits<double>::infinity();
+  return window_for_cuts(bed, unringed, lo, hi, {});
 }
 
 std::string in_bed_numbers(const CutWindow& window, const std::string& message) {

@@ -107,6 +107,9 @@ struct CutWindow {
   std::vector<std::size_t> numbers;  // per sphere of the window: its index in `bed`
 };
 CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d);
+// window_for_cuts's window for a survey of its treatment only: its walls not ringed, so the
+// whole bed's wall gap is not looked for.
+CutWindow survey_window(const Bed& bed, const SurfaceParams& p, double lo, double hi);
 // The spheres of `bed` whose centres lie from `lo` to `hi` (m), whole and in their order, as a
 // window of it (window_for_cuts without its planes and rings): surface `p` with the whole bed's
 // narrowest wall gap in ring_wall_gap_m, as given or found by treating the whole bed.

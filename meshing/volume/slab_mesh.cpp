@@ -243,18 +243,18 @@ FluidDomainProfile slab_profile(const Bed& bed, const SurfaceParams& s, int slab
                                 : bed_height(bed) / d + s.inlet_length_d + s.outlet_length_d);
   const int bins = std::clamp(static_cast<int>(std::ceil(span_d / 0.02)), 100 * std::max(slabs, 1), 1 << 22);
   const std::vector<double> stretches = survey_stretches(bed, spheres_per_window);
-  // A clip window's planes move clear of the contacts near them, which its whole survey places.
-  if (stretches.size() == 2 || s.clip) return fluid_domain_profile(bed, s, volume_per_cell, bins);
+  // A clip window's planes move clear of the contacts near them, which its whole survey places;
+  // a periodic section is laid out whole.
+  if (stretches.size() == 2 || s.clip || bed.container->axial_period() > 0.0)
+    return fluid_domain_profile(bed, s, volume_per_cell, bins);
   // Window by window on the whole domain's bins, each stretch's bins from its own window.
   const std::array<double, 2> grid{-s.inlet_length_d * d, bed_height(bed) + s.outlet_length_d * d};
   const double height = (grid[1] - grid[0]) / bins, margin = piece_margin_d(bed, s) * d;
-  SurfaceParams unringed = s;  // the windows' rings are not made: their gap need not be found
-  unringed.ring_wall_gap_m = inf;
   const std::vector<double> none(bins, 0.0);
   FluidDomainProfile out{{}, grid[0], grid[1], none, none, none, none, inf};
   for (std::size_t k = 0; k + 1 < stretches.size(); ++k) {
     const double lo = stretches[k], hi = stretches[k + 1];
-    const CutWindow w = window_for_cuts(bed, unringed, lo - margin, hi + margin, {});
+    const CutWindow w = survey_window(bed, s, lo - margin, hi + margin);
     const FluidDomainProfile part = fluid_domain_profile(w.bed, w.surface, volume_per_cell, bins, grid);
     double own = 0.0, all = 0.0;  // the window's cells in its stretch, and in all
     for (int b = 0; b < bins; ++b) {
@@ -279,10 +279,7 @@ FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& s, const s
   const int slabs = static_cast<int>(planes.size()) + 1;
   const double d = reference_diameter(bed), margin = piece_margin_d(bed, s), inf = std::numeric_limits<double>::infinity();
   const double lo = k > 0 ? planes[k - 1] * d : -inf, hi = k + 1 < slabs ? planes[k] * d : inf;
-  // The gap of the window's rings does not change its profile: any will do, and spares treating the bed.
-  SurfaceParams given = s;
-  if (!(given.ring_wall_gap_m > 0.0)) given.ring_wall_gap_m = inf;
-  const CutWindow w = window_for_cuts(bed, given, lo - margin * d, hi + margin * d, {});
+  const CutWindow w = survey_window(bed, s, lo - margin * d, hi + margin * d);
   const FluidDomainProfile profile = slab_profile(w.bed, w.surface, 1, volume_per_cell);
   // The share of a binned quantity between the slab's planes, bins cut by a plane in proportion.
   const double height = (profile.z1 - profile.z0) / static_cast<double>(profile.cells.size());

@@ -119,7 +119,7 @@ void check_given_planes_d(const Bed& bed, const SurfaceParams& surface, const st
                           const std::string& name);
 // The fluid domain's profile (fluid_domain_profile, its size at `volume_per_cell`) in bins fine
 // enough to place the planes of `slabs` slabs: 0.02 d, at least 100 per slab. On a bed of more
-// than twice `spheres_per_window` spheres (and no clip window) made window by window
+// than twice `spheres_per_window` spheres (no clip window, no period) made window by window
 // (survey_stretches), each stretch's bins from its own window, so that no process treats the
 // whole bed at once: the same bins (to rounding) and wall gap; the size's fluid volume then
 // leaves the contacts' parts out, and its thin gaps are shared as the cells are.
