@@ -34,6 +34,19 @@ toml::table load_table(const std::string& scene_file) {
   return parse_scene_text(read_file(scene_file), scene_file);
 }
 
+// A number option's check that says what is allowed (CLI11's own range checks print the whole
+// range of a double): "--wall-gap-m: -1; allowed: a number > 0 (m)".
+CLI::Validator allowed_number(bool (*ok)(double), const std::string& what) {
+  return CLI::Validator(
+      [ok, what](std::string& text) {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        const bool number = end != text.c_str() && *end == '\0';
+        return number && ok(value) ? std::string() : text + "; allowed: " + what;
+      },
+      "");
+}
+
 }  // namespace
 
 int run_command_line(int argc, char** argv) {
@@ -112,16 +125,16 @@ int run_command_line(int argc, char** argv) {
                    static_cast<Command>(static_cast<unsigned>(Command::surface) | static_cast<unsigned>(Command::mesh) |
                                         static_cast<unsigned>(Command::case_)));
   piece_cmd->add_option("--piece", piece, "int: this piece, 0 at the bottom (default: OMPI_COMM_WORLD_RANK)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(allowed_number([](double v) { return v >= 0.0; }, "an integer >= 0"));
   piece_cmd->add_option("--pieces", pieces, "int: the number of pieces (default: OMPI_COMM_WORLD_SIZE)")
-      ->check(CLI::PositiveNumber);
+      ->check(allowed_number([](double v) { return v >= 1.0; }, "an integer >= 1"));
   piece_cmd->add_option("--planes-d", planes_d,
                         "numbers: the heights of the planes between the pieces, d above the floor, one fewer than the "
                         "pieces (default: at about equal cells by the mesh estimate)");
   piece_cmd->add_option("--wall-gap-m", wall_gap_m,
                         "number, m: the whole bed's narrowest gap at a curved wall, whose edge every piece rings its "
-                        "walls with (default: found by treating the whole bed)")
-      ->check(CLI::PositiveNumber);
+                        "walls with (default: found by surveying the bed's contacts first)")
+      ->check(allowed_number([](double v) { return v > 0.0; }, "a number > 0 (m)"));
 #endif
 #ifdef BEDFORGE_HAVE_GMSH
   CLI::App* case_cmd = on_directory("case",

@@ -149,13 +149,13 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const cases::CaseParams params = read_section(d.scene, "case", cases::read_case_params);
   // Before any meshing: the planes given must lie inside the fluid domain, and this machine's
   // ranks' pieces must fit in its memory. Given the planes and the wall gap (as a run gives
-  // them), the rank treats only its piece's window; else the whole bed, once, for both.
+  // them), the rank treats only its piece's window; else it surveys the bed for both first.
   if (!planes_d.empty()) meshing::check_given_planes_d(d.bed, surface, planes_d, pieces, "--planes-d");
   std::vector<double> planes = planes_d;
   if (planes.empty() || !(wall_gap_m > 0.0)) {
-    const meshing::FluidDomainProfile profile = meshing::slab_profile(d.bed, surface, pieces, 1.0);
-    if (planes.empty()) planes = meshing::slab_planes_d(d.bed, surface, profile, pieces);
-    if (!(wall_gap_m > 0.0)) wall_gap_m = profile.bed_wall_gap_m;
+    const meshing::SlabPlanes found = meshing::slab_planes(d.bed, surface, pieces);
+    if (planes.empty()) planes = found.planes_d;
+    if (!(wall_gap_m > 0.0)) wall_gap_m = found.wall_gap_m;
   }
   surface.ring_wall_gap_m = wall_gap_m;
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");

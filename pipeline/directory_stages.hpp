@@ -29,7 +29,7 @@ void mesh_directory(const std::filesystem::path& dir, const std::vector<Override
 // (piece_stage.hpp), the case written into DIR/case first, between `planes_d` (d above the floor;
 // empty: meshing::slab_planes_d's; InputError naming --planes-d when they are not pieces - 1
 // increasing heights inside the domain), its walls ringed with the edge of the whole bed's
-// narrowest wall gap `wall_gap_m` (m; 0: found by treating the whole bed). Given both, the rank
+// narrowest wall gap `wall_gap_m` (m; 0: found by meshing::slab_planes). Given both, the rank
 // treats only its piece's window, sizing it for the memory check too (meshing::slab_domain_size;
 // InputError naming mesh.pieces when the piece will not fit in this rank's share of memory).
 // Every piece's report goes beside its cells, not into DIR/report.json, which the ranks would

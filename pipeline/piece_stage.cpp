@@ -298,16 +298,15 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     throw std::runtime_error(what);
   };
   out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
-    // The planes and the whole bed's wall gap from one treatment of it, here, so that each rank
+    // The planes and the whole bed's wall gap from one survey of it, here, so that each rank
     // treats only its piece's window (piece_directory).
-    const meshing::FluidDomainProfile profile = meshing::slab_profile(bed, surface, pieces, 1.0);
-    const std::vector<double> planes = meshing::slab_planes_d(bed, surface, profile, pieces);
-    release_free_memory();  // the treatment's, kept by the allocator, from the ranks started on this machine
+    const meshing::SlabPlanes given = meshing::slab_planes(bed, surface, pieces);
+    release_free_memory();  // the survey's, kept by the allocator, from the ranks started on this machine
     bool moved = false;
     meshing::attempt_with_planes_moved(
-        bed, surface, planes, "mesh.pieces",
+        bed, surface, given.planes_d, "mesh.pieces",
         [&](const std::vector<double>& at) {
-          run_ranks(info.directory, at, profile.bed_wall_gap_m, moved ? "log.pieces_planes_moved" : "log.pieces");
+          run_ranks(info.directory, at, given.wall_gap_m, moved ? "log.pieces_planes_moved" : "log.pieces");
         },
         [&console, &moved](const meshing::PlanesMoved& m) {
           moved = true;

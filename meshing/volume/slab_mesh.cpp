@@ -301,7 +301,12 @@ FluidDomainSize slab_domain_size(const Bed& bed, const SurfaceParams& s, const s
 }
 
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, int slabs) {
-  return slabs < 2 ? std::vector<double>{} : slab_planes_d(bed, s, slab_profile(bed, s, slabs, 1.0), slabs);
+  return slabs < 2 ? std::vector<double>{} : slab_planes(bed, s, slabs).planes_d;
+}
+
+SlabPlanes slab_planes(const Bed& bed, const SurfaceParams& s, int slabs) {
+  const FluidDomainProfile profile = slab_profile(bed, s, slabs, 1.0);
+  return {slab_planes_d(bed, s, profile, slabs), profile.bed_wall_gap_m};
 }
 
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const FluidDomainProfile& profile,
@@ -424,13 +429,13 @@ VolumeMesh build_slabbed_volume_mesh(const Bed& bed, const SurfaceParams& surfac
                                      const std::filesystem::path& bad_cells_path, Progress& progress) {
   if (!pieces_possible(surface, *bed.container) && whole == nullptr)
     throw std::invalid_argument("build_slabbed_volume_mesh: treated contacts in a box need the whole surface to cut slabs from");
-  // One treatment of the whole bed for the planes and the gap every slab's window rings its walls with.
-  const FluidDomainProfile profile = slab_profile(bed, surface, slabs, 1.0);
+  // One survey of the bed for the planes and the gap every slab's window rings its walls with.
+  const SlabPlanes at = slab_planes(bed, surface, slabs);
   SurfaceParams ringed = surface;
-  ringed.ring_wall_gap_m = profile.bed_wall_gap_m;
+  ringed.ring_wall_gap_m = at.wall_gap_m;
   std::optional<PlanesMoved> moved;
   VolumeMesh out = attempt_with_planes_moved(
-      bed, surface, slab_planes_d(bed, surface, profile, slabs), "mesh.slabs",
+      bed, surface, at.planes_d, "mesh.slabs",
       [&](const std::vector<double>& planes) {
         return mesh_and_join_slabs(bed, ringed, whole, planes, d_ref, p, msh_path, bad_cells_path, progress);
       },

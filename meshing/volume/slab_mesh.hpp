@@ -57,6 +57,15 @@ int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, cons
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, int slabs);
 std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& surface, const FluidDomainProfile& profile,
                                   int slabs);
+// The planes between `slabs` slabs (slab_planes_d, d) and the whole bed's narrowest wall gap
+// (FluidDomainProfile::bed_wall_gap_m, m), which every slab's window rings its walls with, from
+// one survey of the bed (slab_profile): what a run hands its ranks (`piece --planes-d
+// --wall-gap-m`), so that each treats only its window.
+struct SlabPlanes {
+  std::vector<double> planes_d;
+  double wall_gap_m = 0.0;
+};
+SlabPlanes slab_planes(const Bed& bed, const SurfaceParams& surface, int slabs);
 // Where `planes` (d) go when the slabs between them fail the quality gate or cannot be cut: each
 // to the middle of the widest interval between the spheres' ends within surface.clip_shift_d of
 // it, other than the interval it lies in (where it stays when there is no other).

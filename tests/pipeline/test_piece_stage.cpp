@@ -330,15 +330,18 @@ TEST(PieceStage, APieceThatCannotBeCutIsTriedAgainWithThePlanesMovedAndTheErrorN
 }
 
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
-// no case to write into, pieces beyond the machine's memory, planes that do not fit the pieces,
-// a piece on polyhedra made without its neighbours, and contacts a plane would cut open; no
-// processor directory is left.
+// a wall gap not above 0, no case to write into, pieces beyond the machine's memory, planes that
+// do not fit the pieces, a piece on polyhedra made without its neighbours, and contacts a plane
+// would cut open; no processor directory is left.
 TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_dir("piece_refused");
   ASSERT_EQ(cli_test::bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
   Result r = cli_test::bedforge("piece " + dir.string() + " --piece 2 --pieces 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--piece 2: allowed: 0 to 1"), std::string::npos) << r.output;
+  r = cli_test::bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --wall-gap-m -1");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--wall-gap-m: -1; allowed: a number > 0 (m)"), std::string::npos) << r.output;
   r = shell("env -u OMPI_COMM_WORLD_RANK " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() + " --pieces 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("--piece not given and OMPI_COMM_WORLD_RANK not set"), std::string::npos) << r.output;
