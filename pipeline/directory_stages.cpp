@@ -159,10 +159,10 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   }
   surface.ring_wall_gap_m = wall_gap_m;
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-  refuse_piece_beyond_memory(estimate_mesh(surface, mesh, params,
-                                           meshing::slab_domain_size(d.bed, surface, planes, piece, kEstimateVolumePerCell),
-                                           reference_diameter(d.bed)),
-                             piece, pieces, local ? std::atoi(local) : 1, available_memory_bytes());
+  const MeshEstimate estimate =
+      estimate_mesh(surface, mesh, params, meshing::slab_domain_size(d.bed, surface, planes, piece, kEstimateVolumePerCell),
+                    reference_diameter(d.bed));
+  refuse_piece_beyond_memory(estimate, surface, piece, pieces, local ? std::atoi(local) : 1, available_memory_bytes());
   // The seed from bed.csv: a run starts its ranks before it writes report.json.
   const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());
   const std::string note = fmt::format("bedforge {}, seed {}, piece {} of {}", kVersion,
@@ -171,7 +171,10 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const nlohmann::json r = piece_stage(d.bed, stage_key(read_file(dir / "bed.csv")), surface,
                                        planes,
                                        mesh, params, piece, pieces, dir / "case", note, console);
-  console.line(fmt::format("piece {} of {}: {} cells in {}{}", piece, pieces, r["cells"].get<long>(),
+  // With the estimate beside the cells made and the peak, so that every run tells how far it erred.
+  console.line(fmt::format("piece {} of {}: {} cells (estimated {:.3g} million tetrahedra, {:.1f} GB; peak {:.1f} GB) in {}{}",
+                           piece + 1, pieces, r["cells"].get<long>(), estimate.cells / 1e6,
+                           estimate.likely_mesh_peak_bytes / 1e9, r.value("peak_memory_mb", 0.0) * 1048576.0 / 1e9,
                            (dir / "case" / fmt::format("processor{}", piece)).string(),
                            r.value("reused", false) || r["slab"].value("reused", false)
                                ? " (kept from an earlier run made from the same)"

@@ -64,6 +64,9 @@ struct MeshEstimate {
   double contact_cells = 0.0;  // of `cells`, those graded around contacts (without cells_per_gap)
   double cells = 0.0;
   double mesh_peak_bytes = 0.0;  // the mesh stage's
+  // The mesh stage's peak as measured, not a bound: with the gaps refined, at
+  // kGapsRefinedBytesPerCell per estimated cell; else mesh_peak_bytes.
+  double likely_mesh_peak_bytes = 0.0;
   double peak_bytes = 0.0;       // the run's: the mesh stage's, or simpleFoam's when the case is run
   bool peak_in_solver = false;   // the peak is simpleFoam's (the case is run), not the mesh stage's
 };
@@ -92,14 +95,27 @@ void refuse_mesh_beyond_memory(const Scene& scene, double available_bytes);
 // narrow gaps' cells are what does not fit. Returns the estimate.
 MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, double available_bytes);
 
+// The mesh stage's peak per estimated cell with the gaps refined (cells_per_gap > 0), for a
+// piece's refusal, where the bound above let a piece through that the kernel killed at 22.2 GB
+// (estimated 22.2 M cells, 10.2 GB): the most measured on meshes of at least 4 M estimated
+// cells, rounded up, a calibration on three runs of the scenes' ratio of contact to surface edge
+// (1/3-1/4): 1073 on a = 5, N = 500 at 0.15 d in one piece, 1033 and 1027 on the middle piece of
+// 12 of a = 14, N = 1e4 at 0.2 and 0.15 d (gmsh's HXT peaks at some 740 bytes per tetrahedron
+// there, 1.23 times the estimated cells). With a contact edge a tenth of the surface edge the
+// runs took 464-569 per estimated cell, so a refusal there may stop a piece that would fit
+// (docs/findings.md, 2026-12-01).
+inline constexpr double kGapsRefinedBytesPerCell = 1100.0;
+
 // Piece `piece` (from 0) of `pieces` (piece_stage), estimated alone as `e` (from
 // meshing::slab_domain_size), with `ranks_here` ranks on this machine (OMPI_COMM_WORLD_LOCAL_SIZE,
 // said in the message): InputError naming mesh.pieces and the count that would fit (the pieces
-// are cut to about equal estimated cells) when e.mesh_peak_bytes exceeds `available_bytes`, this
-// rank's share of the machine's memory (available_memory_bytes()). Errs towards trying: one
-// rank with the whole default bed peaked at 4329 MB where its mesh stage took 3060 MB
+// are cut to about equal estimated cells) when e.likely_mesh_peak_bytes exceeds `available_bytes`,
+// this rank's share of the machine's memory (available_memory_bytes()): a refused piece costs its
+// user one more piece, a killed one its allocation. Where the narrow gaps hold most of the
+// cells, the message names `s`'s cells_per_gap and contact edge too. Without refined gaps it errs towards trying:
+// one rank with the whole default bed peaked at 4329 MB where its mesh stage took 3060 MB
 // (docs/mesh_case_benchmark.md, pieces).
-void refuse_piece_beyond_memory(const MeshEstimate& e, int piece, int pieces, int ranks_here, double available_bytes);
+void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces, int ranks_here, double available_bytes);
 
 // What a user may change when the pieces' ranks lack memory, for the "allowed:" of a message;
 // `more_pieces` says how many pieces (e.g. "mesh.pieces >= 6").
