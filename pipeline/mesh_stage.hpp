@@ -99,12 +99,12 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
 // piece's refusal, where the bound above let a piece through that the kernel killed at 22.2 GB
 // (estimated 22.2 M cells, 10.2 GB): the most measured on meshes of at least 4 M estimated
 // cells, rounded up, a calibration on three runs of the scenes' ratio of contact to surface edge
-// (1/3-1/4): 1073 on a = 5, N = 500 at 0.15 d in one piece, 1033 and 1027 on the middle piece of
-// 12 of a = 14, N = 1e4 at 0.2 and 0.15 d (gmsh's HXT peaks at some 740 bytes per tetrahedron
-// there, 1.23 times the estimated cells). With a contact edge a tenth of the surface edge the
-// runs took 464-569 per estimated cell, so a refusal there may stop a piece that would fit
-// (docs/findings.md, 2026-12-01).
-inline constexpr double kGapsRefinedBytesPerCell = 1100.0;
+// (1/3-1/4): 1126 on a = 5, N = 500 at 0.15 d in one piece, 1057 and 1052 on the middle piece of
+// 12 of a = 14, N = 1e4 at 0.2 and 0.15 d (gmsh's HXT peaks at some 790 bytes per tetrahedron
+// there, 1.23 times the estimated cells); validated on its piece of 24 (1077). With a contact
+// edge a tenth of the surface edge runs took 490-600 per estimated cell, so a refusal there may
+// stop a piece that would fit (docs/findings.md, 2026-12-01).
+inline constexpr double kGapsRefinedBytesPerCell = 1150.0;
 
 // Piece `piece` (from 0) of `pieces` (piece_stage), estimated alone as `e` (from
 // meshing::slab_domain_size), with `ranks_here` ranks on this machine (OMPI_COMM_WORLD_LOCAL_SIZE,
