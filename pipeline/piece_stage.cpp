@@ -276,13 +276,21 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
                           slab.clip_bottom_d, slab.clip_top_d, said.failed_rank);
     }
     // Killed from outside, with no word of its own: on a machine short of memory, the kernel's
-    // out-of-memory killer, which the ranks' check (an estimate that errs low) did not foresee.
+    // out-of-memory killer, which the ranks' check (refuse_piece_beyond_memory) did not foresee.
     if (said.signal == 9)
       throw InputError(fmt::format(
           "mesh.pieces = {}: {} was killed by signal 9 ({}), most likely by the kernel for want of memory (each "
-          "rank checks its piece against its share of this machine's memory before it starts, by an estimate that "
-          "errs low); allowed: {}; see {}",
-          pieces, which, said.signal_name, pieces_memory_remedies("more pieces"), log.string()));
+          "rank checks its piece against its share of this machine's memory before it starts, by {}); allowed: "
+          "{}{}; see {}",
+          pieces, which, said.signal_name,
+          surface.cells_per_gap > 0.0 ? "the most bytes per estimated cell measured with the gaps refined"
+                                      : "an estimate that errs low",
+          pieces_memory_remedies("more pieces"),
+          surface.cells_per_gap > 0.0
+              ? fmt::format(", fewer surface.cells_per_gap (now {}) or a longer surface.contact_edge_length_d (now {})",
+                            surface.cells_per_gap, surface.contact_edge_length_d)
+              : std::string(),
+          log.string()));
     if (said.signal > 0)
       throw std::runtime_error(fmt::format("the case's pieces: {} stopped on signal {} ({}); see {}", which,
                                            said.signal, said.signal_name, log.string()));
