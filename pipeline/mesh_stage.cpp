@@ -193,7 +193,8 @@ MeshEstimate refuse_mesh_beyond_memory(const Scene& scene, const Bed& bed, doubl
       s.cells_per_gap, s.contact_edge_length_d, beyond_memory(e, available_bytes), s.cells_per_gap / std::sqrt(excess), s.contact_edge_length_d * excess, or_not_run(e)));
 }
 
-void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces, int ranks_here, double available_bytes) {
+void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces,
+                                int ranks_here, double available_bytes) {
   const double need = e.likely_mesh_peak_bytes;
   if (need <= available_bytes) return;
   const bool measured = e.gap_cells > 0.0;

@@ -112,10 +112,11 @@ inline constexpr double kGapsRefinedBytesPerCell = 1150.0;
 // are cut to about equal estimated cells) when e.likely_mesh_peak_bytes exceeds `available_bytes`,
 // this rank's share of the machine's memory (available_memory_bytes()): a refused piece costs its
 // user one more piece, a killed one its allocation. Where the narrow gaps hold most of the
-// cells, the message names `s`'s cells_per_gap and contact edge too. Without refined gaps it errs towards trying:
-// one rank with the whole default bed peaked at 4329 MB where its mesh stage took 3060 MB
-// (docs/mesh_case_benchmark.md, pieces).
-void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces, int ranks_here, double available_bytes);
+// cells, the message names `s`'s cells_per_gap and contact edge too. Without refined gaps it
+// errs towards trying: one rank with the whole default bed peaked at 4329 MB where its mesh
+// stage took 3060 MB (docs/mesh_case_benchmark.md, pieces).
+void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces,
+                                int ranks_here, double available_bytes);
 
 // What a user may change when the pieces' ranks lack memory, for the "allowed:" of a message;
 // `more_pieces` says how many pieces (e.g. "mesh.pieces >= 6").
