@@ -34,6 +34,7 @@ toml::table load_table(const std::string& scene_file) {
   return parse_scene_text(read_file(scene_file), scene_file);
 }
 
+#ifdef BEDFORGE_HAVE_VOLUME_MESH  // only `piece` has such options
 // A number option's check that says what is allowed (CLI11's own range checks print the whole
 // range of a double): "--wall-gap-m: -1; allowed: a number > 0 (m)".
 CLI::Validator allowed_number(bool (*ok)(double), const std::string& what) {
@@ -46,6 +47,7 @@ CLI::Validator allowed_number(bool (*ok)(double), const std::string& what) {
       },
       "");
 }
+#endif
 
 }  // namespace
 
