@@ -135,7 +135,7 @@ int run_command_line(int argc, char** argv) {
                         "pieces (default: at about equal cells by the mesh estimate)");
   piece_cmd->add_option("--wall-gap-m", wall_gap_m,
                         "number, m: the whole bed's narrowest gap at a curved wall, whose edge every piece rings its "
-                        "walls with (default: found by surveying the bed's contacts first)")
+                        "walls with, inf where none (default: found by surveying the bed's contacts first)")
       ->check(allowed_number([](double v) { return v > 0.0; }, "a number > 0 (m)"));
 #endif
 #ifdef BEDFORGE_HAVE_GMSH

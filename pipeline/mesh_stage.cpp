@@ -198,28 +198,33 @@ void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfacePar
   const double need = e.likely_mesh_peak_bytes;
   if (need <= available_bytes) return;
   const bool measured = e.gap_cells > 0.0;
-  const std::string how =
-      measured ? fmt::format("{:.0f} bytes per estimated cell, as measured with the gaps refined", kGapsRefinedBytesPerCell)
-               : "an estimate that errs low";
   throw InputError(fmt::format(
       "mesh.pieces = {}: piece {} would take {} {:.1f} GB to mesh ({:.3g} million cells, {}), and a rank may "
       "take {:.1f} GB here ({} rank{} on this machine sharing its memory); allowed: {}",
-      pieces, piece + 1, measured ? "about" : "at least", need / 1e9, e.cells / 1e6, how, available_bytes / 1e9, ranks_here,
-      ranks_here == 1 ? "" : "s",
+      pieces, piece + 1, measured ? "about" : "at least", need / 1e9, e.cells / 1e6, piece_memory_basis(measured),
+      available_bytes / 1e9, ranks_here, ranks_here == 1 ? "" : "s",
       pieces_memory_remedies(fmt::format("mesh.pieces >= {}", static_cast<int>(std::ceil(pieces * need / available_bytes)))) +
           // A longer edge hardly changes the cells across narrow gaps (8.95 M at 0.2 d, 8.98 M at
           // 0.15 d on the same piece), so say what does when they are most of the piece.
-          (e.gap_cells > 0.5 * e.cells ? fmt::format(" (the narrow gaps hold {:.0f} % of its cells: fewer "
-                                                      "surface.cells_per_gap, now {}, or a longer "
-                                                      "surface.contact_edge_length_d, now {})",
-                                                      100.0 * e.gap_cells / e.cells, s.cells_per_gap,
-                                                      s.contact_edge_length_d)
-                                       : std::string())));
+          (e.gap_cells > 0.5 * e.cells
+               ? fmt::format(" (the narrow gaps hold {:.0f} % of its cells: {})", 100.0 * e.gap_cells / e.cells, gaps_remedy(s))
+               : std::string())));
+}
+
+std::string piece_memory_basis(bool gaps_refined) {
+  return gaps_refined ? fmt::format("{:.0f} bytes per estimated cell, as measured with the gaps refined",
+                                    kGapsRefinedBytesPerCell)
+                      : "an estimate that errs low";
 }
 
 std::string pieces_memory_remedies(const std::string& more_pieces) {
   return more_pieces + " (with as many ranks, spread over machines), fewer ranks per machine, or a longer "
                        "surface.edge_length_d";
+}
+
+std::string gaps_remedy(const meshing::SurfaceParams& s) {
+  return fmt::format("fewer surface.cells_per_gap, now {}, or a longer surface.contact_edge_length_d, now {}",
+                     s.cells_per_gap, s.contact_edge_length_d);
 }
 
 }  // namespace bedforge::pipeline

@@ -118,8 +118,13 @@ inline constexpr double kGapsRefinedBytesPerCell = 1150.0;
 void refuse_piece_beyond_memory(const MeshEstimate& e, const meshing::SurfaceParams& s, int piece, int pieces,
                                 int ranks_here, double available_bytes);
 
+// How a piece's memory check sizes it, for a message: at kGapsRefinedBytesPerCell with the gaps
+// refined, else by the bound that errs low.
+std::string piece_memory_basis(bool gaps_refined);
 // What a user may change when the pieces' ranks lack memory, for the "allowed:" of a message;
 // `more_pieces` says how many pieces (e.g. "mesh.pieces >= 6").
 std::string pieces_memory_remedies(const std::string& more_pieces);
+// What makes fewer cells across the narrow gaps under `s`: its cells_per_gap and contact edge.
+std::string gaps_remedy(const meshing::SurfaceParams& s);
 
 }  // namespace bedforge::pipeline

@@ -243,7 +243,8 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   CasePieces out;
   out.count = pieces;
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
-  // The ranks are given `planes` (d) and the whole bed's wall gap (`wall_gap_m`, m), each try its log (`log_name`).
+  // The ranks are given `planes` (d) and the whole bed's wall gap (`wall_gap_m`, m), each try its
+  // log (`log_name`).
   const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir,
                                                                     const std::vector<double>& planes,
                                                                     double wall_gap_m, const std::string& log_name) {
@@ -255,7 +256,9 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
         "[ \"$(id -u)\" = 0 ] && export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; "
         "mpirun -np {} '{}' --quiet --no-progress piece '{}' --planes-d {}{} > '{}' 2>&1", pieces, self.string(),
         run_dir.string(), fmt::join(planes, " "),
-        std::isfinite(wall_gap_m) && wall_gap_m > 0.0 ? fmt::format(" --wall-gap-m {:.17g}", wall_gap_m) : "",
+        // Infinite (no curved wall, or no sphere near one) is given too, or each rank would survey
+        // the bed for it.
+        wall_gap_m > 0.0 ? fmt::format(" --wall-gap-m {:.17g}", wall_gap_m) : "",
         log.string());
     const int status = std::system(cmd.c_str());
     progress.finish();
@@ -282,15 +285,9 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
           "mesh.pieces = {}: {} was killed by signal 9 ({}), most likely by the kernel for want of memory (each "
           "rank checks its piece against its share of this machine's memory before it starts, by {}); allowed: "
           "{}{}; see {}",
-          pieces, which, said.signal_name,
-          surface.cells_per_gap > 0.0 ? "the most bytes per estimated cell measured with the gaps refined"
-                                      : "an estimate that errs low",
+          pieces, which, said.signal_name, piece_memory_basis(surface.cells_per_gap > 0.0),
           pieces_memory_remedies("more pieces"),
-          surface.cells_per_gap > 0.0
-              ? fmt::format(", fewer surface.cells_per_gap (now {}) or a longer surface.contact_edge_length_d (now {})",
-                            surface.cells_per_gap, surface.contact_edge_length_d)
-              : std::string(),
-          log.string()));
+          surface.cells_per_gap > 0.0 ? "; " + gaps_remedy(surface) : std::string(), log.string()));
     if (said.signal > 0)
       throw std::runtime_error(fmt::format("the case's pieces: {} stopped on signal {} ({}); see {}", which,
                                            said.signal, said.signal_name, log.string()));

@@ -62,10 +62,12 @@ RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 // one (std::runtime_error otherwise), naming the piece that stopped first and its heights; a rank
 // killed by signal 9 as InputError naming mesh.pieces (the kernel's out-of-memory killer, most
 // likely). The ranks are given the planes (`piece --planes-d`) as piece_directory would make
-// them, and the whole bed's wall gap (`--wall-gap-m`), so that each treats only its window. When a rank's piece cannot be cut (meshing::SlabCutError, known by its message) or fails
-// the gate, the ranks run once more with the planes moved (meshing::attempt_with_planes_moved;
-// their output in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files (case/piece_layers) are removed once all
-// have succeeded; a failed run leaves them for the next, which remakes only the failed pieces.
+// them, and the whole bed's wall gap (`--wall-gap-m`), so that each treats only its window. When
+// a rank's piece cannot be cut (meshing::SlabCutError, known by its message) or fails the gate,
+// the ranks run once more with the planes moved (meshing::attempt_with_planes_moved; their output
+// in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files
+// (case/piece_layers) are removed once all have succeeded; a failed run leaves them for the
+// next, which remakes only the failed pieces.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
 // need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
