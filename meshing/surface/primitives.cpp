@@ -243,7 +243,9 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
       pts.add(p, std::min(cuts[k].spacing, h));
       owner.push_back(static_cast<int>(k));
     }
-  // 2. Rings graded from each loop's spacing to h.
+  // 2. The field's seeds, then rings graded from each loop's spacing to h.
+  for (const auto& [p, s] : field.seeds_finest_first())
+    if (!is_removed(p) && pts.fits(p, s)) pts.add(p, s), owner.push_back(-1);
   std::vector<double> spacing;
   for (const auto& cut : cuts) spacing.push_back(cut.spacing);
   auto wanted = [&](const Eigen::Vector3d& p, double s) { return field ? std::min(s, field.at(p)) : s; };

@@ -68,14 +68,14 @@ struct CutConflict : std::runtime_error {
 };
 
 // Sphere (centre c, radius r) minus its cuts, open along every cut's loop. Vertices: the loops,
-// rings graded away from each loop (spacing growing by `growth` per ring up to `edge`), and a
-// spherical Fibonacci lattice of spacing `edge` elsewhere, thinned so no two lie closer than
-// 0.8 x their mean spacing; the triangles are their convex hull (the Delaunay triangulation on
-// the sphere) less the faces spanning a loop; a loop vertex off the sphere (moved onto a wall
-// ring, snap_holes_to_rings) is taken into the hull moved radially onto it and kept where it
-// is in the mesh. At least 48 vertices. With a `field`, no vertex
-// is spaced wider than it asks: where it asks for less than `edge`, candidates come from a
-// lattice of spacing field.finest, those asking for the least first.
+// the field's seeds (those on the kept side), rings graded away from each loop (spacing growing by
+// `growth` per ring up to `edge`), and a spherical Fibonacci lattice of spacing `edge` elsewhere,
+// thinned so no two lie closer than 0.8 x their mean spacing; the triangles are their convex hull
+// (the Delaunay triangulation on the sphere) less the faces spanning a loop; a loop vertex off the
+// sphere (moved onto a wall ring, snap_holes_to_rings) is taken into the hull moved radially onto
+// it and kept where it is in the mesh. At least 48 vertices. With a `field`, no vertex is spaced
+// wider than it asks: where it asks for less than `edge`, candidates come from a lattice of
+// spacing field.finest, those asking for the least first.
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
                          double growth, bool outward, const std::string& patch, const SpacingField& field = {});
 

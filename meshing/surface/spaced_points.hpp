@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace bedforge::meshing {
@@ -70,6 +71,15 @@ class SpacedPoints {
 struct SpacingField {
   std::function<double(const Eigen::Vector3d&)> at;
   double finest = 0.0;
+  // Vertices with their spacing (m) that sphere_mesh and plane_mesh offer before their other free
+  // sites, finest first (so where two patches overlap the finer is kept), with `at` or without:
+  // a patch finer than `finest` (end_wedges.hpp).
+  std::vector<std::pair<Eigen::Vector3d, double>> seeds{};
+  std::vector<std::pair<Eigen::Vector3d, double>> seeds_finest_first() const {
+    std::vector<std::pair<Eigen::Vector3d, double>> out = seeds;
+    std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    return out;
+  }
   explicit operator bool() const { return static_cast<bool>(at); }
 };
 

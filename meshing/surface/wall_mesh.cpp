@@ -465,7 +465,8 @@ WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3
     if (!in_region(q) || hole_index.contains(q) || !spaced.fits(s, spacing)) return;
     add_vertex(f.to_world(s), q, spacing);
   };
-  // 2. Rings graded away from the holes.
+  // 2. The field's seeds, then rings graded away from the holes.
+  for (const auto& [p, s] : field.seeds_finest_first()) try_add(local(p), s);
   std::vector<double> spacing;
   for (const auto& hole : holes) spacing.push_back(hole.spacing);
   graded_rings(spacing, edge, growth, [&](std::size_t h, int ring, double offset, double next) {

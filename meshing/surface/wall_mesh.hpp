@@ -74,15 +74,15 @@ WallMesh wall_mesh(double R, double z0, double z1, double edge, const std::vecto
                    bool outward, const std::string& patch, const SpacingField& field = {},
                    const std::vector<double>& rings = {}, const std::vector<int>& row_parts = {});
 
-// Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside
-// the others (an annulus's inner circle), less the holes. Boundary loops are vertices on the
-// plane shared with the faces next to this one, and constraints; hole loops are shared with the
-// parts that meet the face. Vertices as in wall_mesh: the loops, rings graded away from the
-// holes, a staggered lattice of spacing about `edge`, none closer than 0.8 x the mean spacing
-// to another or to a boundary edge; then a constrained Delaunay triangulation (no vertex is
-// added). Normals +w if `along_w`. CutConflict when a hole vertex lies outside the face. A
-// hole may come as close to the boundary as its own loop's chords allow (a sphere 0.005 d off
-// the wall): the triangles in that gap are as narrow as the gap.
+// Flat face in the plane z = 0 of frame `f`: inside the first of `boundary`'s loops, outside the
+// others (an annulus's inner circle), less the holes. Boundary loops are vertices on the plane
+// shared with the faces next to this one, and constraints; hole loops are shared with the parts
+// that meet the face. Vertices as in wall_mesh: the loops, the field's seeds (those in the face),
+// rings graded away from the holes, a staggered lattice of spacing about `edge`, none closer than
+// 0.8 x the mean spacing to another or to a boundary edge; then a constrained Delaunay
+// triangulation (no vertex is added). Normals +w if `along_w`. CutConflict when a hole vertex lies
+// outside the face. A hole may come as close to the boundary as its own loop's chords allow (a
+// sphere 0.005 d off the wall): the triangles in that gap are as narrow as the gap.
 WallMesh plane_mesh(const Frame& f, const std::vector<std::vector<Eigen::Vector3d>>& boundary, double edge,
                     const std::vector<WallHole>& holes, double growth, bool along_w, const std::string& patch,
                     const SpacingField& field = {});
