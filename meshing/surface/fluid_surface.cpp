@@ -318,11 +318,22 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
         for (Eigen::Vector3d& q : cut.loop) follow(q);
   }
 
-  // Edges shortened where the surface faces another across a narrow gap.
+  // Edges shortened where the surface faces another across a narrow gap, and graded about the
+  // spheres' ends near the planes it is cut at (its rings) or ends at (a clip window's, a
+  // periodic section's).
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
+  std::vector<double> cut_heights = rings;
+  if (p.clip || laid.periodic()) cut_heights.insert(cut_heights.end(), {z0, z1});
+  std::vector<EndNearPlane> ends = ends_near_planes(bed.centres, tb.radius, cut_heights, edge);
+  std::vector<std::vector<const EndNearPlane*>> ends_of(bed.size());
+  for (const EndNearPlane& e : ends) ends_of[e.sphere].push_back(&e);
   auto field = [&](int self) {
-    return gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
-                : SpacingField{};
+    SpacingField f = gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
+                          : SpacingField{};
+    if (self >= 0)
+      for (const EndNearPlane* e : ends_of[self])
+        for (const auto& seed : sphere_end_seeds(*e, edge)) f.seeds.push_back(seed);
+    return f;
   };
 
   // Spheres, each on its own (in parallel), stopping at their cuts: meshed on other threads
@@ -427,8 +438,18 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       add(patch, Shape::plane, 0.0, [&] { return moved_up(inlet, z1, patch); });
       continue;
     }
+    // Graded about the ends near it; a periodic section's inlet also about those near its outlet,
+    // which is the inlet moved up a period.
+    std::vector<EndNearPlane> at = ends_at(ends, z, edge);
+    if (laid.periodic())
+      for (EndNearPlane e : ends_at(ends, z1, edge)) {
+        e.plane_z = z0, e.centre.z() -= z1 - z0;
+        at.push_back(e);
+      }
+    SpacingField seeded;
+    seeded.seeds = plane_end_seeds(at, edge);
     add(patch, Shape::plane, 0.0, [&] {
-      WallMesh m = plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch);
+      WallMesh m = plane_mesh(frame, end_boundary(frame, z), edge, *holes, p.growth, up, patch, seeded);
       if (laid.periodic()) inlet = m;
       return m;
     });
@@ -476,6 +497,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   out.report["parameters"] = to_json(p);
   out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
   out.exact_volume_m3 = domain - tb.solid_volume;
+  out.ends_near_planes = ends;
   out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
   out.report["void_fraction_bed_section_change"] =
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);

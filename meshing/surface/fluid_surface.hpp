@@ -6,6 +6,7 @@
 
 #include "core/bed.hpp"
 #include "core/scene_section.hpp"
+#include "meshing/surface/end_wedges.hpp"
 #include "meshing/surface/gap_spacing.hpp"
 #include "meshing/surface/surface_checks.hpp"
 #include "meshing/surface/triangle_mesh.hpp"
@@ -128,6 +129,10 @@ struct FluidSurface {
   double exact_volume_m3 = 0.0;  // of the treated geometry's fluid domain, what the facets approximate
   std::vector<SurfacePiece> pieces;  // of `fluid`, each meshed on its own: walls, inlet, outlet, spheres, parts
   SurfaceCheck check;            // CGAL's verdict on `fluid` (build_checked_fluid_surface only)
+  // Spheres' ends near the planes the surface is to be cut at (SurfaceParams::wall_rings_d) or
+  // ends at (a clip window's, a periodic section's), which the spheres grade their vertices
+  // about and a cut's face must too (PlaneCutParams::ends).
+  std::vector<EndNearPlane> ends_near_planes;
   nlohmann::json report;
 };
 

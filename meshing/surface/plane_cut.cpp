@@ -169,7 +169,8 @@ nlohmann::json to_json(const PlaneCut& c) {
           {"plane_triangles", c.plane_triangles},
           {"edges_flipped", c.edges_flipped},
           {"edges_split", c.edges_split},
-          {"left_to_recover", c.left_to_recover}};
+          {"left_to_recover", c.left_to_recover},
+          {"ends_graded", c.ends_graded}};
 }
 
 PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
@@ -491,6 +492,9 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
              },
              p.finest};
   }
+  const std::vector<EndNearPlane> ends = ends_at(p.ends, z, p.edge);
+  field.seeds = plane_end_seeds(ends, p.edge);
+  out.ends_graded = static_cast<long>(ends.size());
   TriangleMesh face;
   for (std::size_t o = 0; o < outer.size(); ++o)
     face.append(plane_mesh(Frame::along({0.0, 0.0, z}, Eigen::Vector3d::UnitZ()), {outer[o].points}, p.edge, holes[o],

@@ -1,6 +1,7 @@
 #pragma once
 #include <string>
 
+#include "meshing/surface/end_wedges.hpp"
 #include "meshing/surface/fluid_surface.hpp"
 #include "meshing/surface/triangle_mesh.hpp"
 
@@ -23,6 +24,9 @@ struct PlaneCutParams {
   // Flip and split the triangles near the plane towards Delaunay (see cut_by_plane); off, the
   // cut is left as snapped and split (to measure what they do).
   bool delaunay_flips = true;
+  // Spheres' ends near the plane that it does not cut (FluidSurface::ends_near_planes, of any
+  // plane: the cut takes those at its own height): the face gets plane_end_seeds about each.
+  std::vector<EndNearPlane> ends{};
 };
 
 struct PlaneCut {
@@ -35,6 +39,7 @@ struct PlaneCut {
   long edges_flipped = 0;     // near the plane, towards Delaunay (see cut_by_plane)
   long edges_split = 0;       // near the plane, where the flips left triangles gmsh would recover
   long left_to_recover = 0;   // such triangles left where the splits could not take all away (both parts)
+  long ends_graded = 0;       // spheres' ends near the plane that the face is graded about (PlaneCutParams::ends)
 };
 
 // `surface` (closed, welded, normals out of the region it bounds; m) cut by the plane z = `z`
@@ -56,7 +61,8 @@ struct PlaneCut {
 // region's section by the plane is one face or more (bridged spheres and the wall can ring in a
 // pocket of fluid there), each an outer loop (clockwise seen from above on the part below) less
 // the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with
-// `p`'s edge and growth, shorter across narrow gaps (PlaneCutParams::cells_per_gap: the gap at
+// `p`'s edge and growth, graded about the ends of spheres near the plane (PlaneCutParams::ends),
+// shorter across narrow gaps (PlaneCutParams::cells_per_gap: the gap at
 // a point of the face is its distance to the nearest loop point plus that to the nearest loop
 // point ahead of it, within 60 degrees of the direction away from the first, so two sides of
 // one loop (spheres joined by a bridge the plane cuts) count as a gap too), normals +z on the

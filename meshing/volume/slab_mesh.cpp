@@ -403,7 +403,9 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     for (const auto& [j, keep_above] : {std::pair{k - 1, true}, std::pair{k, false}}) {
       if (j < 0 || j + 1 >= slabs) continue;
       try {
-        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), plane_cut_params(surface, d));
+        PlaneCutParams cut_params = plane_cut_params(surface, d);
+        cut_params.ends = fs.ends_near_planes;
+        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), cut_params);
         cut_report.push_back(cut_json(c, planes[j]));
         fs.fluid = std::move(keep_above ? c.above : c.below);
       } catch (const CutConflict& e) {

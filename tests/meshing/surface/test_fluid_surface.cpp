@@ -691,9 +691,11 @@ TEST(FluidSurface, CellsPerGapShortensTheEdgesFacingANarrowGap) {
   EXPECT_LE(longest_edge_near(boxed.fluid, "particles", {1.5, 0.0, 0.6}), 1.6 * 0.05);
 }
 
-// The triangles of a periodic section's inlet and outlet: each at its plane, and the outlet's
-// the inlet's one period up, bit for bit in x and y (each triangle's x and y, sorted).
-void expect_matching_planes(const FluidSurface& fs, const std::string& label) {
+// The triangles of a periodic section's inlet and outlet: each at its plane (within
+// `height_tolerance`, m: the points are rounded as the ASCII STL keeps them, the planes' heights
+// in the report are not), and the outlet's the inlet's one period up, bit for bit in x and y
+// (each triangle's x and y, sorted).
+void expect_matching_planes(const FluidSurface& fs, const std::string& label, double height_tolerance = 0.0) {
   const double z0 = fs.report["domain_m"]["inlet_z"].get<double>(), z1 = fs.report["domain_m"]["outlet_z"].get<double>();
   std::array<std::vector<std::array<double, 6>>, 2> planes;
   for (std::size_t k = 0; k < fs.fluid.triangles.size(); ++k) {
@@ -702,7 +704,7 @@ void expect_matching_planes(const FluidSurface& fs, const std::string& label) {
     std::array<std::pair<double, double>, 3> q;
     for (int j = 0; j < 3; ++j) {
       const Eigen::Vector3d& x = fs.fluid.points[fs.fluid.triangles[k][j]];
-      EXPECT_EQ(x.z(), patch == "inlet" ? z0 : z1) << label;
+      EXPECT_NEAR(x.z(), patch == "inlet" ? z0 : z1, height_tolerance) << label;
       q[j] = {x.x(), x.y()};
     }
     std::sort(q.begin(), q.end());
@@ -733,6 +735,46 @@ TEST(FluidSurface, APeriodicSectionHasMatchingPlanes) {
     expect_matching_planes(fs, treatment_name(t));
     EXPECT_GT(fs.report["periodic_planes_m"]["clearance_d"].get<double>(), p.clip_clearance_d);
   }
+}
+
+// A periodic section whose planes pass near spheres' ends (19 columns of two spheres in a tube
+// of a = 6, period 2.3 d, at heights that leave no interval between ends wider than 0.09 d):
+// its inlet is graded about the point under each end near it and about the point under each
+// end near the outlet, which is the inlet moved up a period, so that the outlet is graded too
+// and still the inlet's copy.
+TEST(FluidSurface, APeriodicSectionsPlanesAreGradedAboutTheEndsNearEither) {
+  auto tube = std::make_shared<Cylinder>(3.0);
+  tube->set_axial_period(2.3);
+  std::vector<Eigen::Vector3d> centres;
+  int k = 0;
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j) {
+      const Eigen::Vector2d xy(1.1 * (i + 0.5 * (j % 2)), 1.1 * std::sqrt(3.0) / 2.0 * j);
+      if (xy.norm() > 2.4) continue;
+      const double z = 0.1 + std::fmod(0.618034 * k++, 1.0);
+      centres.emplace_back(xy.x(), xy.y(), z);
+      centres.emplace_back(xy.x(), xy.y(), z + 1.05);
+    }
+  const Bed b = column(tube, centres);
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::none;
+  p.edge_length_d = 0.45;
+  const FluidSurface fs = valid_surface(b, p, "periodic, ends near its planes");
+  expect_matching_planes(fs, "periodic, ends near its planes", 1e-9);
+  const double z0 = fs.report["domain_m"]["inlet_z"].get<double>(), z1 = fs.report["domain_m"]["outlet_z"].get<double>();
+  int near_outlet = 0, near_inlet = 0;
+  for (const EndNearPlane& e : fs.ends_near_planes) {
+    if (e.gap() > 0.05) continue;
+    SCOPED_TRACE(e.gap());
+    // Graded: the triangles nearest the point under the end no longer than twice the rings'
+    // spacing 0.015 d from the axis (without the grading, the surface's 0.45 d).
+    const double graded = 2.0 * kWedgeEdgePerGap * (e.gap() + 0.015 * 0.015);
+    for (const auto& [patch, z] : {std::pair{"inlet", z0}, std::pair{"outlet", z1}})
+      EXPECT_LT(longest_edge_near(fs.fluid, patch, {e.centre.x(), e.centre.y(), z}), graded) << patch;
+    ++(e.plane_z == z1 ? near_outlet : near_inlet);
+  }
+  EXPECT_GE(near_outlet, 1);
+  EXPECT_GE(near_inlet, 1);
 }
 
 // A periodic section's wall rows at its planes are as fine as the gap beside them: three spheres

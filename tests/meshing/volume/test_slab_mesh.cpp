@@ -532,3 +532,66 @@ TEST(SlabMesh, BridgedPiecesMeshedAloneTriangulateTheirSharedPlanesAlike) {
   const double exact = check_surface(whole.fluid, SelfIntersectionTest::skip).volume;
   EXPECT_NEAR(volume, exact, 1e-3 * exact);
 }
+
+// A piece's plane passing just under a sphere's end that it does not cut (0.0023 d, as one of
+// issue 58's 24 pieces of a = 14, N = 1e4 did, where 5 cells failed the gate): both the sphere
+// and the plane's face are graded about the end (end_wedges.hpp), so that no cell across the
+// wedge between them is flat, and the piece passes the gate.
+TEST(SlabMesh, APlaneJustUnderASpheresEndIsGradedOnBothSidesAndItsPiecePassesTheGate) {
+  const Bed b = test_support::packed_bed(60, 4.0, 1);
+  SurfaceParams sp;
+  sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::bridge;
+  sp.edge_length_d = 0.2;
+  sp.contact_edge_length_d = 0.05;
+  sp.cells_per_gap = 4.0;
+  // The sphere in the bed's middle third whose bottom lies farthest from every other sphere's end.
+  const double top = bed_height(b);
+  int chosen = -1;
+  double clearance = 0.0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const double end = b.centres[i].z() - 0.5;
+    if (end < top / 3.0 || end > 2.0 * top / 3.0) continue;
+    double nearest = HUGE_VAL;
+    for (std::size_t j = 0; j < b.size(); ++j)
+      if (j != i)
+        for (double other : {b.centres[j].z() - 0.5, b.centres[j].z() + 0.5}) nearest = std::min(nearest, std::abs(other - end));
+    if (nearest > clearance) clearance = nearest, chosen = static_cast<int>(i);
+  }
+  ASSERT_GE(chosen, 0);
+  ASSERT_GT(clearance, 0.02);
+  const double gap = 0.0023;
+  const Eigen::Vector3d end = b.centres[chosen] - Eigen::Vector3d(0.0, 0.0, 0.5);
+  const std::vector<double> planes{end.z() - gap};
+  VolumeMeshParams p;
+  const fs::path dir = test_support::fresh_dir("plane_under_an_end", true);
+  const VolumeMesh piece = mesh_slab(b, sp, planes, 1, 1.0, p, dir / "bad_cells.vtk", false);
+  EXPECT_TRUE(piece.quality.bad_cells(p.gate, 1.0).empty());
+  ASSERT_EQ(piece.report["plane_cut"].size(), 1u);
+  EXPECT_GE(piece.report["plane_cut"][0]["ends_graded"].get<long>(), 1);
+  // The longest edge of the faces of `patch` with a corner within 0.01 d of `at` (on the sphere
+  // about its end, on the plane about the point under it): graded to twice the gap there, not
+  // the surface's 0.2 d.
+  auto longest_edge_near = [&](const std::string& patch, const Eigen::Vector3d& at) {
+    double longest = 0.0;
+    const PolyMesh& g = piece.mesh;
+    for (const auto& q : g.patches)
+      if (q.name == patch)
+        for (int f = q.start; f < q.start + q.size; ++f) {
+          const auto& face = g.faces[f];
+          bool near = false;
+          for (int v : face) near = near || (g.points[v] - at).norm() < 0.01;
+          if (near)
+            for (int k = 0; k < face.size(); ++k)
+              longest = std::max(longest, (g.points[face[k]] - g.points[face[(k + 1) % face.size()]]).norm());
+        }
+    return longest;
+  };
+  const double on_sphere = longest_edge_near("particles", end);
+  const double on_plane = longest_edge_near("inlet", Eigen::Vector3d(end.x(), end.y(), planes[0]));
+  EXPECT_GT(on_sphere, 0.0);
+  EXPECT_GT(on_plane, 0.0);
+  // Rings within 0.015 d of the axis: the gap under them at most 0.0023 + 0.015^2 / (2 x 0.5).
+  const double graded = 2.0 * kWedgeEdgePerGap * (gap + 0.015 * 0.015);
+  EXPECT_LT(on_sphere, graded);
+  EXPECT_LT(on_plane, graded);
+}
