@@ -19,7 +19,7 @@ std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& c
     for (std::size_t i = 0; i < centres.size(); ++i)
       for (bool above : {true, false}) {
         const EndNearPlane e{z, centres[i], radii[i], above, static_cast<int>(i)};
-        if (e.gap() > 0.0 && e.gap() < reach) out.push_back(e);
+        if (e.gap() != 0.0 && std::abs(e.gap()) < reach) out.push_back(e);
       }
   std::sort(out.begin(), out.end(), [](const EndNearPlane& a, const EndNearPlane& b) {
     return std::tuple(a.plane_z, a.centre.x(), a.centre.y(), a.above) <
@@ -30,9 +30,10 @@ std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& c
 
 std::vector<std::pair<double, double>> end_rings(const EndNearPlane& e, double coarse) {
   const double r = e.radius, gap = e.gap();
-  // The gap between the plane and the sphere at distance rho from the end's axis.
-  auto gap_at = [&](double rho) { return gap + r - std::sqrt(std::max(0.0, r * r - rho * rho)); };
-  std::vector<std::pair<double, double>> rings{{0.0, kWedgeEdgePerGap * gap}};
+  // The gap between the plane and the sphere at distance rho from the end's axis; inside the loop
+  // of a plane that cuts the sphere, and near it, the cut's depth.
+  auto gap_at = [&](double rho) { return std::max(std::abs(gap), gap + r - std::sqrt(std::max(0.0, r * r - rho * rho))); };
+  std::vector<std::pair<double, double>> rings{{0.0, kWedgeEdgePerGap * std::abs(gap)}};
   for (;;) {
     const auto [rho, spacing] = rings.back();
     const double next = rho + std::sqrt(3.0) / 2.0 * spacing;

@@ -13,14 +13,18 @@ namespace bedforge::meshing {
 // at 85 deg; docs/findings.md, 2026-12-02). So both sides get vertices graded with the gap: rings
 // about the end on the sphere and about the point below (or above) it on the plane, each ring's
 // spacing kWedgeEdgePerGap times the gap at its distance from the end's axis, until that reaches
-// the coarse edge.
+// the coarse edge. A plane that cuts a sphere just inside its end meets it at a small angle in a
+// small loop, which the sphere's coarse facets cut into a few chords (a = 4, N = 120: 2 of 12
+// pieces failed 0.0023 d inside an end, docs/findings.md, 2026-12-02): graded alike, the cut's
+// depth standing for the gap where the sphere is on the plane's far side.
 
 // 2: tetrahedra no flatter than about 2 : 1 across the wedge. Not tuned: the one value tried,
 // with which every wedge of the a = 4 bed above passed (docs/findings.md, 2026-12-02).
 inline constexpr double kWedgeEdgePerGap = 2.0;
 
 // A sphere's end near a plane (m). The end is centre.z - radius above the plane when `above`
-// (the sphere lies above it), else centre.z + radius below it.
+// (the sphere lies above it), else centre.z + radius below it; a gap below 0 is the depth by which
+// the plane cuts the sphere inside that end.
 struct EndNearPlane {
   double plane_z = 0.0;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -31,8 +35,9 @@ struct EndNearPlane {
   Eigen::Vector3d end() const { return centre + Eigen::Vector3d(0.0, 0.0, above ? -radius : radius); }
 };
 
-// The ends of the spheres (`centres`, `radii`: N each, m) that lie more than 0 and less than
-// coarse / kWedgeEdgePerGap from one of the planes z = `planes_z` (m), every sphere given (both
+// The ends of the spheres (`centres`, `radii`: N each, m) that lie less than coarse /
+// kWedgeEdgePerGap from one of the planes z = `planes_z` (m), on either side (not on it; a sphere
+// the plane cuts through its middle has no end near it), every sphere given (both
 // windows of a plane hold the spheres near it, kept or not, so both find the same ends), sorted by
 // plane, then x, then y, so that both windows offer them in one order.
 std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& centres,
@@ -41,7 +46,8 @@ std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& c
 
 // The graded rings about an end: (distance from its axis, spacing) in m, the first (0, its own
 // spacing) the end itself; each next ring sqrt(3)/2 of a spacing further out, until the spacing
-// kWedgeEdgePerGap x gap there would reach `coarse` (not included) or the ring the sphere's equator.
+// kWedgeEdgePerGap x the gap there (where the plane cuts the sphere, not less than the cut's
+// depth) would reach `coarse` (not included) or the ring the sphere's equator.
 std::vector<std::pair<double, double>> end_rings(const EndNearPlane& e, double coarse);
 
 // Vertices with their spacing (m), offered to a mesher before its other free sites

@@ -322,9 +322,12 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // spheres' ends near the planes it is cut at (its rings) or ends at (a clip window's, a
   // periodic section's).
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
-  std::vector<double> cut_heights = rings;
-  if (p.clip || laid.periodic()) cut_heights.insert(cut_heights.end(), {z0, z1});
-  std::vector<EndNearPlane> ends = ends_near_planes(bed.centres, tb.radius, cut_heights, edge);
+  // At the planes it ends at, sphere_mesh cuts the spheres along loops of their own spacing,
+  // which seeds finer than it beside them would break: there only the ends not cut are graded.
+  std::vector<EndNearPlane> ends = ends_near_planes(bed.centres, tb.radius, rings, edge);
+  if (p.clip || laid.periodic())
+    for (const EndNearPlane& e : ends_near_planes(bed.centres, tb.radius, {z0, z1}, edge))
+      if (e.gap() > 0.0) ends.push_back(e);
   std::vector<std::vector<const EndNearPlane*>> ends_of(bed.size());
   for (const EndNearPlane& e : ends) ends_of[e.sphere].push_back(&e);
   auto field = [&](int self) {

@@ -130,8 +130,8 @@ struct FluidSurface {
   std::vector<SurfacePiece> pieces;  // of `fluid`, each meshed on its own: walls, inlet, outlet, spheres, parts
   SurfaceCheck check;            // CGAL's verdict on `fluid` (build_checked_fluid_surface only)
   // Spheres' ends near the planes the surface is to be cut at (SurfaceParams::wall_rings_d) or
-  // ends at (a clip window's, a periodic section's), which the spheres grade their vertices
-  // about and a cut's face must too (PlaneCutParams::ends).
+  // ends at (a clip window's, a periodic section's; there only ends the plane does not cut), which
+  // the spheres grade their vertices about and a cut's face must too (PlaneCutParams::ends).
   std::vector<EndNearPlane> ends_near_planes;
   nlohmann::json report;
 };

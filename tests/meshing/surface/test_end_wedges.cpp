@@ -14,27 +14,31 @@ using namespace bedforge::meshing;
 namespace {
 
 // The gap between the plane and a sphere of radius r whose end lies `gap` from it, at distance
-// rho from the end's axis.
-double gap_at(double gap, double r, double rho) { return gap + r - std::sqrt(r * r - rho * rho); }
+// rho from the end's axis; where the plane cuts the sphere (gap < 0), not less than the cut's depth.
+double gap_at(double gap, double r, double rho) { return std::max(std::abs(gap), gap + r - std::sqrt(r * r - rho * rho)); }
 
 }  // namespace
 
 TEST(EndWedges, EndsWithinTheReachOfAPlaneAreFoundOnBothSidesAndInOneOrderWhateverTheSpheresOrder) {
   // Unit spheres about the plane z = 0; coarse 0.2, so ends within 0.1 of it count.
   std::vector<Eigen::Vector3d> centres{{0.0, 0.0, 0.503},  {1.2, 0.0, -0.55},   // above by 0.003, below by 0.05
-                                       {0.0, 1.2, 0.7},    {1.2, 1.2, 0.3},     // 0.2 off; cut by the plane
-                                       {-1.2, 0.0, -0.59}, {2.4, 0.0, 0.5}};    // 0.09 below; touching it
+                                       {0.0, 1.2, 0.7},    {1.2, 1.2, 0.3},     // 0.2 off; cut 0.2 inside its end
+                                       {-1.2, 0.0, -0.59}, {2.4, 0.0, 0.5},     // 0.09 below; touching it
+                                       {-1.2, 1.2, 0.47}};                      // cut 0.03 inside its bottom
   const std::vector<double> radii(centres.size(), 0.5);
   const auto ends = ends_near_planes(centres, radii, {0.0}, 0.2);
-  ASSERT_EQ(ends.size(), 3u);
+  ASSERT_EQ(ends.size(), 4u);
   EXPECT_EQ(ends[0].sphere, 4);
   EXPECT_FALSE(ends[0].above);
   EXPECT_NEAR(ends[0].gap(), 0.09, 1e-12);
-  EXPECT_EQ(ends[1].sphere, 0);
+  EXPECT_EQ(ends[1].sphere, 6);
   EXPECT_TRUE(ends[1].above);
-  EXPECT_NEAR(ends[1].gap(), 0.003, 1e-12);
-  EXPECT_EQ(ends[2].sphere, 1);
-  EXPECT_NEAR(ends[2].gap(), 0.05, 1e-12);
+  EXPECT_NEAR(ends[1].gap(), -0.03, 1e-12);
+  EXPECT_EQ(ends[2].sphere, 0);
+  EXPECT_TRUE(ends[2].above);
+  EXPECT_NEAR(ends[2].gap(), 0.003, 1e-12);
+  EXPECT_EQ(ends[3].sphere, 1);
+  EXPECT_NEAR(ends[3].gap(), 0.05, 1e-12);
 
   // The windows of a plane hold its spheres in other orders: the ends come out alike.
   std::vector<std::size_t> order(centres.size());
@@ -49,7 +53,8 @@ TEST(EndWedges, EndsWithinTheReachOfAPlaneAreFoundOnBothSidesAndInOneOrderWhatev
 }
 
 TEST(EndWedges, RingsAreSpacedAtTwiceTheGapUnderThemUpToTheCoarseEdge) {
-  for (double gap : {1e-4, 0.0023, 0.03}) {
+  // A gap below 0: the plane cuts the sphere that deep inside its end.
+  for (double gap : {1e-4, 0.0023, 0.03, -0.0023, -0.03}) {
     SCOPED_TRACE(gap);
     const EndNearPlane e{0.0, {0.0, 0.0, 0.5 + gap}, 0.5, true, 0};
     const double coarse = 0.2;
@@ -64,9 +69,11 @@ TEST(EndWedges, RingsAreSpacedAtTwiceTheGapUnderThemUpToTheCoarseEdge) {
         EXPECT_NEAR(rho - rings[k - 1].first, std::sqrt(3.0) / 2.0 * rings[k - 1].second, 1e-12);
       }
     }
-    // The rings stop where the next would be as coarse as the edge around them.
+    // The rings stop where the next would be as coarse as the edge around them, or past the
+    // sphere's equator.
     const auto [rho, spacing] = rings.back();
-    EXPECT_GE(kWedgeEdgePerGap * gap_at(gap, 0.5, rho + std::sqrt(3.0) / 2.0 * spacing), coarse);
+    const double next = rho + std::sqrt(3.0) / 2.0 * spacing;
+    EXPECT_TRUE(next >= 0.5 || kWedgeEdgePerGap * gap_at(gap, 0.5, next) >= coarse) << next;
   }
 }
 
