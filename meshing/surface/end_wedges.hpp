@@ -4,6 +4,8 @@
 #include <utility>
 #include <vector>
 
+#include "meshing/surface/spaced_points.hpp"
+
 namespace bedforge::meshing {
 
 // Where a plane the surface is cut or ends at (a piece's, a clip window's, a periodic section's)
@@ -54,7 +56,6 @@ std::vector<std::pair<double, double>> end_rings(const EndNearPlane& e, double c
 // (SpacingField::seeds): the rings on the sphere about its end, and on the plane about the point
 // facing it, each ring turned by half a step against the sphere's (so that no ring's vertex on
 // the plane lies right under one on the sphere).
-using Seeds = std::vector<std::pair<Eigen::Vector3d, double>>;
 Seeds sphere_end_seeds(const EndNearPlane& e, double coarse);
 Seeds plane_end_seeds(const EndNearPlane& e, double coarse);
 

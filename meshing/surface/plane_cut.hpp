@@ -24,8 +24,8 @@ struct PlaneCutParams {
   // Flip and split the triangles near the plane towards Delaunay (see cut_by_plane); off, the
   // cut is left as snapped and split (to measure what they do).
   bool delaunay_flips = true;
-  // Spheres' ends near the plane that it does not cut (FluidSurface::ends_near_planes, of any
-  // plane: the cut takes those at its own height): the face gets plane_end_seeds about each.
+  // Spheres' ends near the plane, passed by or cut just inside (FluidSurface::ends_near_planes, of
+  // any plane: the cut takes those at its own height): the face gets plane_end_seeds about each.
   std::vector<EndNearPlane> ends{};
 };
 

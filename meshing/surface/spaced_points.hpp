@@ -68,15 +68,18 @@ class SpacedPoints {
 // Edge length wanted at a point of a surface being meshed (m), between `finest` and the
 // mesher's own edge; empty: the mesher's edge everywhere. The meshers take candidate vertices
 // `finest` apart where the field asks for less than their edge, finest first.
+// Vertices with their spacing (m).
+using Seeds = std::vector<std::pair<Eigen::Vector3d, double>>;
+
 struct SpacingField {
   std::function<double(const Eigen::Vector3d&)> at;
   double finest = 0.0;
-  // Vertices with their spacing (m) that sphere_mesh and plane_mesh offer before their other free
-  // sites, finest first (so where two patches overlap the finer is kept), with `at` or without:
-  // a patch finer than `finest` (end_wedges.hpp).
-  std::vector<std::pair<Eigen::Vector3d, double>> seeds{};
-  std::vector<std::pair<Eigen::Vector3d, double>> seeds_finest_first() const {
-    std::vector<std::pair<Eigen::Vector3d, double>> out = seeds;
+  // Vertices that sphere_mesh and plane_mesh offer before their other free sites, finest first
+  // (so where two patches overlap the finer is kept), with `at` or without: a patch finer than
+  // `finest` (end_wedges.hpp).
+  Seeds seeds{};
+  Seeds seeds_finest_first() const {
+    Seeds out = seeds;
     std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
     return out;
   }

@@ -572,15 +572,14 @@ void expect_graded_piece_passing_the_gate(double gap) {
   EXPECT_TRUE(piece.quality.bad_cells(p.gate, 1.0).empty());
   ASSERT_EQ(piece.report["plane_cut"].size(), 1u);
   EXPECT_GE(piece.report["plane_cut"][0]["ends_graded"].get<long>(), 1);
-  // Where the wedge is thinnest: the end, or the loop of radius sqrt(depth (1 - depth)) about its
-  // axis on the plane.
+  // Where the wedge is thinnest: the end (on the plane, the point under it), or the loop of radius
+  // sqrt(depth (1 - depth)) about its axis on the plane.
   const double loop = gap < 0.0 ? std::sqrt(-gap * (1.0 + gap)) : 0.0;
-  auto thinnest = [&](const Eigen::Vector3d& q) {
-    if (gap > 0.0) return (q - end).norm() < 0.01;
+  auto thinnest = [&](const Eigen::Vector3d& q, bool on_plane) {
+    if (gap > 0.0) return (q - Eigen::Vector3d(end.x(), end.y(), on_plane ? planes[0] : end.z())).norm() < 0.01;
     return std::abs(q.z() - planes[0]) < 1e-9 && std::abs((q - end).head<2>().norm() - loop) < 0.01;
   };
-  // The longest edge of the faces of `patch` with a corner where the wedge is thinnest (the
-  // plane's points under the end, when it is not cut).
+  // The longest edge of the faces of `patch` with a corner where the wedge is thinnest.
   auto longest_edge_near = [&](const std::string& patch, bool on_plane) {
     double longest = 0.0;
     const PolyMesh& g = piece.mesh;
@@ -589,9 +588,7 @@ void expect_graded_piece_passing_the_gate(double gap) {
         for (int f = q.start; f < q.start + q.size; ++f) {
           const auto& face = g.faces[f];
           bool near = false;
-          for (int v : face)
-            near = near || (on_plane && gap > 0.0 ? (g.points[v] - Eigen::Vector3d(end.x(), end.y(), planes[0])).norm() < 0.01
-                                                  : thinnest(g.points[v]));
+          for (int v : face) near = near || thinnest(g.points[v], on_plane);
           if (near)
             for (int k = 0; k < face.size(); ++k)
               longest = std::max(longest, (g.points[face[k]] - g.points[face[(k + 1) % face.size()]]).norm());
