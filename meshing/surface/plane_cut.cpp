@@ -30,19 +30,24 @@ Eigen::Vector3d normal(const std::vector<Eigen::Vector3d>& x, const std::array<i
 std::string where(const Eigen::Vector3d& q) { return fmt::format("({:.4g}, {:.4g}, {:.4g}) m", q.x(), q.y(), q.z()); }
 
 // The triangles of `part` with a vertex within `band` of the plane z that are no facet of the
-// Delaunay tetrahedra of its points within 2 band of the plane: more points only take facets
-// away, so each is missing from gmsh's start too.
+// Delaunay tetrahedra of its points within 2 band of the plane and those triangles' corners
+// (a long triangle's reach further): more points only take facets away, so each is missing from
+// gmsh's start too.
 std::vector<std::size_t> off_delaunay_near_plane(const TriangleMesh& part, double z, double band) {
-  std::vector<int> near;
-  for (std::size_t v = 0; v < part.points.size(); ++v)
-    if (std::abs(part.points[v].z() - z) < 2.0 * band) near.push_back(static_cast<int>(v));
+  std::vector<char> taken(part.points.size(), 0);
+  for (std::size_t v = 0; v < part.points.size(); ++v) taken[v] = std::abs(part.points[v].z() - z) < 2.0 * band;
   std::vector<std::size_t> beside;
   for (std::size_t t = 0; t < part.triangles.size(); ++t) {
     const auto& v = part.triangles[t];
     if (std::min({std::abs(part.points[v[0]].z() - z), std::abs(part.points[v[1]].z() - z),
-                  std::abs(part.points[v[2]].z() - z)}) < band)
+                  std::abs(part.points[v[2]].z() - z)}) < band) {
       beside.push_back(t);
+      for (int c : v) taken[c] = 1;
+    }
   }
+  std::vector<int> near;
+  for (std::size_t v = 0; v < part.points.size(); ++v)
+    if (taken[v]) near.push_back(static_cast<int>(v));
   return off_delaunay_facets(part, near, beside);
 }
 

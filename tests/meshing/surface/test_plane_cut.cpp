@@ -304,3 +304,28 @@ TEST(PlaneCut, AWallRingAlongABridgesFootIsCutClosed) {
   expect_valid(c.below, "below");
   expect_valid(c.above, "above");
 }
+
+// A surface whose triangles reach far past the band the cut checks for gmsh's recovery (2 edges
+// from the plane, their points within 4): a coarse wall triangle on issue 58's bed (a = 14,
+// N = 1e4, 0.15 d, 4 pieces, planes moved) reached 0.62 d from the plane with the band at 0.6 d,
+// and its corner, left out of the Delaunay tetrahedra the triangles are sought in, stopped the
+// rank ("unordered_map::at", 2026-12-02). Here an octahedron of unit radius cut halfway up with
+// an edge of 0.1: the apexes lie 0.5 and 1.5 from the plane, and no vertex is near enough to be
+// snapped onto it. Both parts close, the one above is the pyramid of height 0.5 over a square of
+// area 0.5, and together they hold the octahedron's 4/3.
+TEST(PlaneCut, TrianglesReachingFarFromThePlaneAreCut) {
+  TriangleMesh octahedron;
+  octahedron.points = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (int k = 0; k < 4; ++k) {
+    octahedron.triangles.push_back({k, (k + 1) % 4, 4});
+    octahedron.triangles.push_back({(k + 1) % 4, k, 5});
+  }
+  octahedron.patch.assign(8, 0);
+  octahedron.patches = {"wall"};
+  const PlaneCut c = cut_by_plane(octahedron, 0.5, {0.1, 1.5, "outlet", "inlet"});
+  expect_valid(c.below, "below");
+  expect_valid(c.above, "above");
+  const double above = check_surface(c.above, SelfIntersectionTest::all_pairs).volume;
+  EXPECT_NEAR(above, 0.5 * 0.5 / 3.0, 1e-12);
+  EXPECT_NEAR(check_surface(c.below, SelfIntersectionTest::all_pairs).volume + above, 4.0 / 3.0, 1e-12);
+}
