@@ -88,6 +88,8 @@ projection: the largest rank's peak and time, fitted on the pieces sections' ran
 pieces_1e4: issue 58's own bed (a = 14, N = 1e4, bridges, 0.1 d, tetrahedra, not solved) in one piece, then in P
         pieces on P ranks (each of --pieces-1e4-ranks): each rank's peak and time, checkMesh in parallel, and at 4
         ranks the pieces joined by reconstructParMesh and checked whole; the issue's targets for it.
+pieces_1e4_solved: the same bed at 0.15 d on polyhedra, solved: one piece (simpleFoam on 2 processes) against 2 and 4
+        pieces on their ranks: dp/L, scene to dp/L, the largest processes, checkMesh (at 4 ranks reconstructed too).
 weak_scaling_1e4: --weak-1e4-spheres spheres per rank at a = 14 (bridges, 0.1 d, tetrahedra), on 1, 2 and 4 ranks.
 projection_1e4: the projection from pieces_1e4's ranks.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
@@ -116,7 +118,8 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
-            "periodic_slice", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4", "weak_scaling_1e4",
+            "periodic_slice", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
+            "pieces_1e4_solved", "weak_scaling_1e4",
             "projection_1e4"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
@@ -717,17 +720,33 @@ BED_1E4 = ("a = 14, seed 1, bridges, surface edge 0.1 d (the default 0.05 d wher
            "here)")
 
 
+BED_1E4_SOLVED = ("a = 14, seed 1, bridges, surface edge 0.15 d (the default 0.05 d where contacts meet), no "
+                  "refinement across gaps, the polyhedral dual as the case's cells (the default), Re_p = 1, solved")
+
+
 def bed_1e4_scene(count, solve, spheres=10000):
     """Issue 58's bed (BED_1E4) with `spheres` spheres (the column longer or shorter), in `count` pieces (0: one
     piece); `solve` must be False (simpleFoam on it does not fit here)."""
     if solve:
-        raise SystemExit("bed_1e4_scene: the 1e4 bed is not solved on this machine")
+        raise SystemExit("bed_1e4_scene: the 1e4 bed is not solved on this machine at 0.1 d; bed_1e4_solved_scene is")
     text = scene(14, spheres, "bridge", 0.1, False)
     for old, new in [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.03333\n", ""),
                      ("run = false", 'run = false\ncells = "tetrahedra"'),
                      ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')]:
         if old not in text:
             raise SystemExit(f"scene(): no {old}; update bed_1e4_scene")
+        text = text.replace(old, new, 1)
+    return text
+
+
+def bed_1e4_solved_scene(count, solve, spheres=10000):
+    """Issue 58's bed as BED_1E4_SOLVED: at 0.15 d, on polyhedra, solved (the one piece on 2 processes, the
+    pieces on their ranks), in `count` pieces (0: one piece); unsolved when not `solve`."""
+    text = scene(14, spheres, "bridge", 0.15, solve)
+    for old, new in [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.05\n", ""),
+                     ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')]:
+        if old not in text:
+            raise SystemExit(f"scene(): no {old}; update bed_1e4_solved_scene")
         text = text.replace(old, new, 1)
     return text
 
@@ -1050,8 +1069,61 @@ def pieces_1e4_lines(rows):
                      ", ".join(f"{r['pieces']} pieces {100 * (r['cells'] / one['cells'] - 1):+.2f} %" for r in cells) +
                      " (the planes' cut faces; gmsh's threads also make other tetrahedra on each run).")
     lines += ["- dp/L within 0.5 % of the one-piece route's, and scene to dp/L on 2 ranks no slower than one piece: "
-              "not measurable at this edge here (simpleFoam would need some 37 GB); measured at 0.15 d by hand, "
-              "docs/findings.md (2026-11-30, session 52).", ""]
+              "not measurable at this edge here (simpleFoam would need some 37 GB); at 0.15 d in the next section "
+              "(\"Issue 58's bed solved in pieces\").", ""]
+    return lines
+
+
+def pieces_1e4_solved_lines(rows):
+    """Issue 58's bed solved in one piece and in pieces: dp/L, scene to dp/L, memory and checkMesh, and the issue's
+    targets that need the solve."""
+    one = next(r for r in rows if r["pieces"] == 0)
+    lines = ["## Issue 58's bed solved in pieces: a = 14, N = 1e4, bridges, 0.15 d, one piece against 2 and 4 ranks", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. The bed: {BED_1E4_SOLVED}; at 0.15 d, not the 0.1 d "
+             "of the section above, because simpleFoam on the 0.1 d mesh would need some 37 GB here. *One piece*: the run "
+             "as before pieces (its mesh stage, the case stage's dual, decomposePar, simpleFoam on 2 processes). *P "
+             "pieces*: `[mesh] pieces = P`, each rank cutting, meshing and writing its slab's polyhedra as "
+             "`processorK`, then simpleFoam on the P pieces as written (no decomposePar); 4 ranks run oversubscribed "
+             "on the 2 cores. Scene to dp/L: the whole `bedforge run`, packing included, one run after the other. "
+             "checkMesh: Allrun's, `-parallel` on the pieces; where marked, the pieces joined by "
+             "`reconstructParMesh -constant` and checked whole.", "",
+             "| route | polyhedra | largest mesh process (MB) | simpleFoam, largest process (MB) | simpleFoam (s) | "
+             "scene to dp/L (s) | checkMesh | dp/L (Pa/m) |",
+             "|---|---|---|---|---|---|---|---|"]
+    lines.append(f"| one piece, 2 processes | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0):.0f} (mesh stage), "
+                 f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | {one['solver_peak_mb']:.0f} | "
+                 f"{one['solve_s']:.0f} | {one['wall_s']:.0f} | | {one['dp_pa_m']:.6g} |")
+    for r in rows:
+        if r["pieces"] < 2:
+            continue
+        _, _, _, check = rank_columns(r, None)
+        lines.append(f"| {r['pieces']} pieces on {r['pieces']} ranks | {r['cells']} | {largest_peak(r):.0f} (a rank) | "
+                     f"{r['solver_peak_mb']:.0f} | {r['solve_s']:.0f} | {r['wall_s']:.0f} | {check} | "
+                     f"{r['dp_pa_m']:.6g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.3f} %) |")
+    verdict = lambda ok: "**met**" if ok else "**not met**"
+    lines += ["", "Issue 58's targets that need the solve, on this bed at 0.15 d:", ""]
+    for p in (4, 2):
+        r = next((r for r in rows if r["pieces"] == p), None)
+        if r is None:
+            continue
+        change = 100 * (r["dp_pa_m"] / one["dp_pa_m"] - 1)
+        lines.append(f"- dp/L on {p} ranks within 0.5 % of the one-piece route's: {change:+.3f} %, "
+                     f"{verdict(abs(change) <= 0.5)}; the polyhedra differ by {r['cells'] - one['cells']:+d} "
+                     f"({100 * (r['cells'] / one['cells'] - 1):+.2f} %: the planes' cut faces and whole dual cells across "
+                     "them, and gmsh's threads make other tetrahedra on each run).")
+    four = next((r for r in rows if r["pieces"] == 4 and "reconstructed" in r), None)
+    if four:
+        lines.append(f"- 4 ranks: the case runs in parallel without decomposePar (checkMesh -parallel: "
+                     f"{'OK' if four['check_mesh_ok'] else 'failed'}); checkMesh on the reconstructed mesh: "
+                     f"{verdict(four['reconstructed']['mesh_ok'])}.")
+    two = next((r for r in rows if r["pieces"] == 2), None)
+    if two:
+        lines.append(f"- Scene to dp/L on 2 ranks no slower than today's one-piece route: {two['wall_s']:.0f} s against "
+                     f"{one['wall_s']:.0f} s, {two['wall_s'] / one['wall_s']:.2f} times, "
+                     f"{verdict(two['wall_s'] <= one['wall_s'])} (one run each; simpleFoam "
+                     f"{two['solve_s']:.0f} s against {one['solve_s']:.0f} s, the rest meshing, the dual and, for the one "
+                     "piece, decomposePar).")
+    lines.append("")
     return lines
 
 
@@ -1512,7 +1584,8 @@ def write(results):
     for key, section_lines in (("periodic_slice", slice_lines), ("pieces", pieces_lines),
                                ("pieces_bridge", pieces_lines), ("pieces_large", pieces_lines),
                                ("weak_scaling", weak_scaling_lines), ("projection", projection_lines),
-                               ("pieces_1e4", pieces_1e4_lines), ("weak_scaling_1e4", weak_scaling_lines),
+                               ("pieces_1e4", pieces_1e4_lines), ("pieces_1e4_solved", pieces_1e4_solved_lines),
+                               ("weak_scaling_1e4", weak_scaling_lines),
                                ("projection_1e4", projection_lines)):
         if key in results:
             lines += section_lines(results[key])
@@ -1718,6 +1791,10 @@ def main():
         if "pieces_1e4" in args.only:
             results["pieces_1e4"] = pieces(tmp, args.pieces_1e4_ranks, 10000, solved=(), make_scene=bed_1e4_scene,
                                            one_piece=True, reconstruct=(4,))
+            write(results)
+        if "pieces_1e4_solved" in args.only:
+            results["pieces_1e4_solved"] = pieces(tmp, [2, 4], 10000, solved=(0, 2, 4), make_scene=bed_1e4_solved_scene,
+                                                  reconstruct=(4,))
             write(results)
         if "weak_scaling_1e4" in args.only:
             results["weak_scaling_1e4"] = weak_scaling(tmp, [1, 2, 4], args.weak_1e4_spheres, bed_1e4_scene, BED_1E4)
