@@ -960,6 +960,11 @@ def one_over_p_line(rows, reference, verdict):
             ", ".join(f"{x:.2f} at {p}" for p, x in ratios) + f", {verdict(all(0.8 <= x <= 1.2 for _, x in ratios))}."]
 
 
+def one_piece_peaks(one):
+    """The one-piece run's peaks (MB) in a pieces table: its mesh stage's and its case stage's (the dual)."""
+    return f"{one['stage_peak_mb'].get('mesh', 0):.0f} (mesh stage), {one['stage_peak_mb'].get('case', 0):.0f} (case stage)"
+
+
 def pieces_lines(rows):
     """Issue 58's section: one piece (when run) against P pieces on P ranks, and its targets as far as measured."""
     one = next((r for r in rows if r["pieces"] == 0), None)
@@ -990,8 +995,7 @@ def pieces_lines(rows):
     # The peaks are held against the fewest ranks run: one rank, or where one rank's piece would not fit, two.
     fewest = min((r for r in rows if r["pieces"] >= 1), key=lambda r: r["pieces"], default=None)
     if one:
-        lines.append(f"| one piece | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0.0):.0f} (mesh stage), "
-                     f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | | | {one['wall_s']:.0f} | | "
+        lines.append(f"| one piece | {one['cells']} | {one_piece_peaks(one)} | | | {one['wall_s']:.0f} | | "
                      f"{one.get('dp_pa_m', float('nan')):.4g} |")
     for r in rows:
         if r["pieces"] < 1:
@@ -1090,8 +1094,7 @@ def pieces_1e4_solved_lines(rows):
              "| route | polyhedra | largest mesh process (MB) | simpleFoam, largest process (MB) | simpleFoam (s) | "
              "scene to dp/L (s) | checkMesh | dp/L (Pa/m) |",
              "|---|---|---|---|---|---|---|---|"]
-    lines.append(f"| one piece, 2 processes | {one['cells']} | {one['stage_peak_mb'].get('mesh', 0):.0f} (mesh stage), "
-                 f"{one['stage_peak_mb'].get('case', 0):.0f} (case stage) | {one['solver_peak_mb']:.0f} | "
+    lines.append(f"| one piece, 2 processes | {one['cells']} | {one_piece_peaks(one)} | {one['solver_peak_mb']:.0f} | "
                  f"{one['solve_s']:.0f} | {one['wall_s']:.0f} | | {one['dp_pa_m']:.6g} |")
     for r in rows:
         if r["pieces"] < 2:
