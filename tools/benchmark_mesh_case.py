@@ -729,12 +729,17 @@ def bed_1e4_scene(count, solve, spheres=10000):
     piece); `solve` must be False (simpleFoam on it does not fit here)."""
     if solve:
         raise SystemExit("bed_1e4_scene: the 1e4 bed is not solved on this machine at 0.1 d; bed_1e4_solved_scene is")
-    text = scene(14, spheres, "bridge", 0.1, False)
-    for old, new in [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.03333\n", ""),
-                     ("run = false", 'run = false\ncells = "tetrahedra"'),
-                     ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')]:
+    return edited(scene(14, spheres, "bridge", 0.1, False),
+                  [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.03333\n", ""),
+                   ("run = false", 'run = false\ncells = "tetrahedra"'),
+                   ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')], "bed_1e4_scene")
+
+
+def edited(text, replacements, caller):
+    """scene()'s `text` with each (old, new) of `replacements` made once; stops naming `caller` where one is missing."""
+    for old, new in replacements:
         if old not in text:
-            raise SystemExit(f"scene(): no {old}; update bed_1e4_scene")
+            raise SystemExit(f"scene(): no {old}; update {caller}")
         text = text.replace(old, new, 1)
     return text
 
@@ -742,13 +747,9 @@ def bed_1e4_scene(count, solve, spheres=10000):
 def bed_1e4_solved_scene(count, solve, spheres=10000):
     """Issue 58's bed as BED_1E4_SOLVED: at 0.15 d, on polyhedra, solved (the one piece on 2 processes, the
     pieces on their ranks), in `count` pieces (0: one piece); unsolved when not `solve`."""
-    text = scene(14, spheres, "bridge", 0.15, solve)
-    for old, new in [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.05\n", ""),
-                     ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')]:
-        if old not in text:
-            raise SystemExit(f"scene(): no {old}; update bed_1e4_solved_scene")
-        text = text.replace(old, new, 1)
-    return text
+    return edited(scene(14, spheres, "bridge", 0.15, solve),
+                  [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.05\n", ""),
+                   ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')], "bed_1e4_solved_scene")
 
 
 def timed_run(path, text, env):
