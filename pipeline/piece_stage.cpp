@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <regex>
@@ -68,6 +69,21 @@ meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const s
   }
 }
 
+// The planes (d) that can shape piece `piece`'s surface: its own and any other its window reaches
+// (rung on its walls, or near its spheres' ends), which lie within the margin of its spheres plus
+// their diameters. A piece whose planes these are is the same piece when the others move.
+nlohmann::json planes_reaching(const Bed& bed, const meshing::SurfaceParams& surface, const std::vector<double>& planes,
+                               int piece) {
+  const double reach = meshing::piece_margin_d(bed, surface) + 2.0 * largest_diameter(bed) / reference_diameter(bed);
+  const int pieces = static_cast<int>(planes.size()) + 1;
+  const double lo = piece > 0 ? planes[piece - 1] - reach : -std::numeric_limits<double>::infinity();
+  const double hi = piece + 1 < pieces ? planes[piece] + reach : std::numeric_limits<double>::infinity();
+  nlohmann::json out = nlohmann::json::object();
+  for (std::size_t j = 0; j < planes.size(); ++j)
+    if (planes[j] >= lo && planes[j] <= hi) out[std::to_string(j)] = planes[j];
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
@@ -100,10 +116,12 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   const double d = reference_diameter(bed);
   Progress progress("piece", console.progress);
   // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
-  // an earlier run made from the same, so only the pieces that failed are meshed again.
-  const std::string cells_key = stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
-                                           {"mesh", meshing::to_json(mesh)}, {"planes_d", planes}, {"piece", piece},
-                                           {"pieces", pieces}});
+  // an earlier run made from the same, so only the pieces that failed, or whose planes moved, are
+  // meshed again.
+  const std::string cells_key =
+      stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
+                 {"mesh", meshing::to_json(mesh)}, {"planes_d", planes_reaching(bed, surface, planes, piece)},
+                 {"piece", piece}, {"pieces", pieces}});
   const std::string piece_key = stage_key({{"cells", cells_key}, {"case", cases::to_json(case_params)}});
   const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
   if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json")) {
@@ -245,9 +263,12 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
   std::tie(out.inlet_z, out.outlet_z) = domain_heights(bed, surface);
   // The ranks are given `planes` (d) and the whole bed's wall gap (`wall_gap_m`, m), each try its
   // log (`log_name`).
-  const auto run_ranks = [&bed, surface, pieces, run_dir, &console](const fs::path& case_dir,
-                                                                    const std::vector<double>& planes,
-                                                                    double wall_gap_m, const std::string& log_name) {
+  // The piece whose rank stopped first in the last try (-1: none named): the planes moved are its.
+  auto failed_piece = std::make_shared<int>(-1);
+  const auto run_ranks = [&bed, surface, pieces, run_dir, &console, failed_piece](const fs::path& case_dir,
+                                                                                  const std::vector<double>& planes,
+                                                                                  double wall_gap_m,
+                                                                                  const std::string& log_name) {
     const fs::path self = fs::read_symlink("/proc/self/exe"), log = case_dir / log_name;
     Progress progress("pieces", console.progress);
     progress.update(fmt::format("{} ranks, each meshing its piece (mpirun)", pieces));
@@ -273,6 +294,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
           pieces, pieces, log.string()));
     // Which piece stopped first, with its heights: a rank's own message may not say.
     std::string which = "a rank";
+    *failed_piece = said.failed_rank >= 0 && said.failed_rank < pieces ? said.failed_rank : -1;
     if (said.failed_rank >= 0 && said.failed_rank < pieces) {
       const meshing::SurfaceParams slab = meshing::slab_surface(bed, surface, planes, said.failed_rank);
       which = fmt::format("piece {} of {} ({:.2f}-{:.2f} d above the floor, rank {})", said.failed_rank + 1, pieces,
@@ -302,7 +324,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
     if (said.message.rfind("bedforge: did not converge: ", 0) == 0) throw ConvergenceError(what);
     throw std::runtime_error(what);
   };
-  out.write = [&bed, surface, pieces, run_ranks, &console](cases::CaseInfo& info) {
+  out.write = [&bed, surface, pieces, run_ranks, failed_piece, &console](cases::CaseInfo& info) {
     // The planes and the whole bed's wall gap from one survey of it, here, so that each rank
     // treats only its piece's window (piece_directory).
     const meshing::SlabPlanes given = meshing::slab_planes(bed, surface, pieces);
@@ -315,9 +337,13 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
         },
         [&console, &moved](const meshing::PlanesMoved& m) {
           moved = true;
-          console.line(fmt::format("pieces: {}; meshing them again with the planes moved from {:.3f} to {:.3f} d",
+          console.line(fmt::format("pieces: {}; meshing again with the planes moved from {:.3f} to {:.3f} d "
+                                   "(a piece whose planes stayed keeps the cells it made)",
                                    m.because, fmt::join(m.from_d, ", "), fmt::join(m.to_d, ", ")));
-        });
+        },
+        // A rank that stopped first named: only its planes move (a rank stopped on its neighbour's
+        // failure says so later, if at all).
+        [failed_piece] { return *failed_piece >= 0 ? std::vector<int>{*failed_piece} : std::vector<int>{}; });
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
     long cells = 0;
     double fluid = 0.0, void_fraction = 0.0;

@@ -65,9 +65,11 @@ RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 // them, and the whole bed's wall gap (`--wall-gap-m`), so that each treats only its window. When
 // a rank's piece cannot be cut (meshing::SlabCutError, known by its message) or fails the gate,
 // the ranks run once more with the planes moved (meshing::attempt_with_planes_moved; their output
-// in case/log.pieces_planes_moved); the error then names both attempts. The ranks' files
-// (case/piece_layers) are removed once all have succeeded; a failed run leaves them for the
-// next, which remakes only the failed pieces.
+// in case/log.pieces_planes_moved): only the planes of the piece that stopped first when mpirun
+// names it (every plane when not), so that the pieces whose windows reach no moved plane keep the
+// tetrahedra they made; the error then names both attempts. The ranks' files (case/piece_layers)
+// are removed once all have succeeded; a failed run leaves them for the next, which remakes only
+// the failed pieces.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
 // need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,

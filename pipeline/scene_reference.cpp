@@ -215,7 +215,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
         "piece`, started by the run) as `case/processorK` with processor patches, and solved on as many processes "
         "without decomposePar; no process holds the whole mesh; a convergence study's levels likewise; pieces that "
-        "cannot be cut or fail the quality gate are meshed once more with the planes moved, as slabs are. 0 or 1: one piece. Every "
+        "cannot be cut or fail the quality gate are meshed once more with the planes moved, as slabs are (only the "
+        "planes of the piece that stopped first, when mpirun names it: a piece whose window reaches no moved plane "
+        "keeps its cells). 0 or 1: one piece. Every "
         "contact treatment in a cylinder or annulus (bridges, caps and unions cut by the planes from each rank's "
         "widened window, its walls ringed there), shrink or none in a box; no prism layers, no snappyHexMesh, no "
         "`stl` or `mesh` output (there is no whole surface or mesh)"}},

@@ -331,10 +331,16 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
   return planes;
 }
 
-std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes) {
+std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes,
+                                        const std::vector<int>& failed) {
   const std::vector<double> ends = sphere_ends_d(bed, s);
-  std::vector<double> moved;
-  for (double plane : planes) moved.push_back(widest_interval_middle(ends, plane, s.clip_shift_d, plane));
+  std::vector<double> moved = planes;
+  for (std::size_t j = 0; j < planes.size(); ++j) {
+    // Plane j lies between slabs j and j + 1.
+    const bool bounds_failed = failed.empty() || std::find(failed.begin(), failed.end(), static_cast<int>(j)) != failed.end() ||
+                               std::find(failed.begin(), failed.end(), static_cast<int>(j) + 1) != failed.end();
+    if (bounds_failed) moved[j] = widest_interval_middle(ends, planes[j], s.clip_shift_d, planes[j]);
+  }
   return moved;
 }
 

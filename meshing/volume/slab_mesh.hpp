@@ -68,8 +68,11 @@ struct SlabPlanes {
 SlabPlanes slab_planes(const Bed& bed, const SurfaceParams& surface, int slabs);
 // Where `planes` (d) go when the slabs between them fail the quality gate or cannot be cut: each
 // to the middle of the widest interval between the spheres' ends within surface.clip_shift_d of
-// it, other than the interval it lies in (where it stays when there is no other).
-std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes);
+// it, other than the interval it lies in (where it stays when there is no other). When `failed`
+// names the slabs that failed (0 = the lowest), only the planes bounding them move, so that the
+// other slabs, made already, can be kept.
+std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
+                                        const std::vector<int>& failed = {});
 
 // A slab that cannot be cut from the bed between its planes (its clip planes find no height
 // clear of the spheres, or a plane's cut meets another cut): like a slab failing the gate, the
@@ -90,13 +93,15 @@ struct PlanesMoved {
 // option that set their count) when one could not be cut (`cut`), else ConvergenceError.
 [[noreturn]] void throw_slabs_failed(bool cut, const std::string& key, const std::string& what);
 // `attempt(planes)` (planes in d), and when it throws ConvergenceError or SlabCutError,
-// `on_retry` then `attempt(moved)`, moved by moved_slab_planes_d; returns what the attempt that
-// succeeded returned. The error when both fail names both attempts (throw_slabs_failed, by the
-// second's kind); when the planes have nowhere else to go, the first's, not tried again.
+// `on_retry` then `attempt(moved)`, moved by moved_slab_planes_d (only about the slabs `failed()`
+// names, when it is given and names any); returns what the attempt that succeeded returned. The
+// error when both fail names both attempts (throw_slabs_failed, by the second's kind); when the
+// planes have nowhere else to go, the first's, not tried again.
 template <class Attempt>
 auto attempt_with_planes_moved(const Bed& bed, const SurfaceParams& surface, const std::vector<double>& planes,
                                const std::string& key, Attempt&& attempt,
-                               const std::function<void(const PlanesMoved&)>& on_retry) {
+                               const std::function<void(const PlanesMoved&)>& on_retry,
+                               const std::function<std::vector<int>()>& failed = {}) {
   PlanesMoved moved;
   bool cut = false;
   try {
@@ -106,7 +111,7 @@ auto attempt_with_planes_moved(const Bed& bed, const SurfaceParams& surface, con
   } catch (const SlabCutError& e) {
     moved.because = e.what(), cut = true;
   }
-  moved.from_d = planes, moved.to_d = moved_slab_planes_d(bed, surface, planes);
+  moved.from_d = planes, moved.to_d = moved_slab_planes_d(bed, surface, planes, failed ? failed() : std::vector<int>{});
   if (moved.to_d == planes) throw_slabs_failed(cut, key, moved.because);
   on_retry(moved);
   const auto both = [&](const char* second) {

@@ -14,7 +14,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/bed_io.hpp"
+#include "meshing/volume/slab_mesh.hpp"
 #include "pipeline/piece_stage.hpp"
+#include "pipeline/scene.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
@@ -240,6 +243,51 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
   EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
 }
 
+// When a piece fails, only its planes move (meshing::moved_slab_planes_d, as the run's retry
+// moves them): a piece whose planes stayed keeps the tetrahedra it made, and the pieces, kept and
+// new, still form one case whose processor patches match (checkMesh -parallel reads it whole, and
+// a rank refuses a neighbour's cells that do not meet its own at their plane). A bed 19 d tall in
+// 3 pieces of 6 d: the top piece's window does not reach the lowest plane.
+TEST(PieceStage, APieceWhosePlanesStayKeepsItsCellsWhenAnotherPlaneMoves) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
+  std::string tall = kScene;
+  tall.replace(tall.find("diameter_d = 4.0"), 16, "diameter_d = 3.0");
+  tall.replace(tall.find("count = 60"), 10, "count = 150");
+  tall.replace(tall.find("edge_length_d = 0.2"), 19, "edge_length_d = 0.2\ncells_per_gap = 0");
+  const fs::path dir = fresh_dir("piece_kept"), scene = fresh_dir("piece_kept_scene");
+  fs::create_directories(scene);
+  std::ofstream(scene / "s.toml") << tall << "run = false\n[mesh]\npieces = 3\n";
+  const std::string oversubscribed = kOpenFoam + "export OMPI_MCA_rmaps_base_oversubscribe=1; ";
+  Result r = shell(oversubscribed + BEDFORGE_BINARY + " --quiet run " + (scene / "s.toml").string() + " -o " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  // The ranks on their own at the run's planes, so that their tetrahedra stay on disk; then
+  // again as if piece 1 of 3 had failed: the lowest plane moves, the other stays.
+  const bedforge::pipeline::Scene s = bedforge::pipeline::read_scene_file(dir / "scene.toml");
+  const bedforge::Bed bed = bedforge::read_bed_text(dir / "bed.csv", 1.0).bed;
+  const std::vector<double> planes = bedforge::meshing::slab_planes_d(bed, s.surface, 3),
+                            moved = bedforge::meshing::moved_slab_planes_d(bed, s.surface, planes, {0});
+  ASSERT_NE(moved[0], planes[0]);
+  ASSERT_EQ(moved[1], planes[1]);
+  const auto ranks = [&](const std::vector<double>& at) {
+    return shell(oversubscribed + "mpirun -np 3 " + BEDFORGE_BINARY + " --quiet --no-progress piece " + dir.string() +
+                 fmt::format(" --planes-d {:.17g} {:.17g}", at[0], at[1]));
+  };
+  r = ranks(planes);
+  ASSERT_EQ(r.status, 0) << r.output;
+  r = ranks(moved);
+  ASSERT_EQ(r.status, 0) << r.output;
+  long cells = 0;
+  for (int k = 0; k < 3; ++k) {
+    const auto p = nlohmann::json::parse(read(dir / fmt::format("case/processor{}/bedforge_piece.json", k)));
+    EXPECT_EQ(p["slab"].value("reused", false), k == 2) << "piece " << k << ": " << p.dump();
+    cells += p["cells"].get<long>();
+  }
+  const Result check =
+      shell(oversubscribed + "cd " + (dir / "case").string() + " && mpirun -np 3 checkMesh -parallel");
+  ASSERT_EQ(check.status, 0) << check.output;
+  EXPECT_NE(check.output.find(fmt::format("cells:            {}", cells)), std::string::npos) << check.output;
+}
+
 // More ranks than mpirun has slots (cores, or a batch job's tasks): the run says so, naming
 // mesh.pieces and how to run more ranks than cores, not as an internal error.
 TEST(PieceStage, MoreRanksThanMpirunHasSlotsAreRefusedNamingThePieces) {
@@ -301,7 +349,7 @@ TEST(PieceStage, APieceFailingTheGateIsMeshedAgainWithThePlanesMovedAndTheErrorN
   // Each attempt's failure is a rank's, naming its piece's slab and the gate.
   EXPECT_LT(r.output.find("of 2 ("), moved) << r.output;
   EXPECT_GT(r.output.rfind("of 2 ("), moved) << r.output;
-  EXPECT_NE(r.output.find("meshing them again with the planes moved"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshing again with the planes moved"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "case/processor0/constant/polyMesh/owner"));
 }
 
@@ -323,7 +371,7 @@ TEST(PieceStage, APieceThatCannotBeCutIsTriedAgainWithThePlanesMovedAndTheErrorN
   ASSERT_NE(moved, std::string::npos) << r.output;
   EXPECT_LT(r.output.find("cannot be cut from the bed"), moved) << r.output;
   EXPECT_GT(r.output.rfind("cannot be cut from the bed"), moved) << r.output;
-  EXPECT_NE(r.output.find("meshing them again with the planes moved"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshing again with the planes moved"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(dir / "case/log.pieces_planes_moved"));
   EXPECT_FALSE(fs::exists(dir / "case/processor0/constant/polyMesh/owner"));
   EXPECT_FALSE(fs::exists(dir / "case/processor1/constant/polyMesh/owner"));

@@ -261,6 +261,23 @@ TEST(SlabMesh, MovedPlanesLieInAnotherIntervalBetweenTheSpheresEnds) {
   }
 }
 
+// A failed slab named: only the planes bounding it move, as they would with every plane moved;
+// the others stay bit for bit, so that the slabs between them, made already, can be kept.
+TEST(SlabMesh, OnlyThePlanesOfTheSlabsNamedAsFailedMove) {
+  const Bed b = test_support::packed_bed(80, 4.0, 1);
+  SurfaceParams sp;  // shrink
+  const std::vector<double> planes = slab_planes_d(b, sp, 4), all = moved_slab_planes_d(b, sp, planes);
+  ASSERT_EQ(planes.size(), 3u);
+  for (std::size_t k = 0; k < planes.size(); ++k) ASSERT_NE(all[k], planes[k]) << "plane " << k << " cannot move here";
+  const std::vector<double> first = moved_slab_planes_d(b, sp, planes, {0});
+  EXPECT_EQ(first, (std::vector<double>{all[0], planes[1], planes[2]}));
+  const std::vector<double> middle = moved_slab_planes_d(b, sp, planes, {1});
+  EXPECT_EQ(middle, (std::vector<double>{all[0], all[1], planes[2]}));
+  const std::vector<double> last = moved_slab_planes_d(b, sp, planes, {3});
+  EXPECT_EQ(last, (std::vector<double>{planes[0], planes[1], all[2]}));
+  EXPECT_EQ(moved_slab_planes_d(b, sp, planes, {0, 3}), (std::vector<double>{all[0], planes[1], all[2]}));
+}
+
 TEST(SlabMesh, GivenPlanesAreRefusedUnlessIncreasingInsideTheDomainAndOneFewerThanTheSlabs) {
   const Bed b = test_support::packed_bed(80, 4.0, 1);
   SurfaceParams sp;
