@@ -52,9 +52,16 @@ std::string mpi_job(int pieces) {
   return size && job && std::to_string(pieces) == size ? job : "";
 }
 
-// The layer piece `neighbour` wrote at `path`: in a job, waited for until the job's own is
-// there (a rank that fails ends the job, so the wait ends too); outside one, as it is.
-meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const std::string& job, Progress& progress) {
+// A layer's tag: the job that wrote it ("" outside one), then what its plane's cells are made
+// from (`made_from`: the bed, the settings and the plane's height).
+std::string layer_tag(const std::string& job, const std::string& made_from) { return job + " " + made_from; }
+std::string made_from_of(const std::string& tag) { return tag.substr(tag.find(' ') + 1); }
+
+// The layer piece `neighbour` wrote at `path`: in a job, waited for until the job's own, `tag`,
+// is there (a rank that fails ends the job, so the wait ends too); outside one, as it is (its
+// tag checked before any work).
+meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const std::string& job,
+                                    const std::string& tag, Progress& progress) {
   if (job.empty()) return meshing::read_plane_layer(path);
   progress.update(fmt::format("waiting for piece {}'s cells next to this one", neighbour));
   std::optional<fs::file_time_type> seen;
@@ -63,7 +70,7 @@ meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const s
     const fs::file_time_type at = fs::last_write_time(path, ec);
     if (!ec && at != seen) {
       seen = at;
-      if (meshing::read_plane_layer_tag(path) == job) return meshing::read_plane_layer(path);
+      if (meshing::read_plane_layer_tag(path) == tag) return meshing::read_plane_layer(path);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
@@ -104,15 +111,31 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
                                  "contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\"",
                                  meshing::treatment_name(surface.treatment),
                                  meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
-  // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them.
+  // What the cells at plane j (between pieces j and j + 1) are made from, which both pieces' layers
+  // there must share.
   const std::string job = mpi_job(pieces);
+  const auto plane_made_from = [&](int j) {
+    return stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
+                      {"mesh", meshing::to_json(mesh)}, {"plane_d", planes[j]}, {"pieces", pieces}});
+  };
+  // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them,
+  // made at the same planes of the same bed and settings.
   if (case_params.polyhedra && job.empty())
-    for (const auto& [neighbour, plane] : {std::pair{piece - 1, "outlet"}, std::pair{piece + 1, "inlet"}})
-      if (neighbour >= 0 && neighbour < pieces && !fs::exists(layer_path(case_dir, neighbour, plane)))
-        throw InputError(fmt::format("{}: piece {}'s cells next to piece {} are not there; allowed: the pieces of a "
-                                     "case on polyhedra made together (`mpirun -np {} bedforge piece DIR`, or "
-                                     "`bedforge run` with mesh.pieces = {}), or case.cells = \"tetrahedra\"",
-                                     layer_path(case_dir, neighbour, plane).string(), neighbour, piece, pieces, pieces));
+    for (const auto& [neighbour, plane] : {std::pair{piece - 1, "outlet"}, std::pair{piece + 1, "inlet"}}) {
+      if (neighbour < 0 || neighbour >= pieces) continue;
+      const fs::path path = layer_path(case_dir, neighbour, plane);
+      const std::string allowed = fmt::format(
+          "allowed: the pieces of a case on polyhedra made together (`mpirun -np {} bedforge piece DIR`, or `bedforge "
+          "run` with mesh.pieces = {}), or case.cells = \"tetrahedra\"", pieces, pieces);
+      if (!fs::exists(path))
+        throw InputError(fmt::format("{}: piece {}'s cells next to piece {} are not there; {}", path.string(),
+                                     neighbour, piece, allowed));
+      const int j = std::min(piece, neighbour);
+      if (made_from_of(meshing::read_plane_layer_tag(path)) != plane_made_from(j))
+        throw InputError(fmt::format("{}: piece {}'s cells next to piece {} were made for another bed, other settings "
+                                     "or another plane than {:.17g} d; {}",
+                                     path.string(), neighbour, piece, planes[j], allowed));
+    }
   const double d = reference_diameter(bed);
   Progress progress("piece", console.progress);
   // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
@@ -171,12 +194,16 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     for (const auto& [plane, shared] : {std::pair{"inlet", piece > 0}, std::pair{"outlet", piece + 1 < pieces}})
       if (shared) {
         meshing::PlaneLayer layer = meshing::plane_layer(slab.mesh, plane);
-        layer.tag = job;
+        layer.tag = layer_tag(job, plane_made_from(plane == std::string("inlet") ? piece - 1 : piece));
         meshing::write_plane_layer(layer_path(case_dir, piece, plane), layer);
       }
     std::optional<meshing::PlaneLayer> below, above;
-    if (piece > 0) below = neighbour_layer(layer_path(case_dir, piece - 1, "outlet"), piece - 1, job, progress);
-    if (piece + 1 < pieces) above = neighbour_layer(layer_path(case_dir, piece + 1, "inlet"), piece + 1, job, progress);
+    if (piece > 0)
+      below = neighbour_layer(layer_path(case_dir, piece - 1, "outlet"), piece - 1, job,
+                              layer_tag(job, plane_made_from(piece - 1)), progress);
+    if (piece + 1 < pieces)
+      above = neighbour_layer(layer_path(case_dir, piece + 1, "inlet"), piece + 1, job,
+                              layer_tag(job, plane_made_from(piece)), progress);
     progress.update(fmt::format("piece {} of {}: polyhedra", piece + 1, pieces));
     meshing::SlabWithLayers whole =
         meshing::slab_with_layers(slab.mesh, below ? &*below : nullptr, above ? &*above : nullptr);

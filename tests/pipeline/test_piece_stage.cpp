@@ -15,6 +15,7 @@
 #include <string>
 
 #include "core/bed_io.hpp"
+#include "meshing/volume/dual_pieces.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 #include "pipeline/piece_stage.hpp"
 #include "pipeline/scene.hpp"
@@ -379,8 +380,8 @@ TEST(PieceStage, APieceThatCannotBeCutIsTriedAgainWithThePlanesMovedAndTheErrorN
 
 // Refused before any meshing, with exit status 2 and what is allowed: a piece outside the count,
 // a wall gap not above 0, no case to write into, pieces beyond the machine's memory, planes that
-// do not fit the pieces, a piece on polyhedra made without its neighbours, and contacts a plane
-// would cut open; no processor directory is left.
+// do not fit the pieces, a piece on polyhedra made without its neighbours or with a neighbour's
+// cells made for other planes, and contacts a plane would cut open; no processor directory is left.
 TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_dir("piece_refused");
   ASSERT_EQ(cli_test::bedforge("--quiet pack --aspect-ratio 3 --count 12 --diameter-m 0.002 -o " + dir.string()).status, 0);
@@ -425,6 +426,19 @@ TEST(PieceStage, BadRequestsAreRefusedBeforeAnyWork) {
                           "made together"),
             std::string::npos)
       << r.output;
+  // ... or with one an earlier run left for another bed, other settings or other planes.
+  bedforge::meshing::PlaneLayer stale;
+  stale.tag = "1234 another run's plane";
+  fs::create_directories(dir / "case/piece_layers");
+  bedforge::meshing::write_plane_layer(dir / "case/piece_layers/piece1_inlet.bin", stale);
+  r = shell("env -u OMPI_COMM_WORLD_SIZE " + std::string(BEDFORGE_BINARY) + " piece " + dir.string() +
+            " --piece 0 --pieces 2 --contacts shrink");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("piece 1's cells next to piece 0 were made for another bed, other settings or another "
+                          "plane than "),
+            std::string::npos)
+      << r.output;
+  fs::remove_all(dir / "case/piece_layers");
   r = cli_test::bedforge("piece " + dir.string() + " --piece 0 --pieces 2 --layers 2");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("mesh.layers.count = 2"), std::string::npos) << r.output;
