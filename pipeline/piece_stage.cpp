@@ -111,13 +111,12 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
                                  "contacts.treatment and contacts.wall_treatment \"shrink\" or \"none\"",
                                  meshing::treatment_name(surface.treatment),
                                  meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
-  // What the cells at plane j (between pieces j and j + 1) are made from, which both pieces' layers
-  // there must share.
+  // What every piece's cells are made from, and the cells at plane j (between pieces j and j + 1),
+  // which both pieces' layers there must share.
   const std::string job = mpi_job(pieces);
-  const auto plane_made_from = [&](int j) {
-    return stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
-                      {"mesh", meshing::to_json(mesh)}, {"plane_d", planes[j]}, {"pieces", pieces}});
-  };
+  const nlohmann::json settings = {{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
+                                   {"mesh", meshing::to_json(mesh)}, {"pieces", pieces}};
+  const auto plane_made_from = [&](int j) { return stage_key({{"settings", settings}, {"plane_d", planes[j]}}); };
   // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them,
   // made at the same planes of the same bed and settings.
   if (case_params.polyhedra && job.empty())
@@ -141,10 +140,8 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
   // an earlier run made from the same, so only the pieces that failed, or whose planes moved, are
   // meshed again.
-  const std::string cells_key =
-      stage_key({{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
-                 {"mesh", meshing::to_json(mesh)}, {"planes_d", planes_reaching(bed, surface, planes, piece)},
-                 {"piece", piece}, {"pieces", pieces}});
+  const std::string cells_key = stage_key(
+      {{"settings", settings}, {"planes_d", planes_reaching(bed, surface, planes, piece)}, {"piece", piece}});
   const std::string piece_key = stage_key({{"cells", cells_key}, {"case", cases::to_json(case_params)}});
   const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
   if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json")) {

@@ -334,13 +334,11 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
 std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes,
                                         const std::vector<int>& failed) {
   const std::vector<double> ends = sphere_ends_d(bed, s);
+  const auto named = [&](int slab) { return std::find(failed.begin(), failed.end(), slab) != failed.end(); };
   std::vector<double> moved = planes;
-  for (std::size_t j = 0; j < planes.size(); ++j) {
-    // Plane j lies between slabs j and j + 1.
-    const bool bounds_failed = failed.empty() || std::find(failed.begin(), failed.end(), static_cast<int>(j)) != failed.end() ||
-                               std::find(failed.begin(), failed.end(), static_cast<int>(j) + 1) != failed.end();
-    if (bounds_failed) moved[j] = widest_interval_middle(ends, planes[j], s.clip_shift_d, planes[j]);
-  }
+  for (int j = 0; j < static_cast<int>(planes.size()); ++j)  // plane j lies between slabs j and j + 1
+    if (failed.empty() || named(j) || named(j + 1))
+      moved[j] = widest_interval_middle(ends, planes[j], s.clip_shift_d, planes[j]);
   return moved;
 }
 
