@@ -117,6 +117,8 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
   const nlohmann::json settings = {{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
                                    {"mesh", meshing::to_json(mesh)}, {"pieces", pieces}};
   const auto plane_made_from = [&](int j) { return stage_key({{"settings", settings}, {"plane_d", planes[j]}}); };
+  // The tag of a layer at plane j that this job writes and its neighbours read back.
+  const auto tag_at = [&](int j) { return layer_tag(job, plane_made_from(j)); };
   // A piece on polyhedra made on its own takes its neighbours' layers as an earlier job left them,
   // made at the same planes of the same bed and settings.
   if (case_params.polyhedra && job.empty())
@@ -191,16 +193,14 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     for (const auto& [plane, shared] : {std::pair{"inlet", piece > 0}, std::pair{"outlet", piece + 1 < pieces}})
       if (shared) {
         meshing::PlaneLayer layer = meshing::plane_layer(slab.mesh, plane);
-        layer.tag = layer_tag(job, plane_made_from(plane == std::string("inlet") ? piece - 1 : piece));
+        layer.tag = tag_at(plane == std::string("inlet") ? piece - 1 : piece);
         meshing::write_plane_layer(layer_path(case_dir, piece, plane), layer);
       }
     std::optional<meshing::PlaneLayer> below, above;
     if (piece > 0)
-      below = neighbour_layer(layer_path(case_dir, piece - 1, "outlet"), piece - 1, job,
-                              layer_tag(job, plane_made_from(piece - 1)), progress);
+      below = neighbour_layer(layer_path(case_dir, piece - 1, "outlet"), piece - 1, job, tag_at(piece - 1), progress);
     if (piece + 1 < pieces)
-      above = neighbour_layer(layer_path(case_dir, piece + 1, "inlet"), piece + 1, job,
-                              layer_tag(job, plane_made_from(piece)), progress);
+      above = neighbour_layer(layer_path(case_dir, piece + 1, "inlet"), piece + 1, job, tag_at(piece), progress);
     progress.update(fmt::format("piece {} of {}: polyhedra", piece + 1, pieces));
     meshing::SlabWithLayers whole =
         meshing::slab_with_layers(slab.mesh, below ? &*below : nullptr, above ? &*above : nullptr);
