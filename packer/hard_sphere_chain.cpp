@@ -13,9 +13,22 @@ HardSphereChain::HardSphereChain(const Container& c, double d_max, double grid_h
   ny_ = std::max(1L, static_cast<long>((bounds_[3] - bounds_[1]) / d_max));
   hx_ = (bounds_[2] - bounds_[0]) / static_cast<double>(nx_);
   hy_ = (bounds_[3] - bounds_[1]) / static_cast<double>(ny_);
+  d_max_ = d_max;
+  if (per_.lz > 0.0) {
+    lid_ = std::numeric_limits<double>::infinity();
+    grid_period();
+    return;
+  }
   hz_ = d_max;
   nz_ = std::clamp(static_cast<long>(grid_height / d_max) + 1, 1L, 1L << 20);
   cells_.assign(static_cast<std::size_t>(nx_ * ny_ * nz_), {});
+}
+
+void HardSphereChain::grid_period() {
+  nz_ = std::clamp(static_cast<long>(per_.lz / d_max_), 1L, 1L << 20);
+  hz_ = per_.lz / static_cast<double>(nz_);
+  cells_.assign(static_cast<std::size_t>(nx_ * ny_ * nz_), {});
+  for (std::size_t i = 0; i < cell_of_.size(); ++i) insert(static_cast<int>(i), cell_index(x_[i]));
 }
 
 bool HardSphereChain::add(const Eigen::Vector3d& q, double r, double w) {
@@ -59,39 +72,73 @@ void HardSphereChain::remove(int i) {
 }
 
 bool HardSphereChain::inside(int i, const Eigen::Vector3d& p) const {
-  if (p.z() < r_[i] || p.z() > lid_ - r_[i]) return false;
+  if (per_.lz == 0.0 && (p.z() < r_[i] || p.z() > lid_ - r_[i])) return false;
   WallContact w[Container::kMaxWallContacts];
   return c_.wall_contacts(p, r_[i], w) == 0;
 }
 
-bool HardSphereChain::overlaps_any(int i, const Eigen::Vector3d& p) const {
-  const long cell = cell_index(p);
+template <class Visit>
+void HardSphereChain::near(long cell, long layers, Visit visit) const {
   const long cx = cell % nx_, cy = (cell / nx_) % ny_, cz = cell / (nx_ * ny_);
-  // Along a periodic side the grid wraps; with fewer than 3 cells across, every cell of that
-  // row is a neighbour and must be visited once.
-  auto range = [](long c, long n, bool periodic, long& lo, long& hi) {
-    if (periodic && n < 3) lo = 0, hi = n - 1;
-    else lo = c - 1, hi = c + 1;
+  // Along a periodic side the grid wraps; with too few cells across, every cell of that row is
+  // a neighbour and must be visited once.
+  auto range = [](long c, long n, long reach, bool periodic, long& lo, long& hi) {
+    if (periodic && n < 2 * reach + 1) lo = 0, hi = n - 1;
+    else lo = c - reach, hi = c + reach;
   };
-  long x0, x1, y0, y1;
-  range(cx, nx_, per_.lx > 0.0, x0, x1);
-  range(cy, ny_, per_.ly > 0.0, y0, y1);
-  // The top layer holds everything above it: a sphere there may touch any sphere in the layer.
-  for (long Z = std::max(0L, cz - 1); Z <= std::min(nz_ - 1, cz + 1); ++Z)
+  long x0, x1, y0, y1, z0, z1;
+  range(cx, nx_, 1, per_.lx > 0.0, x0, x1);
+  range(cy, ny_, 1, per_.ly > 0.0, y0, y1);
+  range(cz, nz_, layers, per_.lz > 0.0, z0, z1);
+  // Without a period along z the top layer holds everything above it: a sphere there may
+  // touch any sphere in the layer.
+  auto wrap = [](long c, long n, bool periodic, long& out) {
+    if (periodic) out = (c % n + n) % n;
+    else if (c < 0 || c >= n) return false;
+    else out = c;
+    return true;
+  };
+  for (long Z = z0; Z <= z1; ++Z)
     for (long Y = y0; Y <= y1; ++Y)
       for (long X = x0; X <= x1; ++X) {
-        long xx = X, yy = Y;
-        if (per_.lx > 0.0) xx = (X + nx_) % nx_;
-        else if (X < 0 || X >= nx_) continue;
-        if (per_.ly > 0.0) yy = (Y + ny_) % ny_;
-        else if (Y < 0 || Y >= ny_) continue;
-        for (int j : cells_[(Z * ny_ + yy) * nx_ + xx]) {
-          if (j == i) continue;
-          const double reach = r_[i] + r_[j];
-          if (per_.separation(p, x_[j]).squaredNorm() < reach * reach) return true;
-        }
+        long xx, yy, zz;
+        if (!wrap(X, nx_, per_.lx > 0.0, xx) || !wrap(Y, ny_, per_.ly > 0.0, yy) || !wrap(Z, nz_, per_.lz > 0.0, zz))
+          continue;
+        for (int j : cells_[(zz * ny_ + yy) * nx_ + xx]) visit(j);
       }
-  return false;
+}
+
+bool HardSphereChain::overlaps_any(int i, const Eigen::Vector3d& p) const {
+  bool hit = false;
+  near(cell_index(p), 1, [&](int j) {
+    if (j == i || hit) return;
+    const double reach = r_[i] + r_[j];
+    hit = per_.separation(p, x_[j]).squaredNorm() < reach * reach;
+  });
+  return hit;
+}
+
+double HardSphereChain::feasible_compression() const {
+  // Scaling heights by s brings a pair (dx, dy, dz) into contact when
+  // dx^2 + dy^2 + s^2 dz^2 = (r_i + r_j)^2; two layers reach |dz| up to 2 d_max, beyond which
+  // no pair can touch for s >= 0.5.
+  double s = 0.0;
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    near(cell_of_[i], 2, [&](int j) {
+      if (j <= static_cast<int>(i)) return;
+      const Eigen::Vector3d sep = per_.separation(x_[i], x_[j]);
+      const double reach = r_[i] + r_[j], lateral = sep.x() * sep.x() + sep.y() * sep.y();
+      if (lateral < reach * reach && sep.z() != 0.0)
+        s = std::max(s, std::sqrt((reach * reach - lateral) / (sep.z() * sep.z())));
+    });
+  return s;
+}
+
+void HardSphereChain::compress_to(double period) {
+  const double s = period / per_.lz;
+  per_.lz = period;
+  for (auto& q : x_) q = per_.wrapped(Eigen::Vector3d(q.x(), q.y(), q.z() * s));
+  grid_period();
 }
 
 double HardSphereChain::cycle(double temperature, bool gravity) {

@@ -23,7 +23,9 @@ class HardSphereChain {
  public:
   // An empty chain in `c` (packing units). `d_max`: largest diameter to come (sets the grid);
   // `grid_height`: height the grid covers (anything above shares its top layer); `lid`: height
-  // of a closed top (infinity for none); `seed`: the chain's random stream.
+  // of a closed top (infinity for none); `seed`: the chain's random stream. A container periodic
+  // along z (c.axial_period() > 0) has neither floor nor lid: the grid covers one period and
+  // wraps, and `grid_height` and `lid` are not used.
   HardSphereChain(const Container& c, double d_max, double grid_height, double lid, std::uint64_t seed);
 
   // Adds a sphere (centre p, radius r, relative effective mass w) if it lies inside and
@@ -45,6 +47,14 @@ class HardSphereChain {
   void lift(double height, double dilation);
   void set_lid(double lid) { lid_ = lid; }
 
+  // Along a periodic axis: the period, and the least factor s by which every height and the
+  // period can be scaled (z -> s z) without two spheres overlapping (0 when no pair stands in
+  // the way). Pairs are sought up to two grid layers apart, so s is exact down to 0.5.
+  double period() const { return per_.lz; }
+  double feasible_compression() const;
+  // Scales every height and the period to `period` (at least period() x feasible_compression()).
+  void compress_to(double period);
+
   const std::vector<Eigen::Vector3d>& positions() const { return x_; }
   // sum w_i z_i / sum w_i: the mass centre, whose drop measures settling.
   double mass_centre() const;
@@ -65,7 +75,14 @@ class HardSphereChain {
   std::vector<long> cell_of_;  // per sphere
   std::vector<int> slot_;      // position of the sphere in its cell's vector
 
+  double d_max_;
   long cell_index(const Eigen::Vector3d& p) const;
+  // The grid over one period along a periodic axis: layers at least d_max_ high.
+  void grid_period();
+  // Calls visit(j) for each sphere in the cells within `layers` grid layers of `cell` and one
+  // cell across (every cell of a periodic row shorter than 2 layers + 1).
+  template <class Visit>
+  void near(long cell, long layers, Visit visit) const;
   void insert(int i, long cell);
   void remove(int i);
   bool overlaps_any(int i, const Eigen::Vector3d& p) const;

@@ -77,6 +77,11 @@ namespace {
 // Random sequential placement below the lid stops working near a solid fraction of 0.38 (its
 // jamming limit); 0.30 leaves room for the walls' excluded volume.
 constexpr double kMaxPlacementSolidFraction = 0.30;
+// A periodic section's compression: cycles without gravity between two compressions, and the
+// share of moves accepted they aim at (small moves that often succeed even out the gaps along z
+// faster than the settling's large ones; docs/monte_carlo.md, periodic sections).
+constexpr long kCompressionBlockCycles = 5;
+constexpr double kCompressionAcceptance = 0.3;
 
 }  // namespace
 
@@ -120,11 +125,19 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
     solid += std::numbers::pi / 6.0 * std::pow(di / d_ref, 3);
   }
 
-  // (a) Placement below the lid, then mixing without gravity.
-  const double lid = params.mixing_height_d ? *params.mixing_height_d
-                                            : solid / (box->cross_section_area() * (1.0 - params.initial_void_fraction));
+  // (a) Placement below the lid, then mixing without gravity. A periodic section has no floor to
+  // settle on: its spheres are placed in a period long enough for random placement, mixed, and
+  // compressed to the asked period instead of shaken (b').
+  const double period = box->axial_period();
+  if (period > 0.0) {
+    resolved.shakes = 0;
+    box->set_axial_period(std::max(period, solid / (box->cross_section_area() * kMaxPlacementSolidFraction)));
+  }
+  const double lid = period > 0.0             ? box->axial_period()
+                     : params.mixing_height_d ? *params.mixing_height_d
+                                              : solid / (box->cross_section_area() * (1.0 - params.initial_void_fraction));
   const double fraction = solid / (box->cross_section_area() * lid);
-  if (fraction > kMaxPlacementSolidFraction)
+  if (period == 0.0 && fraction > kMaxPlacementSolidFraction)
     throw InputError(fmt::format("packing.monte_carlo.{}: {} spheres fill {:.3f} of the volume below the mixing lid "
                                  "({:.4g} d high); allowed: at most {} (random placement jams near 0.38), so raise "
                                  "it",
@@ -135,8 +148,11 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   for (std::size_t i = 0; i < r.size(); ++i) {
     bool placed = false;
     for (int attempt = 0; attempt < 100'000 && !placed; ++attempt) {
+      // A period with no room left (the walls' excluded volume) is stretched by a tenth.
+      if (period > 0.0 && attempt > 0 && attempt % 1000 == 0) chain.compress_to(1.1 * chain.period());
       const Eigen::Vector2d xy = box->sample_centre(rng, r[i]);
-      placed = chain.add({xy.x(), xy.y(), r[i] + (lid - 2.0 * r[i]) * rng.uniform()}, r[i], w[i]);
+      const double z = period > 0.0 ? chain.period() * rng.uniform() : r[i] + (lid - 2.0 * r[i]) * rng.uniform();
+      placed = chain.add({xy.x(), xy.y(), z}, r[i], w[i]);
     }
     if (!placed)
       throw InputError(fmt::format("could not place sphere {} of {} (d = {:.4g} m) below the mixing lid in 100000 "
@@ -144,10 +160,11 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
                                    i + 1, count, d[i]));
   }
 
-  const double t_star = params.temperature, target = params.target_acceptance;
+  const double placed_period = chain.period();
+  const double t_star = params.temperature, target = period > 0.0 ? kCompressionAcceptance : params.target_acceptance;
   const double delta_lo = 1e-4 * d_min, delta_hi = params.max_displacement_d * d_min;
   chain.set_displacement(delta_hi);
-  const long total_cycles = params.mixing_cycles + params.settling_cycles + shake_count * params.max_settle_cycles;
+  const long total_cycles = params.mixing_cycles + params.settling_cycles + resolved.shakes.value() * params.max_settle_cycles;
   long cycles = 0;
   nlohmann::json history = nlohmann::json::array(), shakes = nlohmann::json::array();
   nlohmann::json stages = nlohmann::json::object();
@@ -164,8 +181,10 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
                          {"mass_centre_d", chain.mass_centre()},
                          {"acceptance", a},
                          {"max_displacement_d", chain.displacement() / d_min}});
-      progress.update(fmt::format("monte carlo, {} stage, cycle {}, mass centre {:.4f} d, acceptance {:.2f}", stage,
-                                  cycles, chain.mass_centre(), a),
+      if (period > 0.0) history.back()["period_d"] = chain.period();
+      const std::string where = period > 0.0 ? fmt::format("period {:.4f} d", chain.period())
+                                             : fmt::format("mass centre {:.4f} d", chain.mass_centre());
+      progress.update(fmt::format("monte carlo, {} stage, cycle {}, {}, acceptance {:.2f}", stage, cycles, where, a),
                       std::min(1.0, static_cast<double>(cycles) / static_cast<double>(std::max(1L, total_cycles))));
     }
   };
@@ -181,11 +200,32 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   });
   chain.set_lid(std::numeric_limits<double>::infinity());
 
+  // (b') A periodic section: blocks of cycles without gravity, each followed by the period's
+  // shrinking halfway to where the nearest pair along z would touch, down to the asked period,
+  // within settling_cycles.
+  if (period > 0.0)
+    timed("compression", [&] {
+      long used = 0;
+      while (chain.period() > period) {
+        if (used >= params.settling_cycles) {
+          const double reached = solid / (box->cross_section_area() * chain.period());
+          throw ConvergenceError(fmt::format(
+              "the Monte Carlo periodic section stopped at a solid fraction of {:.4f} (period {:.4g} d) after {} "
+              "compression cycles (packing.monte_carlo.settling_cycles), short of the asked {:.4f} (period {:.4g} "
+              "d); allowed: fewer spheres (particles.count), a longer container.period_z_d, or more settling_cycles",
+              reached, chain.period(), used, solid / (box->cross_section_area() * period), period));
+        }
+        for (long c = 0; c < kCompressionBlockCycles; ++c, ++used) run(false, "compression");
+        const double towards = 0.5 * (1.0 + std::max(0.5, chain.feasible_compression()));
+        chain.compress_to(std::max(period, chain.period() * towards));
+      }
+    });
+
   // (b) Shakes, each settled until the mass centre stops falling.
   const double settle_tol = params.settle_tolerance_d * d_min;
   long unsettled = 0;
   timed("shaking", [&] {
-    for (long k = 0; k < shake_count; ++k) {
+    for (long k = 0; k < resolved.shakes.value(); ++k) {
       chain.lift(amplitude, params.shake_dilation);
       double before = chain.mass_centre();
       long used = 0;
@@ -203,9 +243,10 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   });
 
   // (c) Final settling cycles under gravity.
-  timed("settling", [&] {
-    for (long c = 0; c < params.settling_cycles; ++c) run(true, "settling");
-  });
+  if (period == 0.0)
+    timed("settling", [&] {
+      for (long c = 0; c < params.settling_cycles; ++c) run(true, "settling");
+    });
   progress.finish();
 
   // Check the promise exactly, with the neighbour list rather than the chain's own grid.
@@ -219,7 +260,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
     WallContact wc[Container::kMaxWallContacts];
     const int nw = box->wall_contacts(x[i], r[i], wc);
     for (int m = 0; m < nw; ++m) worst = std::max(worst, wc[m].overlap);
-    worst = std::max(worst, r[i] - x[i].z());
+    if (period == 0.0) worst = std::max(worst, r[i] - x[i].z());
     if (!x[i].allFinite()) worst = std::numeric_limits<double>::infinity();
   }
   if (!(worst <= 1e-12))
@@ -236,8 +277,8 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
               {"parameters", to_json(resolved)},
               {"reference_diameter_m", d_ref},
               {"smallest_diameter_m", sizes.smallest()},
-              {"mixing_height_d", lid},
-              {"mixing_solid_fraction", fraction},
+              {period > 0.0 ? "placed_period_d" : "mixing_height_d", period > 0.0 ? placed_period : lid},
+              {"mixing_solid_fraction", period > 0.0 ? solid / (box->cross_section_area() * placed_period) : fraction},
               {"cycles", cycles},
               {"moves_per_second", static_cast<double>(cycles) * static_cast<double>(count) / std::max(time, 1e-9)},
               {"cycles_per_second", static_cast<double>(cycles) / std::max(time, 1e-9)},
@@ -248,10 +289,13 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
               {"history", thin_history(history)},
               {"max_overlap_d", std::max(0.0, worst) / d_min},
               {"time_s", time}};
-  out.summary = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {} "
-                            "of {} shakes settled, no overlap",
+  const std::string settled =
+      period > 0.0 ? fmt::format("compressed from a period of {:.4g} d to {:.4g} d", placed_period, period)
+                   : fmt::format("{} of {} shakes settled", shakes.size() - unsettled, shakes.size());
+  out.summary = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {}, "
+                            "no overlap",
                             x.size(), container.kind(), cycles, out.info["cycles_per_second"].get<double>(),
-                            out.info["mean_acceptance"].get<double>(), shakes.size() - unsettled, shakes.size());
+                            out.info["mean_acceptance"].get<double>(), settled);
   return out;
 }
 

@@ -52,24 +52,21 @@ void set_period_from_void_fraction(const Scene& sc, Container& c, double d_max) 
                                  key, sc.count, c.axial_period(), 3.0 * d_max));
 }
 
-// What a periodic section (container.period_z) can be given today: the accelerated soft-sphere
-// packer or an imported bed; positions and analysis; no floor-bound packer, no surface yet.
+// What a periodic section (container.period_z) can be packed by: a packer that needs no floor (the
+// accelerated soft-sphere packer, the Monte Carlo packer compressing instead of settling), or an
+// imported bed.
 void check_periodic_section(const Scene& sc, const toml::table& table) {
   const std::string key = sc.soft_sphere.target_void_fraction > 0.0 ? "packing.soft_sphere.target_void_fraction"
                           : !table.contains("container")             ? "the bed file's container record, period_z,"
                           : table["container"]["period_z_m"]          ? "container.period_z_m"
                                                                      : "container.period_z_d";
-  if (sc.algorithm == "monte-carlo")
-    throw InputError(fmt::format("{} is set, but packing.algorithm = \"monte-carlo\" settles spheres on a floor; "
-                                 "allowed with an axial period: \"soft-sphere\" (accelerated) or \"import\"",
-                                 key));
   if (sc.algorithm == "soft-sphere" && sc.soft_sphere.mode == packer::SoftSphereParams::Mode::faithful)
     throw InputError(fmt::format("{} is set, but packing.soft_sphere.mode = \"faithful\" follows Salvat et al.'s "
                                  "schedule, which settles the bed on a floor; allowed with an axial period: "
                                  "\"accelerated\"",
                                  key));
 
-  if (sc.algorithm == "soft-sphere" && sc.sizes.smallest() == sc.sizes.largest()) {
+  if (sc.algorithm != "import" && sc.sizes.smallest() == sc.sizes.largest()) {
     // Equal spheres packed from random positions without friction jam at random close packing.
     const double solid = static_cast<double>(sc.count) * sc.sizes.mean_volume() /
                          (sc.container->cross_section_area() * sc.container->axial_period());

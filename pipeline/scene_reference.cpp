@@ -52,7 +52,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"axial period: the bed repeats along z every period, with neither floor nor top (a periodic section of a long "
         "bed; `particles.count` in one period sets its void fraction); at least 3 largest diameters; packed by the "
         "accelerated soft-sphere packer, which compresses a longer period down to this one without gravity and "
-        "taps them where they jam first, or stops with an error naming the void fraction it jammed at; meshed as a "
+        "taps them where they jam first, or the Monte Carlo packer, which compresses it the same way between blocks of "
+        "cycles without gravity (neither shakes nor settles); each stops with an error naming the void fraction it "
+        "jammed at; meshed as a "
         "cyclic case, its spheres cut by the periodic planes (bridges and caps the planes cross are opened, their "
         "spheres shrunk by `contacts.shrink_factor`, or cut through: `contacts.at_periodic_planes`; enlarge only cut "
         "through)"}},
@@ -122,7 +124,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"a shake also stretches the bed so its top rises this many amplitudes more, every gap opening in proportion to "
         "its height (0: a rigid lift)",
         "1"}},
-      {"packing.monte_carlo.settling_cycles", {"cycles after the last shake"}},
+      {"packing.monte_carlo.settling_cycles",
+       {"cycles after the last shake; on a periodic section (`container.period_z_d`), the cap on the cycles that "
+        "compress it"}},
       {"packing.monte_carlo.settle_block_cycles", {"when a shake has settled: cycles per block compared"}},
       {"packing.monte_carlo.settle_tolerance_d", {"when a shake has settled: largest change of the mean height"}},
       {"packing.monte_carlo.max_settle_cycles", {"when a shake has settled: cap on its cycles"}},

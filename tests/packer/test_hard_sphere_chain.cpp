@@ -150,3 +150,64 @@ TEST(HardSphereChain, AShakeLiftsAndStretchesTheBedWithoutOverlap) {
   chain.lift(1.0, 0.0);
   EXPECT_NEAR(chain.positions()[0].z(), after[0].z() + 1.0, 1e-12);
 }
+
+namespace {
+
+// Largest overlap of any pair across a period `lz` and of the wall (no floor on a periodic axis).
+double worst_periodic_overlap(const std::vector<Eigen::Vector3d>& x, double r, const Container& c, double lz) {
+  Periodicity per;
+  per.lz = lz;
+  double worst = -kInf;
+  for (size_t i = 0; i < x.size(); ++i) {
+    for (size_t j = i + 1; j < x.size(); ++j) worst = std::max(worst, 2 * r - per.separation(x[i], x[j]).norm());
+    WallContact w[Container::kMaxWallContacts];
+    const int n = c.wall_contacts(x[i], r, w);
+    for (int k = 0; k < n; ++k) worst = std::max(worst, w[k].overlap);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(HardSphereChain, CompressesAPeriodicAxisToTheFirstContactExactly) {
+  // Period 6: A and B (lateral 0.6, 1.4 apart in z) touch when heights scale by 0.8 / 1.4 =
+  // 0.571; A and C (lateral 0.8, 0.8 apart only across the period) by 0.6 / 0.8 = 0.75; B and
+  // C never (1.4 apart sideways). So the first contact is across the period, at 0.75.
+  Cylinder cyl(2.0);
+  cyl.set_axial_period(6.0);
+  HardSphereChain chain(cyl, 1.0, 0.0, 0.0, 1);
+  ASSERT_TRUE(chain.add({0.0, 0.0, 0.5}, 0.5, 1.0));
+  ASSERT_TRUE(chain.add({0.6, 0.0, 1.9}, 0.5, 1.0));
+  ASSERT_TRUE(chain.add({-0.8, 0.0, 5.7}, 0.5, 1.0));
+  EXPECT_FALSE(chain.add({0.0, 0.0, 6.3}, 0.5, 1.0));  // at 0.3 a period down: A is there
+  EXPECT_NEAR(chain.feasible_compression(), 0.75, 1e-12);
+  chain.compress_to(6.0 * 0.75);
+  EXPECT_EQ(chain.period(), 4.5);
+  const auto& x = chain.positions();
+  EXPECT_NEAR(x[0].z(), 0.375, 1e-12);
+  EXPECT_NEAR(worst_periodic_overlap(x, 0.5, cyl, 4.5), 0.0, 1e-12);  // touching, not overlapping
+  EXPECT_NEAR(chain.feasible_compression(), 1.0, 1e-12);
+}
+
+TEST(HardSphereChain, CompressedPeriodicSectionsNeverOverlap) {
+  // 40 spheres in a periodic tube (R = 2, period 20 down to 6.5: solid fraction 0.1 to 0.26),
+  // compressed halfway to the first contact between blocks of cycles, as the packer does.
+  Cylinder cyl(2.0);
+  cyl.set_axial_period(20.0);
+  HardSphereChain chain(cyl, 1.0, 0.0, 0.0, 3);
+  Rng rng(5);
+  while (chain.size() < 40) {
+    const Eigen::Vector2d xy = cyl.sample_centre(rng, 0.5);
+    chain.add({xy.x(), xy.y(), 20.0 * rng.uniform()}, 0.5, 1.0);
+  }
+  for (int k = 0; k < 200 && chain.period() > 6.5; ++k) {
+    for (int c = 0; c < 5; ++c) chain.adapt_displacement(chain.cycle(1.0, false), 0.3, 1e-4, 0.5);
+    chain.compress_to(std::max(6.5, chain.period() * 0.5 * (1.0 + std::max(0.5, chain.feasible_compression()))));
+    ASSERT_LE(worst_periodic_overlap(chain.positions(), 0.5, cyl, chain.period()), 1e-12) << "step " << k;
+    for (const auto& p : chain.positions()) {
+      ASSERT_GE(p.z(), 0.0);
+      ASSERT_LT(p.z(), chain.period());
+    }
+  }
+  EXPECT_EQ(chain.period(), 6.5);
+}

@@ -177,3 +177,48 @@ TEST(MonteCarlo, DefaultShakesFollowThePaper) {
   p.shakes = 3;
   EXPECT_EQ(shakes(spheres({0.0012, 0.001}, {0.5, 0.5})), 3u);
 }
+
+TEST(MonteCarlo, PeriodicSectionIsCompressedToItsPeriod) {
+  // a = 5, period 10 d, 200 spheres: a solid fraction of 0.533, below the 0.575 that the packer
+  // reached at 215 spheres (docs/monte_carlo.md); no floor, pairs across the period.
+  Cylinder c(0.0025);
+  c.set_axial_period(0.01);
+  MonteCarloParams p;
+  p.mixing_cycles = 200;
+  const auto r = pack(c, 200, 4, p);
+  expect_valid(r.bed);
+  ASSERT_EQ(r.bed.container->axial_period(), 0.01);
+  const Periodicity per = r.bed.container->periodicity();
+  int across = 0;  // pairs within 0.01 d of touching only through the period
+  for (size_t i = 0; i < r.bed.size(); ++i) {
+    EXPECT_GE(r.bed.centres[i].z(), 0.0);
+    EXPECT_LT(r.bed.centres[i].z(), 0.01);
+    for (size_t j = i + 1; j < r.bed.size(); ++j)
+      across += (r.bed.centres[i] - r.bed.centres[j]).norm() > 0.00101 &&
+                per.separation(r.bed.centres[i], r.bed.centres[j]).norm() < 0.00101;
+  }
+  EXPECT_GT(across, 0);
+  EXPECT_EQ(r.info["shakes"].size(), 0u);
+  EXPECT_TRUE(r.info["stages"].contains("compression"));
+  EXPECT_GT(r.info["placed_period_d"].get<double>(), 10.0);
+  EXPECT_EQ(pack(c, 200, 4, p).bed.centres, r.bed.centres);  // the same seed, the same section
+}
+
+TEST(MonteCarlo, PeriodicSectionThatJamsStopsWithItsSolidFraction) {
+  // 230 spheres in 10 d of an a = 5 tube (solid fraction 0.613) within 2000 compression cycles:
+  // a clear error naming the fraction reached and the keys to change, not a hang.
+  Cylinder c(0.0025);
+  c.set_axial_period(0.01);
+  MonteCarloParams p;
+  p.mixing_cycles = 20;
+  p.settling_cycles = 2000;
+  try {
+    pack(c, 230, 1, p);
+    FAIL() << "accepted";
+  } catch (const ConvergenceError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("solid fraction of 0."), std::string::npos) << m;
+    EXPECT_NE(m.find("settling_cycles"), std::string::npos) << m;
+    EXPECT_NE(m.find("container.period_z_d"), std::string::npos) << m;
+  }
+}
