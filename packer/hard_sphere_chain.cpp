@@ -78,7 +78,7 @@ bool HardSphereChain::inside(int i, const Eigen::Vector3d& p) const {
 }
 
 template <class Visit>
-void HardSphereChain::near(long cell, long layers, Visit visit) const {
+bool HardSphereChain::near(long cell, long layers, Visit visit) const {
   const long cx = cell % nx_, cy = (cell / nx_) % ny_, cz = cell / (nx_ * ny_);
   // Along a periodic side the grid wraps; with too few cells across, every cell of that row is
   // a neighbour and must be visited once.
@@ -104,18 +104,17 @@ void HardSphereChain::near(long cell, long layers, Visit visit) const {
         long xx, yy, zz;
         if (!wrap(X, nx_, per_.lx > 0.0, xx) || !wrap(Y, ny_, per_.ly > 0.0, yy) || !wrap(Z, nz_, per_.lz > 0.0, zz))
           continue;
-        for (int j : cells_[(zz * ny_ + yy) * nx_ + xx]) visit(j);
+        for (int j : cells_[(zz * ny_ + yy) * nx_ + xx])
+          if (visit(j)) return true;
       }
+  return false;
 }
 
 bool HardSphereChain::overlaps_any(int i, const Eigen::Vector3d& p) const {
-  bool hit = false;
-  near(cell_index(p), 1, [&](int j) {
-    if (j == i || hit) return;
+  return near(cell_index(p), 1, [&](int j) {
     const double reach = r_[i] + r_[j];
-    hit = per_.separation(p, x_[j]).squaredNorm() < reach * reach;
+    return j != i && per_.separation(p, x_[j]).squaredNorm() < reach * reach;
   });
-  return hit;
 }
 
 double HardSphereChain::feasible_compression() const {
@@ -125,11 +124,12 @@ double HardSphereChain::feasible_compression() const {
   double s = 0.0;
   for (std::size_t i = 0; i < x_.size(); ++i)
     near(cell_of_[i], 2, [&](int j) {
-      if (j <= static_cast<int>(i)) return;
+      if (j <= static_cast<int>(i)) return false;
       const Eigen::Vector3d sep = per_.separation(x_[i], x_[j]);
       const double reach = r_[i] + r_[j], lateral = sep.x() * sep.x() + sep.y() * sep.y();
       if (lateral < reach * reach && sep.z() != 0.0)
         s = std::max(s, std::sqrt((reach * reach - lateral) / (sep.z() * sep.z())));
+      return false;
     });
   return s;
 }

@@ -80,9 +80,10 @@ class HardSphereChain {
   // The grid over one period along a periodic axis: layers at least d_max_ high.
   void grid_period();
   // Calls visit(j) for each sphere in the cells within `layers` grid layers of `cell` and one
-  // cell across (every cell of a periodic row shorter than 2 layers + 1).
+  // cell across (every cell of a periodic row shorter than 2 layers + 1), until it returns true;
+  // returns whether it did.
   template <class Visit>
-  void near(long cell, long layers, Visit visit) const;
+  bool near(long cell, long layers, Visit visit) const;
   void insert(int i, long cell);
   void remove(int i);
   bool overlaps_any(int i, const Eigen::Vector3d& p) const;

@@ -212,7 +212,8 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
           throw ConvergenceError(fmt::format(
               "the Monte Carlo periodic section stopped at a solid fraction of {:.4f} (period {:.4g} d) after {} "
               "compression cycles (packing.monte_carlo.settling_cycles), short of the asked {:.4f} (period {:.4g} "
-              "d); allowed: fewer spheres (particles.count), a longer container.period_z_d, or more settling_cycles",
+              "d); allowed: fewer spheres (particles.count), a longer container.period_z_d (or period_z_m), or more "
+              "settling_cycles",
               reached, chain.period(), used, solid / (box->cross_section_area() * period), period));
         }
         for (long c = 0; c < kCompressionBlockCycles; ++c, ++used) run(false, "compression");
