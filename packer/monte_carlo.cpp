@@ -83,15 +83,16 @@ constexpr double kMaxPlacementSolidFraction = 0.30;
 constexpr long kCompressionBlockCycles = 5;
 constexpr double kCompressionAcceptance = 0.3;
 
-}  // namespace
+// The spheres to pack, largest first (random placement finds room for them while the container
+// is still empty): diameters (m); radii and buoyancy-corrected masses relative to a sphere of
+// d_ref of the first density, in units of d_ref; their total volume (d_ref^3).
+struct DrawnSpheres {
+  std::vector<double> d, r, w;
+  double solid = 0.0;
+};
 
-PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistribution& sizes, const Container& container,
-                            long long count, std::uint64_t seed, Progress& progress) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const double d_ref = sizes.sauter_mean(), d_min = sizes.smallest() / d_ref;
-  const auto box = container.scaled(1.0 / d_ref);
-
-  // Species and their buoyancy-corrected masses, relative to a sphere of d_ref of the first density.
+DrawnSpheres draw_spheres(const MonteCarloParams& params, const SizeDistribution& sizes, long long count, double d_ref,
+                     Rng& rng) {
   const bool per_species = params.particle_density.size() > 1;
   if (per_species && (sizes.kind != SizeDistribution::Kind::discrete ||
                       sizes.diameters_m.size() != params.particle_density.size()))
@@ -99,16 +100,6 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
                                  "a discrete mixture (particles.diameters has {})",
                                  params.particle_density.size(),
                                  sizes.kind == SizeDistribution::Kind::discrete ? sizes.diameters_m.size() : 0));
-  // The paper's schedule unless the scene sets the shakes: 10 for equal spheres, 100 for
-  // mixtures of sizes or densities (Abreu et al. 1999, step b). The report records the number.
-  const bool equal_spheres = !per_species && sizes.smallest() == sizes.largest();
-  const long shake_count = params.shakes.value_or(equal_spheres ? 10 : 100);
-  MonteCarloParams resolved = params;
-  resolved.shakes = shake_count;
-  Rng rng(seed);
-  std::vector<double> d = sizes.sample(count, rng);
-  // Largest first: random placement finds room for them while the container is still empty.
-  std::stable_sort(d.begin(), d.end(), std::greater<>());
   auto density_of = [&](double di) {
     if (!per_species) return params.particle_density[0];
     std::size_t k = 0;
@@ -116,27 +107,193 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
       if (std::abs(sizes.diameters_m[s] - di) < std::abs(sizes.diameters_m[k] - di)) k = s;
     return params.particle_density[k];
   };
+  DrawnSpheres out;
+  out.d = sizes.sample(count, rng);
+  std::stable_sort(out.d.begin(), out.d.end(), std::greater<>());
   const double ref_excess = params.particle_density[0] - params.fluid_density;
-  std::vector<double> r, w;
-  double solid = 0.0;
-  for (double di : d) {
-    r.push_back(0.5 * di / d_ref);
-    w.push_back((density_of(di) - params.fluid_density) / ref_excess * std::pow(di / d_ref, 3));
-    solid += std::numbers::pi / 6.0 * std::pow(di / d_ref, 3);
+  for (double di : out.d) {
+    out.r.push_back(0.5 * di / d_ref);
+    out.w.push_back((density_of(di) - params.fluid_density) / ref_excess * std::pow(di / d_ref, 3));
+    out.solid += std::numbers::pi / 6.0 * std::pow(di / d_ref, 3);
   }
+  return out;
+}
 
-  // (a) Placement below the lid, then mixing without gravity. A periodic section has no floor to
-  // settle on: its spheres are placed in a period long enough for random placement, mixed, and
-  // compressed to the asked period instead of shaken (b').
-  const double period = box->axial_period();
-  if (period > 0.0) {
-    resolved.shakes = 0;
-    box->set_axial_period(std::max(period, solid / (box->cross_section_area() * kMaxPlacementSolidFraction)));
+// Places `s` at random, one after the other, below `lid` (d_ref units; or anywhere in the
+// chain's period, which is stretched by a tenth whenever a sphere finds no room in 1000 trials:
+// the walls' excluded volume).
+void place_spheres(HardSphereChain& chain, const Container& box, const DrawnSpheres& s, double lid, Rng& rng) {
+  const bool periodic = box.axial_period() > 0.0;
+  for (std::size_t i = 0; i < s.r.size(); ++i) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 100'000 && !placed; ++attempt) {
+      if (periodic && attempt > 0 && attempt % 1000 == 0) chain.compress_to(1.1 * chain.period());
+      const Eigen::Vector2d xy = box.sample_centre(rng, s.r[i]);
+      const double z = periodic ? chain.period() * rng.uniform() : s.r[i] + (lid - 2.0 * s.r[i]) * rng.uniform();
+      placed = chain.add({xy.x(), xy.y(), z}, s.r[i], s.w[i]);
+    }
+    if (!placed)
+      throw InputError(fmt::format("could not place sphere {} of {} (d = {:.4g} m) below the mixing lid in 100000 "
+                                   "random trials; raise packing.monte_carlo.initial_void_fraction or mixing_height_d",
+                                   i + 1, s.r.size(), s.d[i]));
   }
+}
+
+// Runs the chain's cycles, adapting its step to a target acceptance, and keeps what the report
+// and the progress line show of them: a history row every 100 cycles, each stage's cycles and
+// time.
+class CycleRunner {
+ public:
+  // `t0`: when the packing started, which the history's times count from.
+  CycleRunner(HardSphereChain& chain, Progress& progress, std::chrono::steady_clock::time_point t0, double temperature,
+              double target, double delta_lo, double delta_hi, double d_min, long total_cycles)
+      : chain_(chain), progress_(progress), t0_(t0), t_star_(temperature), target_(target), delta_lo_(delta_lo),
+        delta_hi_(delta_hi), d_min_(d_min), total_(total_cycles), periodic_(chain.period() > 0.0) {
+    chain_.set_displacement(delta_hi);
+  }
+  // One cycle, with or without gravity, of the stage named.
+  void run(bool gravity, const char* stage) {
+    const double a = chain_.cycle(t_star_, gravity);
+    chain_.adapt_displacement(a, target_, delta_lo_, delta_hi_);
+    acceptance_sum_ += a;
+    if (++cycles_ % 100 == 0) {
+      history_.push_back({{"cycle", cycles_},
+                          {"time_s", elapsed()},
+                          {"stage", stage},
+                          {"mass_centre_d", chain_.mass_centre()},
+                          {"acceptance", a},
+                          {"max_displacement_d", chain_.displacement() / d_min_}});
+      if (periodic_) history_.back()["period_d"] = chain_.period();
+      const std::string where = periodic_ ? fmt::format("period {:.4f} d", chain_.period())
+                                          : fmt::format("mass centre {:.4f} d", chain_.mass_centre());
+      progress_.update(fmt::format("monte carlo, {} stage, cycle {}, {}, acceptance {:.2f}", stage, cycles_, where, a),
+                       std::min(1.0, static_cast<double>(cycles_) / static_cast<double>(std::max(1L, total_))));
+    }
+  }
+  // `body`, its cycles and time recorded as the stage named.
+  template <class Body>
+  void timed(const char* stage, Body body) {
+    const auto s0 = std::chrono::steady_clock::now();
+    const long c0 = cycles_;
+    body();
+    stages_[stage] = {{"cycles", cycles_ - c0},
+                      {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count()}};
+  }
+  double elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+  long cycles() const { return cycles_; }
+  double mean_acceptance() const { return cycles_ ? acceptance_sum_ / static_cast<double>(cycles_) : 0.0; }
+  const nlohmann::json& history() const { return history_; }
+  const nlohmann::json& stages() const { return stages_; }
+
+ private:
+  HardSphereChain& chain_;
+  Progress& progress_;
+  const std::chrono::steady_clock::time_point t0_;
+  const double t_star_, target_, delta_lo_, delta_hi_, d_min_;
+  const long total_;
+  const bool periodic_;
+  long cycles_ = 0;
+  double acceptance_sum_ = 0.0;
+  nlohmann::json history_ = nlohmann::json::array(), stages_ = nlohmann::json::object();
+};
+
+// (b) and (c) for a bed on a floor: `shakes` shakes, each settled until the mass centre stops
+// falling, then the settling cycles. Returns one row per shake.
+nlohmann::json shake_and_settle(CycleRunner& runner, HardSphereChain& chain, const MonteCarloParams& params,
+                                long shakes, double d_min) {
+  const double amplitude = params.shake_amplitude_d * d_min, settle_tol = params.settle_tolerance_d * d_min;
+  nlohmann::json rows = nlohmann::json::array();
+  runner.timed("shaking", [&] {
+    for (long k = 0; k < shakes; ++k) {
+      chain.lift(amplitude, params.shake_dilation);
+      double before = chain.mass_centre();
+      long used = 0;
+      bool settled = false;
+      while (!settled && used < params.max_settle_cycles) {
+        for (long c = 0; c < params.settle_block_cycles && used < params.max_settle_cycles; ++c, ++used)
+          runner.run(true, "shaking");
+        const double now = chain.mass_centre();
+        settled = before - now < settle_tol;
+        before = now;
+      }
+      rows.push_back({{"shake", k + 1}, {"cycles", used}, {"settled", settled}, {"mass_centre_d", before}});
+    }
+  });
+  runner.timed("settling", [&] {
+    for (long c = 0; c < params.settling_cycles; ++c) runner.run(true, "settling");
+  });
+  return rows;
+}
+
+// (b') A periodic section, which has no floor to settle on: blocks of cycles without gravity,
+// each followed by the period's shrinking halfway to where the nearest pair along z would touch,
+// down to `period`, within settling_cycles. `solid` and `area` (d_ref units) give the solid
+// fraction the error names.
+void compress_to_period(CycleRunner& runner, HardSphereChain& chain, const MonteCarloParams& params, double period,
+                        double solid, double area) {
+  runner.timed("compression", [&] {
+    long used = 0;
+    while (chain.period() > period) {
+      if (used >= params.settling_cycles)
+        throw ConvergenceError(fmt::format(
+            "the Monte Carlo periodic section stopped at a solid fraction of {:.4f} (period {:.4g} d) after {} "
+            "compression cycles (packing.monte_carlo.settling_cycles), short of the asked {:.4f} (period {:.4g} "
+            "d); allowed: fewer spheres (particles.count), a longer container.period_z_d (or period_z_m), or more "
+            "settling_cycles",
+            solid / (area * chain.period()), chain.period(), used, solid / (area * period), period));
+      for (long c = 0; c < kCompressionBlockCycles; ++c, ++used) runner.run(false, "compression");
+      const double towards = 0.5 * (1.0 + std::max(0.5, chain.feasible_compression()));
+      chain.compress_to(std::max(period, chain.period() * towards));
+    }
+  });
+}
+
+// The largest overlap of the packed spheres `x` (radii `r`, d_ref units) with each other, the
+// walls and (on a floor) the floor, checked with the neighbour list rather than the chain's own
+// grid; infinite when a centre is not finite.
+double worst_overlap(const std::vector<Eigen::Vector3d>& x, const std::vector<double>& r, const Container& box,
+                     double d_min) {
+  NeighbourList nl(0.01 * d_min);
+  nl.build(x, r, box);
+  const Periodicity per = box.periodicity();
+  const bool floor = box.axial_period() == 0.0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int j : nl.of(i)) worst = std::max(worst, r[i] + r[j] - per.separation(x[i], x[j]).norm());
+    WallContact wc[Container::kMaxWallContacts];
+    const int nw = box.wall_contacts(x[i], r[i], wc);
+    for (int m = 0; m < nw; ++m) worst = std::max(worst, wc[m].overlap);
+    if (floor) worst = std::max(worst, r[i] - x[i].z());
+    if (!x[i].allFinite()) worst = std::numeric_limits<double>::infinity();
+  }
+  return worst;
+}
+
+}  // namespace
+
+PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistribution& sizes, const Container& container,
+                            long long count, std::uint64_t seed, Progress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double d_ref = sizes.sauter_mean(), d_min = sizes.smallest() / d_ref;
+  const auto box = container.scaled(1.0 / d_ref);
+  Rng rng(seed);
+  const DrawnSpheres s = draw_spheres(params, sizes, count, d_ref, rng);
+  const double area = box->cross_section_area();
+  // The paper's schedule unless the scene sets the shakes: 10 for equal spheres, 100 for
+  // mixtures of sizes or densities (Abreu et al. 1999, step b); a periodic section is compressed
+  // instead (b'). The report records the number.
+  const double period = box->axial_period();
+  const bool equal_spheres = params.particle_density.size() == 1 && sizes.smallest() == sizes.largest();
+  MonteCarloParams resolved = params;
+  resolved.shakes = period > 0.0 ? 0 : params.shakes.value_or(equal_spheres ? 10 : 100);
+
+  // (a) Placement below the lid, then mixing without gravity. A periodic section is placed in a
+  // period long enough for random placement.
+  if (period > 0.0) box->set_axial_period(std::max(period, s.solid / (area * kMaxPlacementSolidFraction)));
   const double lid = period > 0.0             ? box->axial_period()
                      : params.mixing_height_d ? *params.mixing_height_d
-                                              : solid / (box->cross_section_area() * (1.0 - params.initial_void_fraction));
-  const double fraction = solid / (box->cross_section_area() * lid);
+                                              : s.solid / (area * (1.0 - params.initial_void_fraction));
+  const double fraction = s.solid / (area * lid);
   if (period == 0.0 && fraction > kMaxPlacementSolidFraction)
     throw InputError(fmt::format("packing.monte_carlo.{}: {} spheres fill {:.3f} of the volume below the mixing lid "
                                  "({:.4g} d high); allowed: at most {} (random placement jams near 0.38), so raise "
@@ -144,126 +301,26 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
                                  params.mixing_height_d ? "mixing_height_d" : "initial_void_fraction", count, fraction,
                                  lid, kMaxPlacementSolidFraction));
   const double amplitude = params.shake_amplitude_d * d_min;
-  HardSphereChain chain(*box, 2.0 * r.front(), lid + 2.0 * amplitude + 2.0, lid, seed ^ 0x5DEECE66DULL);
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    bool placed = false;
-    for (int attempt = 0; attempt < 100'000 && !placed; ++attempt) {
-      // A period with no room left (the walls' excluded volume) is stretched by a tenth.
-      if (period > 0.0 && attempt > 0 && attempt % 1000 == 0) chain.compress_to(1.1 * chain.period());
-      const Eigen::Vector2d xy = box->sample_centre(rng, r[i]);
-      const double z = period > 0.0 ? chain.period() * rng.uniform() : r[i] + (lid - 2.0 * r[i]) * rng.uniform();
-      placed = chain.add({xy.x(), xy.y(), z}, r[i], w[i]);
-    }
-    if (!placed)
-      throw InputError(fmt::format("could not place sphere {} of {} (d = {:.4g} m) below the mixing lid in 100000 "
-                                   "random trials; raise packing.monte_carlo.initial_void_fraction or mixing_height_d",
-                                   i + 1, count, d[i]));
-  }
-
+  HardSphereChain chain(*box, 2.0 * s.r.front(), lid + 2.0 * amplitude + 2.0, lid, seed ^ 0x5DEECE66DULL);
+  place_spheres(chain, *box, s, lid, rng);
   const double placed_period = chain.period();
-  const double t_star = params.temperature, target = period > 0.0 ? kCompressionAcceptance : params.target_acceptance;
-  const double delta_lo = 1e-4 * d_min, delta_hi = params.max_displacement_d * d_min;
-  chain.set_displacement(delta_hi);
-  const long total_cycles = params.mixing_cycles + params.settling_cycles + resolved.shakes.value() * params.max_settle_cycles;
-  long cycles = 0;
-  nlohmann::json history = nlohmann::json::array(), shakes = nlohmann::json::array();
-  nlohmann::json stages = nlohmann::json::object();
-  double acceptance_sum = 0.0;
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  auto run = [&](bool gravity, const char* stage) {
-    const double a = chain.cycle(t_star, gravity);
-    chain.adapt_displacement(a, target, delta_lo, delta_hi);
-    acceptance_sum += a;
-    if (++cycles % 100 == 0) {
-      history.push_back({{"cycle", cycles},
-                         {"time_s", elapsed()},
-                         {"stage", stage},
-                         {"mass_centre_d", chain.mass_centre()},
-                         {"acceptance", a},
-                         {"max_displacement_d", chain.displacement() / d_min}});
-      if (period > 0.0) history.back()["period_d"] = chain.period();
-      const std::string where = period > 0.0 ? fmt::format("period {:.4f} d", chain.period())
-                                             : fmt::format("mass centre {:.4f} d", chain.mass_centre());
-      progress.update(fmt::format("monte carlo, {} stage, cycle {}, {}, acceptance {:.2f}", stage, cycles, where, a),
-                      std::min(1.0, static_cast<double>(cycles) / static_cast<double>(std::max(1L, total_cycles))));
-    }
-  };
-  auto timed = [&](const char* stage, auto body) {
-    const auto s0 = std::chrono::steady_clock::now();
-    const long c0 = cycles;
-    body();
-    stages[stage] = {{"cycles", cycles - c0},
-                     {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count()}};
-  };
-  timed("mixing", [&] {
-    for (long c = 0; c < params.mixing_cycles; ++c) run(false, "mixing");
+
+  const long total_cycles = params.mixing_cycles + params.settling_cycles + *resolved.shakes * params.max_settle_cycles;
+  CycleRunner runner(chain, progress, t0, params.temperature, period > 0.0 ? kCompressionAcceptance : params.target_acceptance,
+                     1e-4 * d_min, params.max_displacement_d * d_min, d_min, total_cycles);
+  runner.timed("mixing", [&] {
+    for (long c = 0; c < params.mixing_cycles; ++c) runner.run(false, "mixing");
   });
   chain.set_lid(std::numeric_limits<double>::infinity());
-
-  // (b') A periodic section: blocks of cycles without gravity, each followed by the period's
-  // shrinking halfway to where the nearest pair along z would touch, down to the asked period,
-  // within settling_cycles.
+  nlohmann::json shakes = nlohmann::json::array();
   if (period > 0.0)
-    timed("compression", [&] {
-      long used = 0;
-      while (chain.period() > period) {
-        if (used >= params.settling_cycles) {
-          const double reached = solid / (box->cross_section_area() * chain.period());
-          throw ConvergenceError(fmt::format(
-              "the Monte Carlo periodic section stopped at a solid fraction of {:.4f} (period {:.4g} d) after {} "
-              "compression cycles (packing.monte_carlo.settling_cycles), short of the asked {:.4f} (period {:.4g} "
-              "d); allowed: fewer spheres (particles.count), a longer container.period_z_d (or period_z_m), or more "
-              "settling_cycles",
-              reached, chain.period(), used, solid / (box->cross_section_area() * period), period));
-        }
-        for (long c = 0; c < kCompressionBlockCycles; ++c, ++used) run(false, "compression");
-        const double towards = 0.5 * (1.0 + std::max(0.5, chain.feasible_compression()));
-        chain.compress_to(std::max(period, chain.period() * towards));
-      }
-    });
-
-  // (b) Shakes, each settled until the mass centre stops falling.
-  const double settle_tol = params.settle_tolerance_d * d_min;
-  long unsettled = 0;
-  timed("shaking", [&] {
-    for (long k = 0; k < resolved.shakes.value(); ++k) {
-      chain.lift(amplitude, params.shake_dilation);
-      double before = chain.mass_centre();
-      long used = 0;
-      bool settled = false;
-      while (!settled && used < params.max_settle_cycles) {
-        for (long c = 0; c < params.settle_block_cycles && used < params.max_settle_cycles; ++c, ++used)
-          run(true, "shaking");
-        const double now = chain.mass_centre();
-        settled = before - now < settle_tol;
-        before = now;
-      }
-      unsettled += !settled;
-      shakes.push_back({{"shake", k + 1}, {"cycles", used}, {"settled", settled}, {"mass_centre_d", before}});
-    }
-  });
-
-  // (c) Final settling cycles under gravity.
-  if (period == 0.0)
-    timed("settling", [&] {
-      for (long c = 0; c < params.settling_cycles; ++c) run(true, "settling");
-    });
+    compress_to_period(runner, chain, params, period, s.solid, area);
+  else
+    shakes = shake_and_settle(runner, chain, params, *resolved.shakes, d_min);
   progress.finish();
 
-  // Check the promise exactly, with the neighbour list rather than the chain's own grid.
   std::vector<Eigen::Vector3d> x = chain.positions();
-  NeighbourList nl(0.01 * d_min);
-  nl.build(x, r, *box);
-  const Periodicity per = box->periodicity();
-  double worst = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    for (int j : nl.of(i)) worst = std::max(worst, r[i] + r[j] - per.separation(x[i], x[j]).norm());
-    WallContact wc[Container::kMaxWallContacts];
-    const int nw = box->wall_contacts(x[i], r[i], wc);
-    for (int m = 0; m < nw; ++m) worst = std::max(worst, wc[m].overlap);
-    if (period == 0.0) worst = std::max(worst, r[i] - x[i].z());
-    if (!x[i].allFinite()) worst = std::numeric_limits<double>::infinity();
-  }
+  const double worst = worst_overlap(x, s.r, *box, d_min);
   if (!(worst <= 1e-12))
     throw ConvergenceError(fmt::format("internal error: the Monte Carlo bed has an overlap of {:.3g} d", worst));
 
@@ -271,23 +328,25 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
   out.bed.container = container.scaled(1.0);
   for (std::size_t i = 0; i < x.size(); ++i) {
     out.bed.centres.push_back(x[i] * d_ref);
-    out.bed.diameters.push_back(d[i]);
+    out.bed.diameters.push_back(s.d[i]);
   }
-  const double time = elapsed();
+  long unsettled = 0;
+  for (const auto& row : shakes) unsettled += !row["settled"].get<bool>();
+  const double time = runner.elapsed(), cycles = static_cast<double>(runner.cycles());
   out.info = {{"algorithm", "monte-carlo"},
               {"parameters", to_json(resolved)},
               {"reference_diameter_m", d_ref},
               {"smallest_diameter_m", sizes.smallest()},
               {period > 0.0 ? "placed_period_d" : "mixing_height_d", period > 0.0 ? placed_period : lid},
-              {"mixing_solid_fraction", period > 0.0 ? solid / (box->cross_section_area() * placed_period) : fraction},
-              {"cycles", cycles},
-              {"moves_per_second", static_cast<double>(cycles) * static_cast<double>(count) / std::max(time, 1e-9)},
-              {"cycles_per_second", static_cast<double>(cycles) / std::max(time, 1e-9)},
-              {"mean_acceptance", cycles ? acceptance_sum / static_cast<double>(cycles) : 0.0},
-              {"stages", stages},
+              {"mixing_solid_fraction", period > 0.0 ? s.solid / (area * placed_period) : fraction},
+              {"cycles", runner.cycles()},
+              {"moves_per_second", cycles * static_cast<double>(count) / std::max(time, 1e-9)},
+              {"cycles_per_second", cycles / std::max(time, 1e-9)},
+              {"mean_acceptance", runner.mean_acceptance()},
+              {"stages", runner.stages()},
               {"shakes", shakes},
               {"unsettled_shakes", unsettled},
-              {"history", thin_history(history)},
+              {"history", thin_history(runner.history())},
               {"max_overlap_d", std::max(0.0, worst) / d_min},
               {"time_s", time}};
   const std::string settled =
@@ -295,7 +354,7 @@ PackResult pack_monte_carlo(const MonteCarloParams& params, const SizeDistributi
                    : fmt::format("{} of {} shakes settled", shakes.size() - unsettled, shakes.size());
   out.summary = fmt::format("pack (monte-carlo): {} spheres in a {}, {} cycles ({:.0f} per s), acceptance {:.2f}, {}, "
                             "no overlap",
-                            x.size(), container.kind(), cycles, out.info["cycles_per_second"].get<double>(),
+                            x.size(), container.kind(), runner.cycles(), out.info["cycles_per_second"].get<double>(),
                             out.info["mean_acceptance"].get<double>(), settled);
   return out;
 }
