@@ -97,10 +97,10 @@ std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p,
 // from `lo` to `hi` (m), and its planes lie half a largest diameter beyond their ends, where they
 // cut nothing; on a side where `lo` or `hi` is infinite, the plane is `p`'s own (the scene's
 // inlet or outlet, or its clip plane). Its lengths in d are the bed's (Bed::reference_diameter_m),
-// and its curved walls are ringed at `rings_d` (d above the floor) with the edge of the whole
+// and its walls are ringed at `rings_d` (d above the floor; curved walls with the edge of the whole
 // bed's narrowest wall gap, so that every window of one bed rings a plane with the same vertices:
 // p.ring_wall_gap_m when given (FluidDomainProfile::bed_wall_gap_m; a rank is handed it, and
-// treats only its window), else found by treating the whole bed.
+// treats only its window), else found by treating the whole bed).
 struct CutWindow {
   Bed bed;
   SurfaceParams surface;

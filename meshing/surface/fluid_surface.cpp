@@ -296,14 +296,16 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   }
   const double wall_sag = box ? 0.0 : ring_sagitta(R, wall_edge);
 
-  // Rings on the curved walls at the heights asked (those inside the window), each a height the
-  // STL's rounding keeps: the holes' loops meet them at vertices, moved there alike in the loops'
-  // other owners (a bridge's end, a sphere's cut).
+  // Rings on the walls at the heights asked (those inside the window), each a height the STL's
+  // rounding keeps: the holes' loops meet them at vertices, moved there alike in the loops' other
+  // owners (a bridge's end, a sphere's cut); a box's sides are meshed in strips between those no
+  // hole reaches.
   std::vector<double> rings;
-  if (!p.wall_rings_d.empty() && (box || laid.periodic()))
-    throw std::invalid_argument("build_fluid_surface: wall rings need a cylinder or annulus, not periodic");
+  if (!p.wall_rings_d.empty() && laid.periodic())
+    throw std::invalid_argument("build_fluid_surface: wall rings on a periodic section (its copy laid out is not)");
   for (double h : p.wall_rings_d)
     if (const double z = round_to_ascii_stl(h * d); z > z0 + wall_edge && z < z1 - wall_edge) rings.push_back(z);
+  std::sort(rings.begin(), rings.end());
   if (!rings.empty()) {
     std::unordered_map<PointKey, Eigen::Vector3d, PointKeyHash> moved;
     for (auto& holes : tb.wall_holes)
@@ -404,12 +406,33 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
          {Eigen::Vector3d::UnitX(), {1, -1}, {1, 1}},
          {-Eigen::Vector3d::UnitY(), {-1, -1}, {1, -1}},
          {Eigen::Vector3d::UnitY(), {-1, 1}, {1, 1}}}};
+    // A side with rings is meshed strip by strip between those no hole reaches, so that its row
+    // of vertices there is the strip edge's, the same at every such ring (a periodic section's
+    // seams); at the others only the holes' vertices lie on the ring (snapped above).
+    std::vector<double> strips{z0};
+    for (double z : rings)
+      if (std::none_of(tb.wall_holes.begin(), tb.wall_holes.end(), [z](const std::vector<WallHole>& side) {
+            return std::any_of(side.begin(), side.end(), [z](const WallHole& h) {
+              const auto [lo, hi] = std::minmax_element(h.loop.begin(), h.loop.end(),
+                                                        [](const auto& u, const auto& v) { return u.z() < v.z(); });
+              return lo->z() <= z && hi->z() >= z;
+            });
+          }))
+        strips.push_back(z);
+    strips.push_back(z1);
     for (std::size_t k = 0; k < sides.size(); ++k) {
       const auto& [normal, a, b] = sides[k];
-      const auto loop = box_face_loop({corner(a, z0), corner(b, z0), corner(b, z1), corner(a, z1)}, edge);
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
-      add("wall", Shape::plane, 0.0,
-          [&] { return plane_mesh(frame, {loop}, edge, tb.wall_holes[k], p.growth, true, "wall", field(-1)); });
+      std::vector<std::vector<WallHole>> holes_of(strips.size() - 1);
+      for (const WallHole& h : tb.wall_holes[k])
+        holes_of[std::upper_bound(strips.begin() + 1, strips.end() - 1, h.loop.front().z()) - strips.begin() - 1]
+            .push_back(h);
+      for (std::size_t j = 0; j + 1 < strips.size(); ++j) {
+        const auto loop = box_face_loop(
+            {corner(a, strips[j]), corner(b, strips[j]), corner(b, strips[j + 1]), corner(a, strips[j + 1])}, edge);
+        add("wall", Shape::plane, 0.0,
+            [&] { return plane_mesh(frame, {loop}, edge, holes_of[j], p.growth, true, "wall", field(-1)); });
+      }
     }
   } else {
     add("wall", Shape::cylinder, R, [&] {

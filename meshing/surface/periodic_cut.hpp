@@ -6,8 +6,7 @@ namespace bedforge::meshing {
 
 // Whether build_fluid_surface cuts a periodic section of `bed` under `p` through its treated
 // contacts (build_cut_periodic_surface): contacts.at_periodic_planes = "cut", bridges, caps or
-// enlarge, in a cylinder or annulus (a box's flat sides are not ringed; the scene reader refuses
-// it).
+// enlarge.
 bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 
 // The fluid surface of `bed`, periodic along z (container.axial_period() = H > 0), between two
@@ -18,13 +17,16 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 //
 // How: the spheres whose centres lie from s - W to z1 + W (s = z0 - m, the seam; W =
 // piece_margin_d) are laid out a period apart as an ordinary bed, whole, with an empty end half a
-// diameter deep each side (so no plane of its own cuts a contact), its curved walls ringed at s,
-// z0, s + H and z1, and its surface built (build_fluid_surface) and cut at z0 (cut_by_plane).
-// The section is the part above z0 up to s + H, and the part below z0 from s up, moved up a
-// period. The cut's changes reach no seam (m is kSeamDepthEdges edges, at least kSeamDepthMinD
-// d), and there the repeated layout's surface repeats itself a period on: the spheres and
-// contacts by construction, the wall along its ring; the seam's vertices are taken from the
-// part moved up, so the two join bit for bit. A surface some three times the period's.
+// diameter deep each side (so no plane of its own cuts a contact), its walls ringed at s, z0,
+// s + H and z1 (a box's sides split into strips at the seams), and its surface built
+// (build_fluid_surface) and cut at z0 (cut_by_plane). The section is the part above z0 up to
+// s + H, and the part below z0 from s up, moved up a period. The cut's changes reach no seam (m
+// is at least kSeamDepthEdges edges and kSeamDepthMinD d, more where the seam keeps clear of a
+// height about which a sphere's or contact's mesh is symmetric, and in a box of the contacts
+// with its sides), and there the repeated layout's surface repeats itself a period on: the
+// spheres and contacts by construction, the wall along its ring or strip edge; the seam's
+// vertices are taken from the part moved up, so the two join bit for bit. A surface some three
+// times the period's.
 //   fluid  closed, patches inlet, outlet, wall (inner_wall), particles (m)
 //   bed    the particles' triangles, normals out of the solid: open where the planes cut them
 //   exact_volume_m3  A H less the treated solid of one period: the solid of two periods of the
@@ -33,15 +35,16 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 //   pieces one piece of no known shape (the self-intersection test takes every pair near)
 //   report the layout's surface report with the treatment's figures for one period
 //          (contacts_treated, solid_volume_change_m3, ...) and "periodic_planes_m" with the cut's.
-// InputError naming the key when the period is shorter than twice the seam depth; the errors of
+// InputError naming the key when the period is shorter than twice the seam depth, or when no
+// seam height keeps clear of what it must (a box's side contacts at every height); the errors of
 // build_fluid_surface and cut_by_plane (CutConflict as InputError); std::runtime_error when the
 // layout's surface does not repeat itself at the seam (a defect of ours), saying where.
 inline constexpr double kSeamDepthEdges = 4.0, kSeamDepthMinD = 0.5;
 FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p);
 
 // InputError naming the key when a periodic section in `container` (its axial period set) cannot
-// be cut through its contacts under `p` (contacts.at_periodic_planes = "cut"): a box, or a period
-// shorter than twice the seam depth (d: the reference diameter, m). The scene reader calls it
+// be cut through its contacts under `p` (contacts.at_periodic_planes = "cut"): a period shorter
+// than twice the seam depth (d: the reference diameter, m). The scene reader calls it
 // before any work; build_cut_periodic_surface checks the period again.
 void check_periodic_cut(const Container& container, const SurfaceParams& p, double d);
 

@@ -941,3 +941,86 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked)
     expect_matching_planes(fs, treatment_name(t));
   }
 }
+
+// A sphere capped against the wall whose centre lies exactly at the least seam height (0.8 d
+// below the plane): its mesh is symmetric about that height, so triangles centred on it would be
+// taken by both parts or by neither; the seam moves off it.
+TEST(FluidSurface, APeriodicSeamKeepsOffTheHeightsWhereMeshesAreSymmetric) {
+  auto tube = std::make_shared<Cylinder>(1.5);
+  tube->set_axial_period(3.0);
+  const double side = 0.8 / std::sqrt(2.0);
+  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15},
+                              {side, -0.75 + side, 2.55}, {-0.6, 0.8, 0.7}});
+  SurfaceParams p;
+  p.treatment = p.wall_treatment = Treatment::cap;
+  p.edge_length_d = 0.2;
+  p.contact_edge_length_d = 0.05;
+  p.clip_clearance_d = 0.25;
+  p.cut_at_periodic_planes = true;
+  const FluidSurface fs = build_fluid_surface(b, p);
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
+  EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting);
+  ASSERT_NEAR(fs.report["domain_m"]["inlet_z"].get<double>(), 1.5, 1e-9);
+  const double depth = fs.report["periodic_planes_m"]["seam_depth_d"].get<double>();
+  EXPECT_GT(depth, 0.8);
+  EXPECT_LT(depth, 0.801);
+  expect_matching_planes(fs, "cap");
+}
+
+// The same in a box 3 d square: sphere C touches a side across the plane (its contact's hole is
+// cut there), and sphere G touches another side where the two parts would meet at the least
+// seam depth (0.8 d below the plane, 4 edges of 0.2 d), so they meet lower where G's contact
+// opens the side, keeping half an edge clear of its hole (the sides are meshed in strips split
+// at the seams).
+TEST(FluidSurface, APeriodicPlaneCutsThroughABoxsContactsWhenAsked) {
+  auto box = std::make_shared<Box>(3.0, 3.0, false, false);
+  box->set_axial_period(3.0);
+  const double side = 0.8 / std::sqrt(2.0);
+  const Bed b = column(box, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15},
+                             {side, -0.75 + side, 2.55}, {-1.0, -0.9, 0.72}});
+  const double inf = std::numeric_limits<double>::infinity();
+  for (Treatment t : {Treatment::bridge, Treatment::cap, Treatment::enlarge}) {
+    SurfaceParams p;
+    p.treatment = p.wall_treatment = t;
+    p.edge_length_d = 0.2;
+    p.contact_edge_length_d = 0.05;
+    p.clip_clearance_d = 0.25;
+    p.cut_at_periodic_planes = true;
+    const FluidSurface fs = build_fluid_surface(b, p);
+    const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
+    EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting) << treatment_name(t);
+    EXPECT_EQ(fs.report["periodic_planes_m"]["contacts_opened"].get<long>(), 0) << treatment_name(t);
+    // The seam: bridged or joined to the side, G opens a hole in it, which the seam keeps half an
+    // edge clear of, below the least depth; capped, G leaves the side whole and the seam where it was.
+    const double z0 = fs.report["domain_m"]["inlet_z"].get<double>();
+    const double seam = z0 - fs.report["periodic_planes_m"]["seam_depth_d"].get<double>();
+    double hole_lo = inf, hole_hi = -inf;
+    const TreatedBed plain =
+        treat_contacts(column(std::make_shared<Box>(3.0, 3.0, false, false), b.centres), p, {-inf, inf, false});
+    for (const WallHole& h : plain.wall_holes[0])
+      for (const Eigen::Vector3d& q : h.loop) hole_lo = std::min(hole_lo, q.z()), hole_hi = std::max(hole_hi, q.z());
+    if (t == Treatment::cap) {
+      EXPECT_TRUE(plain.wall_holes[0].empty());
+      EXPECT_NEAR(z0 - seam, 0.8, 1e-3);
+    } else {
+      ASSERT_LT(hole_lo, hole_hi) << treatment_name(t) << ": G makes no hole in the side x = -1.5";
+      EXPECT_GT(z0 - seam, 0.8) << treatment_name(t);
+      for (double z : {seam, seam + 3.0, seam - 3.0})
+        EXPECT_TRUE(z < hole_lo - 0.1 + 1e-9 || z > hole_hi + 0.1 - 1e-9) << treatment_name(t) << " seam " << seam;
+    }
+    // Every contact is treated once, and the volume is exact as in the tube.
+    Bed tall = column(std::make_shared<Box>(3.0, 3.0, false, false), b.centres);
+    tall.centres[5].z() -= 3.0;
+    const nlohmann::json treated = treat_contacts(tall, p, {-inf, inf, false}).report;
+    for (const char* kind : {"particle_particle", "particle_wall"})
+      EXPECT_EQ(fs.report["contacts_treated"][kind].get<long>(), treated["contacts_treated"][kind].get<long>())
+          << treatment_name(t) << " " << kind;
+    const double change = treated["solid_volume_change_m3"].get<double>();
+    const double exact = 9.0 * 3.0 - 7.0 * 4.0 / 3.0 * std::numbers::pi * 0.125 - change;
+    EXPECT_NEAR(fs.exact_volume_m3, exact, 1e-12) << treatment_name(t);
+    const double added = fs.report["chordal_deviation_d"].get<double>() * 7.0 * std::numbers::pi;
+    EXPECT_GT(k.volume, exact - 1e-9) << treatment_name(t);
+    EXPECT_LT(k.volume, exact + added) << treatment_name(t);
+    expect_matching_planes(fs, treatment_name(t));
+  }
+}
