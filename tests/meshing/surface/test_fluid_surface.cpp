@@ -942,22 +942,34 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughTheBridgesAndCapsItCrossesWhenAsked)
   }
 }
 
-// A sphere capped against the wall whose centre lies exactly at the least seam height (0.8 d
-// below the plane): its mesh is symmetric about that height, so triangles centred on it would be
-// taken by both parts or by neither; the seam moves off it.
-TEST(FluidSurface, APeriodicSeamKeepsOffTheHeightsWhereMeshesAreSymmetric) {
-  auto tube = std::make_shared<Cylinder>(1.5);
-  tube->set_axial_period(3.0);
+namespace {
+
+// The last test's six spheres in `c` (period 3 d, a section 3 d wide) with a seventh, G, at `g`.
+Bed with_sphere_g(std::shared_ptr<Container> c, const Eigen::Vector3d& g) {
+  c->set_axial_period(3.0);
   const double side = 0.8 / std::sqrt(2.0);
-  const Bed b = column(tube, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15},
-                              {side, -0.75 + side, 2.55}, {-0.6, 0.8, 0.7}});
+  return column(std::move(c), {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85},
+                               {0.0, -0.75, 0.15}, {side, -0.75 + side, 2.55}, g});
+}
+// Treatment `t` on pairs and walls, cut through at the periodic planes, a surface edge of 0.2 d.
+SurfaceParams cut_through(Treatment t) {
   SurfaceParams p;
-  p.treatment = p.wall_treatment = Treatment::cap;
+  p.treatment = p.wall_treatment = t;
   p.edge_length_d = 0.2;
   p.contact_edge_length_d = 0.05;
   p.clip_clearance_d = 0.25;
   p.cut_at_periodic_planes = true;
-  const FluidSurface fs = build_fluid_surface(b, p);
+  return p;
+}
+
+}  // namespace
+
+// A sphere capped against the wall whose centre lies exactly at the least seam height (0.8 d
+// below the plane): its mesh is symmetric about that height, so triangles centred on it would be
+// taken by both parts or by neither; the seam moves off it.
+TEST(FluidSurface, APeriodicSeamKeepsOffTheHeightsWhereMeshesAreSymmetric) {
+  const Bed b = with_sphere_g(std::make_shared<Cylinder>(1.5), {-0.6, 0.8, 0.7});
+  const FluidSurface fs = build_fluid_surface(b, cut_through(Treatment::cap));
   const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
   EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting);
   ASSERT_NEAR(fs.report["domain_m"]["inlet_z"].get<double>(), 1.5, 1e-9);
@@ -973,19 +985,10 @@ TEST(FluidSurface, APeriodicSeamKeepsOffTheHeightsWhereMeshesAreSymmetric) {
 // opens the side, keeping half an edge clear of its hole (the sides are meshed in strips split
 // at the seams).
 TEST(FluidSurface, APeriodicPlaneCutsThroughABoxsContactsWhenAsked) {
-  auto box = std::make_shared<Box>(3.0, 3.0, false, false);
-  box->set_axial_period(3.0);
-  const double side = 0.8 / std::sqrt(2.0);
-  const Bed b = column(box, {{-0.5, 0.0, 1.5}, {0.5, 0.0, 1.5}, {0.0, 1.0, 1.5}, {0.0, 0.75, 2.85}, {0.0, -0.75, 0.15},
-                             {side, -0.75 + side, 2.55}, {-1.0, -0.9, 0.72}});
+  const Bed b = with_sphere_g(std::make_shared<Box>(3.0, 3.0, false, false), {-1.0, -0.9, 0.72});
   const double inf = std::numeric_limits<double>::infinity();
   for (Treatment t : {Treatment::bridge, Treatment::cap, Treatment::enlarge}) {
-    SurfaceParams p;
-    p.treatment = p.wall_treatment = t;
-    p.edge_length_d = 0.2;
-    p.contact_edge_length_d = 0.05;
-    p.clip_clearance_d = 0.25;
-    p.cut_at_periodic_planes = true;
+    const SurfaceParams p = cut_through(t);
     const FluidSurface fs = build_fluid_surface(b, p);
     const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
     EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting) << treatment_name(t);
