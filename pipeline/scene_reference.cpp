@@ -149,8 +149,7 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"periodic section (container.period_z_d), bridges, caps and unions: what its planes do to the treated "
         "contacts they cross: `open` them (their spheres shrunk by shrink_factor, the contact left a gap; not enlarge) "
         "or `cut` them through as treated (a surface built over two periods and cut at one plane; a period of at least "
-        "twice max(4 edge_length_d, 0.5) d; in a box the two periods meet at a height clear of the contacts with its "
-        "sides; enlarge too). `cut` left 5-14 cells of 290 k failing checkMesh at the planes where `open` left none "
+        "twice max(4 edge_length_d, 0.5) d; enlarge too). `cut` left 5-14 cells of 290 k failing checkMesh at the planes where `open` left none "
         "(docs/findings.md, 2026-12-01), so `open` is the default"}},
       {"contacts.shrink_factor", {"shrink: sphere scale", "1"}},
       {"contacts.enlarge_factor", {"enlarge: sphere scale", "1"}},

@@ -138,6 +138,70 @@ std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>&
   return loop;
 }
 
+// Whether a hole's loop has vertices on both sides of the height z (m).
+bool crosses(const WallHole& h, double z) {
+  return std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() < z; }) &&
+         std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() > z; });
+}
+
+// A box side's horizontal edge at a ring, from corner `from` to corner `to` (box_edge's points,
+// `to` left out), passing each hole of `crossing` (loops that meet the ring only at vertices,
+// snap_holes_to_rings) along its arc on the side `above` or below the ring: the strip's boundary
+// there. The edge's points within half a step of a hole's span are left out, decided on the
+// coordinate along the edge so that the strips on either side leave out the same.
+std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double edge,
+                                       const std::vector<const WallHole*>& crossing, bool above) {
+  const double z = from.z();
+  const int axis = from.x() == to.x() ? 1 : 0;
+  const std::vector<Eigen::Vector3d> row = box_edge(from, to, edge);
+  const double step = std::abs(to[axis] - from[axis]) / static_cast<double>(row.size());
+  const double sign = to[axis] > from[axis] ? 1.0 : -1.0;
+  // Each hole's arc, from its ring vertex first met to the last, keyed by where it starts.
+  std::vector<std::pair<double, std::vector<Eigen::Vector3d>>> arcs;
+  std::vector<std::pair<double, double>> spans;
+  for (const WallHole* h : crossing) {
+    const auto& loop = h->loop;
+    const std::size_t n = loop.size();
+    std::size_t first = n, last = n;
+    for (std::size_t k = 0; k < n; ++k)
+      if (loop[k].z() == z) {
+        if (first == n || sign * loop[k][axis] < sign * loop[first][axis]) first = k;
+        if (last == n || sign * loop[k][axis] > sign * loop[last][axis]) last = k;
+      }
+    if (first == n || first == last)
+      throw CutConflict(fmt::format("the hole of particle {} crosses the ring at z = {} m but not at two vertices",
+                                    h->particle, z));
+    // Of the two ways round from `first` to `last`, the one on the side asked.
+    for (const long dir : {1L, -1L}) {
+      std::vector<Eigen::Vector3d> arc{loop[first]};
+      bool on_side = true;
+      for (std::size_t k = (first + n + dir) % n; k != last; k = (k + n + dir) % n) {
+        arc.push_back(loop[k]);
+        on_side = on_side && (above ? loop[k].z() >= z : loop[k].z() <= z);
+      }
+      arc.push_back(loop[last]);
+      if (on_side && arc.size() > 2) arcs.emplace_back(sign * loop[first][axis], std::move(arc));
+    }
+    spans.emplace_back(std::min(loop[first][axis], loop[last][axis]), std::max(loop[first][axis], loop[last][axis]));
+  }
+  if (arcs.size() != crossing.size())
+    throw CutConflict(fmt::format("a hole crossing the ring at z = {} m has no arc on one side of it", z));
+  std::sort(arcs.begin(), arcs.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+  std::vector<Eigen::Vector3d> out;
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < row.size(); ++k) {
+    const double x = row[k][axis];
+    for (; next < arcs.size() && arcs[next].first < sign * x; ++next)
+      out.insert(out.end(), arcs[next].second.begin(), arcs[next].second.end());
+    const bool near = k > 0 && std::any_of(spans.begin(), spans.end(), [&](const auto& sp) {
+      return x > sp.first - 0.5 * step && x < sp.second + 0.5 * step;
+    });
+    if (!near) out.push_back(row[k]);
+  }
+  for (; next < arcs.size(); ++next) out.insert(out.end(), arcs[next].second.begin(), arcs[next].second.end());
+  return out;
+}
+
 }  // namespace
 
 std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
@@ -298,8 +362,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
 
   // Rings on the walls at the heights asked (those inside the window), each a height the STL's
   // rounding keeps: the holes' loops meet them at vertices, moved there alike in the loops' other
-  // owners (a bridge's end, a sphere's cut); a box's sides are meshed in strips between those no
-  // hole reaches.
+  // owners (a bridge's end, a sphere's cut); a box's sides are meshed in strips between them.
   std::vector<double> rings;
   if (!p.wall_rings_d.empty() && laid.periodic())
     throw std::invalid_argument("build_fluid_surface: wall rings on a periodic section (its copy laid out is not)");
@@ -406,30 +469,43 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
          {Eigen::Vector3d::UnitX(), {1, -1}, {1, 1}},
          {-Eigen::Vector3d::UnitY(), {-1, -1}, {1, -1}},
          {Eigen::Vector3d::UnitY(), {-1, 1}, {1, 1}}}};
-    // A side with rings is meshed strip by strip between those no hole reaches, so that its row
-    // of vertices there is the strip edge's, the same at every such ring (a periodic section's
-    // seams); at the others only the holes' vertices lie on the ring (snapped above).
+    // A side with rings is meshed strip by strip between them, so that its row of vertices at
+    // a ring is the same at every ring of one bed (a periodic section's seams): the ring's points
+    // and, where a hole crosses it, the hole's vertices on it, each strip passing the hole along
+    // its own side of the loop.
     std::vector<double> strips{z0};
-    for (double z : rings)
-      if (std::none_of(tb.wall_holes.begin(), tb.wall_holes.end(), [z](const std::vector<WallHole>& side) {
-            return std::any_of(side.begin(), side.end(), [z](const WallHole& h) {
-              const auto [lo, hi] = std::minmax_element(h.loop.begin(), h.loop.end(),
-                                                        [](const auto& u, const auto& v) { return u.z() < v.z(); });
-              return lo->z() <= z && hi->z() >= z;
-            });
-          }))
-        strips.push_back(z);
+    strips.insert(strips.end(), rings.begin(), rings.end());
     strips.push_back(z1);
     for (std::size_t k = 0; k < sides.size(); ++k) {
       const auto& [normal, a, b] = sides[k];
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
+      // Per ring, the holes crossing it; per strip, the holes within it.
+      std::vector<std::vector<const WallHole*>> crossing(strips.size());
       std::vector<std::vector<WallHole>> holes_of(strips.size() - 1);
-      for (const WallHole& h : tb.wall_holes[k])
-        holes_of[std::upper_bound(strips.begin() + 1, strips.end() - 1, h.loop.front().z()) - strips.begin() - 1]
-            .push_back(h);
+      for (const WallHole& h : tb.wall_holes[k]) {
+        std::vector<std::size_t> rings_crossed;
+        for (std::size_t j = 1; j + 1 < strips.size(); ++j)
+          if (crosses(h, strips[j])) rings_crossed.push_back(j);
+        if (rings_crossed.size() > 1)
+          throw InputError(fmt::format("the box's side {}: the contact of particle {} crosses two of its rings, {:.6g} "
+                                       "and {:.6g} m; allowed: planes farther apart",
+                                       k, h.particle, strips[rings_crossed[0]], strips[rings_crossed[1]]));
+        if (!rings_crossed.empty()) {
+          crossing[rings_crossed[0]].push_back(&h);
+          continue;
+        }
+        const auto [lowest, highest] =
+            std::minmax_element(h.loop.begin(), h.loop.end(), [](const auto& u, const auto& v) { return u.z() < v.z(); });
+        const double mid = 0.5 * (lowest->z() + highest->z());
+        holes_of[std::upper_bound(strips.begin() + 1, strips.end() - 1, mid) - strips.begin() - 1].push_back(h);
+      }
       for (std::size_t j = 0; j + 1 < strips.size(); ++j) {
-        const auto loop = box_face_loop(
-            {corner(a, strips[j]), corner(b, strips[j]), corner(b, strips[j + 1]), corner(a, strips[j + 1])}, edge);
+        const double lo = strips[j], hi = strips[j + 1];
+        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, crossing[j], true);
+        for (const auto& part : {box_edge(corner(b, lo), corner(b, hi), edge),
+                                 ring_path(corner(b, hi), corner(a, hi), edge, crossing[j + 1], false),
+                                 box_edge(corner(a, hi), corner(a, lo), edge)})
+          loop.insert(loop.end(), part.begin(), part.end());
         add("wall", Shape::plane, 0.0,
             [&] { return plane_mesh(frame, {loop}, edge, holes_of[j], p.growth, true, "wall", field(-1)); });
       }

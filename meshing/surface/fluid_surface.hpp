@@ -48,8 +48,8 @@ struct SurfaceParams {
   double clip_clearance_d = 0.005;      // from every sphere's top and bottom and every treated contact
   // Heights above the floor (d) where the walls get rings, not from a scene: the planes a bed's
   // pieces are cut at, so that each piece's window cuts the wall there alike (curved walls: a
-  // row of vertices, wall_mesh; a box's sides: strips split there unless a contact hole reaches
-  // it, holes' vertices near it moved onto it);
+  // row of vertices, wall_mesh; a box's sides: strips between them, passing a hole that
+  // crosses one along either half of its loop; holes' vertices near a ring moved onto it);
   // and the narrowest wall gap of the whole bed (m), whose edge the ringed walls take, and walls
   // without rings when narrower than this bed's (0: this bed's; window_for_cuts sets both, and
   // spheres_between the gap).

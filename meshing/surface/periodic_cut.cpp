@@ -69,50 +69,38 @@ double seam_depth(const SurfaceParams& p, double d) {
 }
 
 // The seam's depth below z0 (m): the least from seam_depth(p, d) up to H less that whose height,
-// a period on or back, keeps clear of
-//  - a height where the treated `section` (one period from z0) has a mesh symmetric about it (a
-//    sphere's centre, a contact's point between two spheres), by kSymmetryClearanceD: a triangle
-//    centred on the seam would be taken by both parts or by neither (a simple cubic array's
-//    spheres lie at such heights);
-//  - in a box, every hole the treated section cuts in its sides, by half a surface edge: the
-//    sides are meshed in strips whose edges are the seams (build_fluid_surface), which no
-//    contact with a side may cross.
-// InputError when no height will do.
+// a period on or back, keeps kSymmetryClearanceD clear of every height where the treated
+// `section` (one period from z0) has a mesh symmetric about it (a sphere's centre, a contact's
+// point between two spheres): a triangle centred on the seam would be taken by both parts or by
+// neither (a simple cubic array's spheres lie at such heights). InputError when none does.
 inline constexpr double kSymmetryClearanceD = 1e-4;
-double seam_depth_clear(const UnwrappedSection& section, const SurfaceParams& p, double d, bool box) {
+double seam_depth_clear(const UnwrappedSection& section, const SurfaceParams& p, double d) {
   const double H = section.planes.z1 - section.planes.z0, z0 = section.planes.z0, least = seam_depth(p, d);
-  const double edge = p.edge_length_d * d, inf = std::numeric_limits<double>::infinity();
+  const double inf = std::numeric_limits<double>::infinity();
   const Bed& b = section.bed;
-  // Heights less z0 that the seam keeps clear of by `clearance`, a period on and back.
+  // The heights less z0 that the seam keeps clear of, a period on and back.
   std::vector<std::pair<double, double>> taken;
-  auto take = [&](double lo, double hi, double clearance) {
-    for (double shift : {-H, 0.0, H}) taken.emplace_back(lo - z0 - clearance + shift, hi - z0 + clearance + shift);
+  const double clearance = kSymmetryClearanceD * d;
+  auto take = [&](double z) {
+    for (double shift : {-H, 0.0, H}) taken.emplace_back(z - z0 - clearance + shift, z - z0 + clearance + shift);
   };
-  const double symmetric = kSymmetryClearanceD * d;
-  const double joined = std::max({p.bridge_gap_d, p.cap_gap_d, p.enlarge_join_gap_d}) * d;
+  const double joined = std::max({p.bridge_gap_d, p.cap_gap_d, p.enlarge_join_gap_d}) * d, reach = 2.0 * largest_diameter(b);
   std::vector<std::size_t> by_z(b.size());
   std::iota(by_z.begin(), by_z.end(), 0);
   std::sort(by_z.begin(), by_z.end(), [&b](std::size_t u, std::size_t v) { return b.centres[u].z() < b.centres[v].z(); });
   for (std::size_t k = 0; k < by_z.size(); ++k) {
     const std::size_t i = by_z[k];
     const double ri = 0.5 * b.diameters[i];
-    take(b.centres[i].z(), b.centres[i].z(), symmetric);
+    take(b.centres[i].z());
     for (std::size_t l = k + 1; l < by_z.size(); ++l) {
       const std::size_t j = by_z[l];
       const double rj = 0.5 * b.diameters[j];
-      if (b.centres[j].z() - b.centres[i].z() > 2.0 * largest_diameter(b)) break;
+      if (b.centres[j].z() - b.centres[i].z() > reach) break;
       if ((b.centres[j] - b.centres[i]).norm() > ri + rj + joined) continue;
       const double at = (b.centres[i].z() * rj + b.centres[j].z() * ri) / (ri + rj);
-      take(at, at, symmetric);
+      take(at);
     }
   }
-  if (box)
-    for (const auto& side : treat_contacts(b, p, {-inf, inf, false}).wall_holes)
-      for (const WallHole& h : side) {
-        double lo = inf, hi = -inf;
-        for (const Eigen::Vector3d& q : h.loop) lo = std::min(lo, q.z()), hi = std::max(hi, q.z());
-        take(lo, hi, 0.5 * edge);
-      }
   // The seam at z0 - m lies at t = H - m of the period: the highest free t in [least, H - least].
   auto clear = [&](double t) {
     return std::none_of(taken.begin(), taken.end(), [t](const auto& r) { return t > r.first && t < r.second; });
@@ -123,10 +111,9 @@ double seam_depth_clear(const UnwrappedSection& section, const SurfaceParams& p,
     if (lo <= H - least && lo >= least && lo > best && clear(lo)) best = lo;
   if (best < least)
     throw InputError(fmt::format(
-        "contacts.at_periodic_planes = \"cut\"{}: no height of the period {:.4g} d keeps clear of the {}, where its "
-        "two parts would meet; allowed: \"open\"{}",
-        box ? " in a box" : "", H / d, box ? "contacts with the box's sides" : "spheres' centres and contacts",
-        box ? ", or a wall treatment without holes in the sides (contacts.wall_treatment = \"none\")" : ""));
+        "contacts.at_periodic_planes = \"cut\": no height of the period {:.4g} d keeps clear of the spheres' centres "
+        "and contacts, where its two parts would meet; allowed: \"open\"",
+        H / d));
   return H - best;
 }
 
@@ -157,13 +144,11 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
   const UnwrappedSection section = unwrap_periodic_section(
       bed, p, treated_heights(repeated(bed, -largest_diameter(bed), H + largest_diameter(bed)), p));
   const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
-  const bool box = dynamic_cast<const Box*>(bed.container.get()) != nullptr;
-  const double m = seam_depth_clear(section, p, d, box), s = z0 - m;
+  const double m = seam_depth_clear(section, p, d), s = z0 - m;
 
   // 2. The bed repeated a period apart, whole spheres from piece_margin_d below the lower seam
   // to as far above the upper plane, in a window whose own planes cut nothing (window_for_cuts),
-  // its walls ringed at the seams and the planes (a box's sides split at the seams, which keep
-  // clear of its contacts).
+  // its walls ringed at the seams and the planes (a box's sides meshed in strips between them).
   const double margin = piece_margin_d(bed, p) * d;
   const Bed laid = repeated(bed, s - margin, z1 + margin);
   const CutWindow window = window_for_cuts(laid, p, s - margin, z1 + margin, {s / d, z0 / d, (s + H) / d, z1 / d});

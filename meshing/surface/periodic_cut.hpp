@@ -18,12 +18,11 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 // How: the spheres whose centres lie from s - W to z1 + W (s = z0 - m, the seam; W =
 // piece_margin_d) are laid out a period apart as an ordinary bed, whole, with an empty end half a
 // diameter deep each side (so no plane of its own cuts a contact), its walls ringed at s, z0,
-// s + H and z1 (a box's sides split into strips at the seams), and its surface built
+// s + H and z1 (a box's sides meshed in strips between them), and its surface built
 // (build_fluid_surface) and cut at z0 (cut_by_plane). The section is the part above z0 up to
 // s + H, and the part below z0 from s up, moved up a period. The cut's changes reach no seam (m
-// is at least kSeamDepthEdges edges and kSeamDepthMinD d, more where the seam keeps clear of a
-// height about which a sphere's or contact's mesh is symmetric, and in a box of the contacts
-// with its sides), and there the repeated layout's surface repeats itself a period on: the
+// is at least kSeamDepthEdges edges and kSeamDepthMinD d, a hair more where the seam keeps clear
+// of a height about which a sphere's or contact's mesh is symmetric), and there the repeated layout's surface repeats itself a period on: the
 // spheres and contacts by construction, the wall along its ring or strip edge; the seam's
 // vertices are taken from the part moved up, so the two join bit for bit. A surface some three
 // times the period's.
@@ -35,8 +34,7 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 //   pieces one piece of no known shape (the self-intersection test takes every pair near)
 //   report the layout's surface report with the treatment's figures for one period
 //          (contacts_treated, solid_volume_change_m3, ...) and "periodic_planes_m" with the cut's.
-// InputError naming the key when the period is shorter than twice the seam depth, or when no
-// seam height keeps clear of what it must (a box's side contacts at every height); the errors of
+// InputError naming the key when the period is shorter than twice the seam depth; the errors of
 // build_fluid_surface and cut_by_plane (CutConflict as InputError); std::runtime_error when the
 // layout's surface does not repeat itself at the seam (a defect of ours), saying where.
 inline constexpr double kSeamDepthEdges = 4.0, kSeamDepthMinD = 0.5;
