@@ -147,10 +147,10 @@ bool crosses(const WallHole& h, double z) {
 // A box side's horizontal edge at a ring, from corner `from` to corner `to` (box_edge's points,
 // `to` left out), passing each hole of `crossing` (loops that meet the ring only at vertices,
 // snap_holes_to_rings) along its arc on the side `above` or below the ring: the strip's boundary
-// there. The edge's points within half a step of a hole's span are left out, decided on the
-// coordinate along the edge so that the strips on either side leave out the same.
+// there. Its points are decided on the coordinate along the edge alone, so that the strips on
+// either side of the ring, and every ring a hole crosses alike, take the same.
 std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double edge,
-                                       const std::vector<const WallHole*>& crossing, bool above) {
+                                       double growth, const std::vector<const WallHole*>& crossing, bool above) {
   const double z = from.z();
   const int axis = from.x() == to.x() ? 1 : 0;
   const std::vector<Eigen::Vector3d> row = box_edge(from, to, edge);
@@ -186,17 +186,42 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
   }
   if (arcs.size() != crossing.size())
     throw CutConflict(fmt::format("a hole crossing the ring at z = {} m has no arc on one side of it", z));
+  // The ring's points: the edge's, less those within a step of a hole's span, and between the
+  // two, points graded by `growth` from the hole's spacing (a hole's vertex an edge from the next
+  // ring point would make needles beside it).
+  std::vector<double> along;
+  for (std::size_t k = 0; k < row.size(); ++k) {
+    const double x = row[k][axis];
+    if (k == 0 || std::none_of(spans.begin(), spans.end(),
+                               [&](const auto& sp) { return x > sp.first - step && x < sp.second + step; }))
+      along.push_back(x);
+  }
+  for (std::size_t h = 0; h < crossing.size(); ++h)
+    for (const double out : {-1.0, 1.0}) {
+      const double end = out < 0.0 ? spans[h].first : spans[h].second;
+      double at = end, spacing = std::min(crossing[h]->spacing, step);
+      while (true) {
+        at += out * spacing;
+        const bool clear = std::all_of(along.begin(), along.end(), [&](double x) { return std::abs(x - at) > 0.6 * spacing; }) &&
+                           std::none_of(spans.begin(), spans.end(), [&](const auto& sp) {
+                             return at > sp.first - 0.5 * spacing && at < sp.second + 0.5 * spacing;
+                           });
+        const double lo = std::min(from[axis], to[axis]), hi = std::max(from[axis], to[axis]);
+        if (!clear || at <= lo || at >= hi) break;
+        along.push_back(at);
+        spacing = std::min(growth * spacing, step);
+      }
+    }
+  std::sort(along.begin(), along.end(), [sign](double u, double v) { return sign * u < sign * v; });
   std::sort(arcs.begin(), arcs.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
   std::vector<Eigen::Vector3d> out;
   std::size_t next = 0;
-  for (std::size_t k = 0; k < row.size(); ++k) {
-    const double x = row[k][axis];
+  for (const double x : along) {
     for (; next < arcs.size() && arcs[next].first < sign * x; ++next)
       out.insert(out.end(), arcs[next].second.begin(), arcs[next].second.end());
-    const bool near = k > 0 && std::any_of(spans.begin(), spans.end(), [&](const auto& sp) {
-      return x > sp.first - 0.5 * step && x < sp.second + 0.5 * step;
-    });
-    if (!near) out.push_back(row[k]);
+    Eigen::Vector3d q = from;
+    q[axis] = x;
+    out.push_back(q);
   }
   for (; next < arcs.size(); ++next) out.insert(out.end(), arcs[next].second.begin(), arcs[next].second.end());
   return out;
@@ -501,9 +526,9 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       }
       for (std::size_t j = 0; j + 1 < strips.size(); ++j) {
         const double lo = strips[j], hi = strips[j + 1];
-        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, crossing[j], true);
+        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, p.growth, crossing[j], true);
         for (const auto& part : {box_edge(corner(b, lo), corner(b, hi), edge),
-                                 ring_path(corner(b, hi), corner(a, hi), edge, crossing[j + 1], false),
+                                 ring_path(corner(b, hi), corner(a, hi), edge, p.growth, crossing[j + 1], false),
                                  box_edge(corner(a, hi), corner(a, lo), edge)})
           loop.insert(loop.end(), part.begin(), part.end());
         add("wall", Shape::plane, 0.0,
