@@ -138,19 +138,22 @@ std::vector<Eigen::Vector3d> box_face_loop(const std::array<Eigen::Vector3d, 4>&
   return loop;
 }
 
-// Whether a hole's loop has vertices on both sides of the height z (m).
-bool crosses(const WallHole& h, double z) {
-  return std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() < z; }) &&
-         std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() > z; });
+// Whether a hole's loop meets the height z (m): has vertices on both sides of it, or two on it
+// (snap_holes_to_rings can leave a loop's edge along a ring with the loop on one side).
+bool meets(const WallHole& h, double z) {
+  return (std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() < z; }) &&
+          std::any_of(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() > z; })) ||
+         std::count_if(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() == z; }) >= 2;
 }
 
 // A box side's horizontal edge at a ring, from corner `from` to corner `to` (box_edge's points,
-// `to` left out), passing each hole of `crossing` (loops that meet the ring only at vertices,
-// snap_holes_to_rings) along its arc on the side `above` or below the ring: the strip's boundary
-// there. Its points are decided on the coordinate along the edge alone, so that the strips on
-// either side of the ring, and every ring a hole crosses alike, take the same.
+// `to` left out), passing each hole of `meeting` (loops that meet the ring only at vertices,
+// snap_holes_to_rings) along its arc on the side `above` or below the ring (its edge along the
+// ring where it lies on the other side): the strip's boundary there. Its points are decided on
+// the coordinate along the edge alone, so that the strips on either side of the ring, and every
+// ring a hole meets alike, take the same.
 std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double edge,
-                                       double growth, const std::vector<const WallHole*>& crossing, bool above) {
+                                       double growth, const std::vector<const WallHole*>& meeting, bool above) {
   const double z = from.z();
   const int axis = from.x() == to.x() ? 1 : 0;
   const std::vector<Eigen::Vector3d> row = box_edge(from, to, edge);
@@ -159,7 +162,7 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
   // Each hole's arc, from its ring vertex first met to the last, keyed by where it starts.
   std::vector<std::pair<double, std::vector<Eigen::Vector3d>>> arcs;
   std::vector<std::pair<double, double>> spans;
-  for (const WallHole* h : crossing) {
+  for (const WallHole* h : meeting) {
     const auto& loop = h->loop;
     const std::size_t n = loop.size();
     std::size_t first = n, last = n;
@@ -169,9 +172,11 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
         if (last == n || sign * loop[k][axis] > sign * loop[last][axis]) last = k;
       }
     if (first == n || first == last)
-      throw CutConflict(fmt::format("the hole of particle {} crosses the ring at z = {} m but not at two vertices",
+      throw CutConflict(fmt::format("the hole of particle {} meets the ring at z = {} m but not at two vertices",
                                     h->particle, z));
-    // Of the two ways round from `first` to `last`, the one on the side asked.
+    // Of the two ways round from `first` to `last`, the one on the side asked; where the loop
+    // lies on the other side, its edge along the ring.
+    std::vector<Eigen::Vector3d> chosen;
     for (const long dir : {1L, -1L}) {
       std::vector<Eigen::Vector3d> arc{loop[first]};
       bool on_side = true;
@@ -180,12 +185,13 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
         on_side = on_side && (above ? loop[k].z() >= z : loop[k].z() <= z);
       }
       arc.push_back(loop[last]);
-      if (on_side && arc.size() > 2) arcs.emplace_back(sign * loop[first][axis], std::move(arc));
+      if (on_side && (chosen.empty() || arc.size() > chosen.size())) chosen = std::move(arc);
     }
+    if (!chosen.empty()) arcs.emplace_back(sign * loop[first][axis], std::move(chosen));
     spans.emplace_back(std::min(loop[first][axis], loop[last][axis]), std::max(loop[first][axis], loop[last][axis]));
   }
-  if (arcs.size() != crossing.size())
-    throw CutConflict(fmt::format("a hole crossing the ring at z = {} m has no arc on one side of it", z));
+  if (arcs.size() != meeting.size())
+    throw CutConflict(fmt::format("a hole meeting the ring at z = {} m has no way round on one side of it", z));
   // The ring's points: the edge's, less those within a step of a hole's span, and between the
   // two, points graded by `growth` from the hole's spacing (a hole's vertex an edge from the next
   // ring point would make needles beside it).
@@ -196,10 +202,10 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
                                [&](const auto& sp) { return x > sp.first - step && x < sp.second + step; }))
       along.push_back(x);
   }
-  for (std::size_t h = 0; h < crossing.size(); ++h)
+  for (std::size_t h = 0; h < meeting.size(); ++h)
     for (const double out : {-1.0, 1.0}) {
       const double end = out < 0.0 ? spans[h].first : spans[h].second;
-      double at = end, spacing = std::min(crossing[h]->spacing, step);
+      double at = end, spacing = std::min(meeting[h]->spacing, step);
       while (true) {
         at += out * spacing;
         const bool clear = std::all_of(along.begin(), along.end(), [&](double x) { return std::abs(x - at) > 0.6 * spacing; }) &&
@@ -496,7 +502,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
          {Eigen::Vector3d::UnitY(), {-1, 1}, {1, 1}}}};
     // A side with rings is meshed strip by strip between them, so that its row of vertices at
     // a ring is the same at every ring of one bed (a periodic section's seams): the ring's points
-    // and, where a hole crosses it, the hole's vertices on it, each strip passing the hole along
+    // and, where a hole meets it, the hole's vertices on it, each strip passing the hole along
     // its own side of the loop.
     std::vector<double> strips{z0};
     strips.insert(strips.end(), rings.begin(), rings.end());
@@ -504,19 +510,19 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
     for (std::size_t k = 0; k < sides.size(); ++k) {
       const auto& [normal, a, b] = sides[k];
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
-      // Per ring, the holes crossing it; per strip, the holes within it.
-      std::vector<std::vector<const WallHole*>> crossing(strips.size());
+      // Per ring, the holes meeting it; per strip, the holes within it.
+      std::vector<std::vector<const WallHole*>> meeting(strips.size());
       std::vector<std::vector<WallHole>> holes_of(strips.size() - 1);
       for (const WallHole& h : tb.wall_holes[k]) {
-        std::vector<std::size_t> rings_crossed;
+        std::vector<std::size_t> rings_met;
         for (std::size_t j = 1; j + 1 < strips.size(); ++j)
-          if (crosses(h, strips[j])) rings_crossed.push_back(j);
-        if (rings_crossed.size() > 1)
-          throw InputError(fmt::format("the box's side {}: the contact of particle {} crosses two of its rings, {:.6g} "
+          if (meets(h, strips[j])) rings_met.push_back(j);
+        if (rings_met.size() > 1)
+          throw InputError(fmt::format("the box's side {}: the contact of particle {} meets two of its rings, {:.6g} "
                                        "and {:.6g} m; allowed: planes farther apart",
-                                       k, h.particle, strips[rings_crossed[0]], strips[rings_crossed[1]]));
-        if (!rings_crossed.empty()) {
-          crossing[rings_crossed[0]].push_back(&h);
+                                       k, h.particle, strips[rings_met[0]], strips[rings_met[1]]));
+        if (!rings_met.empty()) {
+          meeting[rings_met[0]].push_back(&h);
           continue;
         }
         const auto [lowest, highest] =
@@ -526,9 +532,9 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       }
       for (std::size_t j = 0; j + 1 < strips.size(); ++j) {
         const double lo = strips[j], hi = strips[j + 1];
-        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, p.growth, crossing[j], true);
+        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, p.growth, meeting[j], true);
         for (const auto& part : {box_edge(corner(b, lo), corner(b, hi), edge),
-                                 ring_path(corner(b, hi), corner(a, hi), edge, p.growth, crossing[j + 1], false),
+                                 ring_path(corner(b, hi), corner(a, hi), edge, p.growth, meeting[j + 1], false),
                                  box_edge(corner(a, hi), corner(a, lo), edge)})
           loop.insert(loop.end(), part.begin(), part.end());
         add("wall", Shape::plane, 0.0,
