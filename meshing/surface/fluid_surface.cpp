@@ -202,6 +202,9 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
                                [&](const auto& sp) { return x > sp.first - step && x < sp.second + step; }))
       along.push_back(x);
   }
+  // Both corners are kept off alike: the ring is walked from either end (once per strip beside
+  // it), and only `from` is in the row.
+  const double lo = std::min(from[axis], to[axis]), hi = std::max(from[axis], to[axis]);
   for (std::size_t h = 0; h < meeting.size(); ++h)
     for (const double out : {-1.0, 1.0}) {
       const double end = out < 0.0 ? spans[h].first : spans[h].second;
@@ -212,8 +215,7 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
                            std::none_of(spans.begin(), spans.end(), [&](const auto& sp) {
                              return at > sp.first - 0.5 * spacing && at < sp.second + 0.5 * spacing;
                            });
-        const double lo = std::min(from[axis], to[axis]), hi = std::max(from[axis], to[axis]);
-        if (!clear || at <= lo || at >= hi) break;
+        if (!clear || at <= lo + 0.6 * spacing || at >= hi - 0.6 * spacing) break;
         along.push_back(at);
         spacing = std::min(growth * spacing, step);
       }

@@ -1022,3 +1022,16 @@ TEST(FluidSurface, APeriodicPlaneCutsThroughABoxsContactsWhenAsked) {
     expect_matching_planes(fs, treatment_name(t));
   }
 }
+
+// G moved into the box's corner, 0.008 d from the second side: enlarged, its holes come within a
+// few spacings of the corner where the seam meets them. The ring is walked from either corner
+// (once for each strip beside it); when only the corner it starts from kept graded points off,
+// the two strips differed at the corner and the surface was open there (found by a sweep of G's
+// y from -0.999 to -0.5: y = -0.992 and -0.989 failed).
+TEST(FluidSurface, ABoxsSeamBesideACornerIsTheSameFromBothStrips) {
+  const Bed b = with_sphere_g(std::make_shared<Box>(3.0, 3.0, false, false), {-1.0, -0.992, 0.72});
+  const FluidSurface fs = build_fluid_surface(b, cut_through(Treatment::enlarge));
+  const SurfaceCheck k = check_surface(fs.fluid, SelfIntersectionTest::all_pairs);
+  EXPECT_TRUE(k.manifold && k.closed && !k.self_intersecting);
+  expect_matching_planes(fs, "enlarge");
+}
