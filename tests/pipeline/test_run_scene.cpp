@@ -441,10 +441,13 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   expect_converging_to_zick_homsy(c);
 }
 
-// Why case.cells defaults to polyhedra: on gmsh's tetrahedra themselves the same tube's pressure
-// drop settles far from the exact one (+12 to +17 % on 5 k to 160 k tetrahedra, measured
-// 2026-11-24), on their dual within the 1 % above. The bound is a third of that measured bias.
-TEST(RunScene, OnTetrahedraTheEmptyTubeMissesHagenPoiseuille) {
+// On gmsh's tetrahedra the pressure's cell-to-cell noise, read by gradients from the four face
+// neighbours, drove the same tube's pressure drop +12 to +17 % above the exact one on 5 k to 160 k
+// tetrahedra (measured 2026-11-24; +15.9 % on this mesh, 2026-12-03); fitted over the cells that
+// share a vertex and with the full non-orthogonal correction it settles 1.3-2.1 % low (this mesh
+// -2.1 %, 0.1 d meshes -1.3 to -1.6 %, 2026-12-03). The bound, 4 %, is under a third of the old
+// bias and above the new one's largest measured value.
+TEST(RunScene, OnTetrahedraTheEmptyTubeIsWithinAFewPerCentOfHagenPoiseuille) {
   const Scene scene = example_scene("empty_tube_verification.toml",
                                     {{"case.cells", std::string("tetrahedra")}, {"case.convergence.levels", 0LL}});
   const fs::path dir = test_support::fresh_dir("empty_tube_tetrahedra");
@@ -452,7 +455,7 @@ TEST(RunScene, OnTetrahedraTheEmptyTubeMissesHagenPoiseuille) {
   const nlohmann::json& flow = r.stages["case"]["flow"];
   EXPECT_EQ(flow["mesh"]["mesher"], "gmsh tetrahedra");
   EXPECT_EQ(flow["mesh"]["cells"], r.stages["case"]["cells"]);
-  EXPECT_GT(flow["relative_error_to_exact"].get<double>(), 0.05) << flow.dump();
+  EXPECT_LT(std::abs(flow["relative_error_to_exact"].get<double>()), 0.04) << flow.dump();
 }
 
 // The mesh's estimate from the scene alone: for the empty tube its fluid volume is exact, and
