@@ -116,7 +116,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "study_reynolds", "study_treatments",
             "default", "solver", "verification", "verification_spheres", "verification_periodic",
             "periodic_slice", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
             "pieces_1e4_solved", "weak_scaling_1e4",
@@ -126,7 +126,7 @@ ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/sha
 
 
 def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000,
-          levels=0, ratio=1.3):
+          levels=0, ratio=1.3, cells="polyhedra"):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -147,6 +147,7 @@ algorithm = "hxt"
 count = {layers}
 thickness_d = {layer_thickness}
 [case]
+cells = "{cells}"
 reynolds = {reynolds}
 iterations = {iterations}
 processors = 2
@@ -323,15 +324,15 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
     yield row
 
 
-def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0):
+def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra"):
     """One run of the scene with a mesh-convergence study; its levels and verdict."""
-    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}")
-    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio)
+    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}")
+    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells)
     open(path + ".toml", "w").write(text)
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     case = rep["stages"]["case"]
-    return {**commit_and_date(), "a": a, "n": n, "treatment": treatment, "reynolds": reynolds,
+    return {**commit_and_date(), "a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
             "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap, "wall_s": wall, "peak_mb": peak_mb(rep),
             "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
@@ -1198,6 +1199,64 @@ def study_lines(r):
     return lines
 
 
+def cost_lines(runs):
+    """Issue 57's cost curve on one bed: each route's levels as error against the best
+    extrapolation, against cells and seconds per sphere; the route whose band is narrowest gives
+    the reference."""
+    def fits(r):
+        st = r["study"]
+        return st.get("grid_convergence", {}), st.get("least_squares", {})
+
+    usable = [r for r in runs if fits(r)[0].get("extrapolated") is not None and fits(r)[0].get("gci_fine") is not None]
+    best = min(usable, key=lambda r: fits(r)[0]["gci_fine"]) if usable else None
+    r0 = runs[0]
+    n = r0["n"]
+    lines = [f"## Cost per sphere: polyhedra against tetrahedra (a = {r0['a']}, N = {n}, {r0['treatment']}, "
+             f"Re_p = {r0['reynolds']:g})", "",
+             f"Made at commit {r0['commit']} on {r0['date']}: issue 57's bed (seed 1), one `bedforge run` per route with "
+             f"a study of {len(r0['study']['levels'])} levels, ratio {r0['ratio']}, from a surface edge of "
+             f"{r0['edge_d']} d, contact edge a third, {r0['cells_per_gap']:g} cells per gap, on 2 processes; "
+             "`case.cells` the only difference. Seconds per sphere are a level's wall time (surface, mesh, case and "
+             "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
+             "with the narrower GCI band"
+             + (f": the {best['cells']}' {fits(best)[0]['extrapolated']:.4g} Pa/m (GCI "
+                f"{100 * fits(best)[0]['gci_fine']:.1f} %)." if best else "; no route gave one."), "",
+             "| cells | level | cells per sphere | dp/L (Pa/m) | against the reference | s per sphere (2 cores) |",
+             "|---|---|---|---|---|---|"]
+    ref = fits(best)[0]["extrapolated"] if best else None
+    for r in runs:
+        for lv in r["study"]["levels"]:
+            if "failure" in lv:
+                lines.append(f"| {r['cells']} | {lv['level']} | failed: {lv['failure']} | | | {lv['time_s'] / n:.1f} |")
+                continue
+            dp = lv["pressure_gradient_bed_pa_m"]
+            lines.append(f"| {r['cells']} | {lv['level']} | {lv['cells'] / n:,.0f} | {dp:.4g} | "
+                         + (f"{100 * (dp / ref - 1):+.1f} %" if ref else "") + f" | {lv['time_s'] / n:.1f} |")
+    lines += ["", "| cells | finest level's GCI | order, finest three | least squares over all: order, extrapolation "
+                  "| extrapolation (Pa/m) | issue 57's targets (GCI <= 5 %, <= 20 k cells per sphere, order 1.5-2.5, "
+                  "the two orders within 0.3) |", "|---|---|---|---|---|---|"]
+    for r in runs:
+        g, ls = fits(r)
+        finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+        if g.get("gci_fine") is None or finest is None:
+            lines.append(f"| {r['cells']} | none: {r['study']['conclusion']} | | | | not met |")
+            continue
+        per_sphere = finest["cells"] / n
+        gap = abs(ls["order"] - g["apparent_order"]) if ls.get("order") is not None else None
+        missed = ([f"GCI {100 * g['gci_fine']:.1f} %"] if g["gci_fine"] > 0.05 else []) + \
+                 ([f"{per_sphere / 1000:.1f} k cells per sphere"] if per_sphere > 20000 else []) + \
+                 ([f"order {g['apparent_order']:.2f}"] if not 1.5 <= g["apparent_order"] <= 2.5 else []) + \
+                 ([f"orders {gap:.2f} apart" if gap is not None else "no least-squares fit"]
+                  if gap is None or gap > 0.3 else [])
+        lines.append(f"| {r['cells']} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | "
+                     + (f"{ls['order']:.2f}, {ls['extrapolated']:.4g}" if ls.get("order") is not None else "none")
+                     + f" | {g['extrapolated']:.4g} | " + ("met" if not missed else "not met: " + ", ".join(missed)) + " |")
+    lines += ["", "The 500-sphere bed of issue 57's cost curve is not in this section: its study on tetrahedra (some "
+                  "4.5 times the polyhedra's cells) did not fit the time of the session that made it "
+                  "(docs/findings.md, 2026-12-03).", ""]
+    return lines
+
+
 def drag_share(level):
     """The walls' share of a level's drag; runs before 2026-11-26 did not record it."""
     return f"{100 * level['wall_share_of_drag']:.1f} %" if "wall_share_of_drag" in level else "not recorded"
@@ -1547,6 +1606,8 @@ def write(results):
         lines.append("")
         for r in results["study_treatments"]:
             lines += study_lines(r)
+    if "cost" in results:
+        lines += cost_lines(results["cost"])
     if "verification" in results:
         v = results["verification"]
         lines += ["## Verification: the empty tube against Hagen-Poiseuille, tetrahedra and their polyhedral dual", "",
@@ -1679,6 +1740,9 @@ def main():
     ap.add_argument("--ratio", type=float, default=1.3, help="study: cell size ratio between levels")
     ap.add_argument("--study-gap-edge", type=float, default=0.15, help="study_gaps: finest surface edge (d)")
     ap.add_argument("--study-gap-cells", type=float, default=4, help="study_gaps: surface.cells_per_gap")
+    ap.add_argument("--cost-edge", type=float, default=0.07, help="cost: finest surface edge (d)")
+    ap.add_argument("--cost-levels", type=int, default=4, help="cost: meshes in all")
+    ap.add_argument("--cost-gap-cells", type=float, default=4, help="cost: surface.cells_per_gap on the finest")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
     ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
     ap.add_argument("--default-reference-levels", type=int, default=4,
@@ -1745,6 +1809,10 @@ def main():
             write(results)
         if "study_gaps" in args.only:
             results["study_gaps"] = study(tmp, args.study_gap_edge, args.levels, args.ratio, args.study_gap_cells)
+            write(results)
+        if "cost" in args.only:
+            results["cost"] = [study(tmp, args.cost_edge, args.cost_levels, args.ratio, args.cost_gap_cells, a=4, n=40,
+                                     cells=cells) for cells in ("polyhedra", "tetrahedra")]
             write(results)
         # Runs at other Re_p or treatments are kept, so one can be redone alone.
         for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
