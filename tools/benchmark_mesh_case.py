@@ -1219,7 +1219,7 @@ def cost_lines(runs):
              "`case.cells` the only difference. Seconds per sphere are a level's wall time (surface, mesh, case and "
              "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
              "with the narrower GCI band"
-             + (f": the {best['cells']}' {fits(best)[0]['extrapolated']:.4g} Pa/m (GCI "
+             + (f": that of the {best['cells']}, {fits(best)[0]['extrapolated']:.4g} Pa/m (GCI "
                 f"{100 * fits(best)[0]['gci_fine']:.1f} %)." if best else "; no route gave one."), "",
              "| cells | level | cells per sphere | dp/L (Pa/m) | against the reference | s per sphere (2 cores) |",
              "|---|---|---|---|---|---|"]
