@@ -60,9 +60,10 @@ namespace {
 
 constexpr double kDensestVoidFraction = 0.36;
 // simpleFoam's two processes held together 897 and 1038 bytes per tetrahedron on the polyhedral
-// dual, 1300 and 1431 on the tetrahedra themselves (5.95 M and 2.73 M tetrahedra, 2026-11-28,
-// docs/findings.md): as much as the mesh stage or more.
-constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 1200.0;
+// dual (2026-11-28, docs/findings.md); on the tetrahedra themselves, whose gradients are fitted
+// over the cells sharing a vertex, twice the largest process's 3.4-3.5 kB per tetrahedron (2.94 M
+// and 5.97 M, 2026-12-04 and 2026-12-03, docs/findings.md): as much as the mesh stage or more.
+constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 3300.0;
 
 MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                         const cases::CaseParams& c, const meshing::FluidDomainSize& fluid, double d) {

@@ -494,9 +494,9 @@ TEST(RunScene, AMeshBeyondMemoryIsRefusedBeforePacking) {
 }
 
 // A case that is run peaks in simpleFoam, whose two processes held together 897 and 1038 bytes
-// per tetrahedron on the dual and 1300 and 1431 on the tetrahedra (5.95 M and 2.73 M
-// tetrahedra, 2026-11-28; docs/findings.md), above the mesh stage's 460: a memory that fits the
-// mesh alone is refused for the run, naming the way out, and the tetrahedra need more.
+// per tetrahedron on the dual (2026-11-28) and about 3.4 kB on the tetrahedra (2026-12-04;
+// docs/findings.md), above the mesh stage's 460: a memory that fits the mesh alone is refused for
+// the run, naming the way out, and the tetrahedra need more.
 TEST(RunScene, ACaseThatIsRunIsRefusedWhenTheSolverWouldNotFit) {
   const Scene written = small_scene("\"case\"", "[case]\nrun = false\n");
   const Scene run = small_scene("\"case\"", "[case]\nrun = true\n");
