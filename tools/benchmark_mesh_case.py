@@ -61,8 +61,8 @@ cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1
         case.cells = "polyhedra" and "tetrahedra" (--cost-levels meshes from --cost-edge d, contact edge a third,
         --cost-gap-cells per gap): each level's cells and seconds per sphere, its error against the extrapolation
         with the narrower band, and the issue's targets.
-cost_500: the same on the README's bed at its shipped mesh settings (scenes/default.toml: a = 5, N = 500,
-        surface edge 0.15 d, contact edge 0.05 d, 4 cells per gap, 3 levels of ratio 1.3).
+cost_500: the same on the README's bed at the mesh settings scenes/default.toml had until 2026-12-04 (a = 5,
+        N = 500, surface edge 0.15 d, contact edge 0.05 d, 4 cells per gap, 3 levels of ratio 1.3).
 verification_spheres: a column of a simple cubic array of spheres in Stokes flow (Re_p = 0.01) in a square
         box whose slip walls are the array's mirror planes, as scenes/examples/simple_cubic_verification.toml
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
@@ -350,18 +350,19 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
 
 def finer_default_scene(ratio, levels):
     """scenes/default.toml with every mesh length 1 / ratio of its own and `levels` levels; refuses a
-    default scene whose settings it does not recognise."""
+    default scene that does not set each of those lengths."""
     text = open(DEFAULT_SCENE).read()
-    edge = float(re.search(r"^edge_length_d = ([0-9.]+)", text, re.M).group(1))
-    gap = float(re.search(r"^cells_per_gap = ([0-9.]+)", text, re.M).group(1))
-    changes = [(r"^edge_length_d = [0-9.]+", f"edge_length_d = {edge / ratio:.6g}\ncontact_edge_length_d = {edge / 3 / ratio:.6g}"),
-               (r"^cells_per_gap = [0-9.]+", f"cells_per_gap = {gap * ratio:.6g}"),
-               (r"^\[mesh\]$", f"[mesh]\nmax_size_d = {0.25 / ratio:.6g}"),
-               (r"^levels = \d+", f"levels = {levels}")]
-    for pattern, replacement in changes:
-        text, n = re.subn(pattern, replacement, text, count=1, flags=re.M)
-        if n != 1:
-            raise SystemExit(f"scenes/default.toml: no line matches {pattern}; update finer_default_scene")
+    changes = [("edge_length_d", lambda v: v / ratio), ("contact_edge_length_d", lambda v: v / ratio),
+               ("cells_per_gap", lambda v: v * ratio), ("max_size_d", lambda v: v / ratio)]
+    for key, scaled in changes:
+        pattern = rf"^{key} = ([0-9.]+)"
+        found = re.search(pattern, text, re.M)
+        if not found:
+            raise SystemExit(f"scenes/default.toml: no line sets {key}; update finer_default_scene")
+        text = re.sub(pattern, f"{key} = {scaled(float(found.group(1))):.6g}", text, count=1, flags=re.M)
+    text, n = re.subn(r"^levels = \d+", f"levels = {levels}", text, count=1, flags=re.M)
+    if n != 1:
+        raise SystemExit("scenes/default.toml: no line sets levels; update finer_default_scene")
     return text
 
 
@@ -1220,7 +1221,8 @@ def cost_lines(runs):
     lines = [f"## Cost per sphere: polyhedra against tetrahedra (a = {r0['a']}, N = {n}, {r0['treatment']}, "
              f"Re_p = {r0['reynolds']:g})", "",
              f"Made at commit {r0['commit']} on {r0['date']}: "
-             + ("issue 57's bed" if n == 40 else "the README's bed at its shipped mesh settings")
+             + ("issue 57's bed" if n == 40 else "the README's bed at the mesh settings scenes/default.toml had until "
+                "2026-12-04, when its cells were polyhedra")
              + " (seed 1), one `bedforge run` per route with "
              f"a study of {len(r0['study']['levels'])} levels, ratio {r0['ratio']}, from a surface edge of "
              f"{r0['edge_d']} d, contact edge a third, {r0['cells_per_gap']:g} cells per gap, on 2 processes; "

@@ -121,9 +121,10 @@ TEST(OpenFoamCase, TheDefaultScenesPathEndsInThePressureDropWithItsBand) {
   // One ratio (1.3) finer: every mesh length over 1.3, cells per gap times 1.3, one mesh.
   const fs::path finer_scene = fresh_dir("default_finer_scene") / "finer.toml";
   fs::create_directories(finer_scene.parent_path());
-  std::ofstream(finer_scene) << default_scene_with({{"edge_length_d = 0.15", "edge_length_d = 0.11538"},
-                                                    {"cells_per_gap = 4", "cells_per_gap = 5.2\ncontact_edge_length_d = 0.038462"},
-                                                    {"[mesh]\n", "[mesh]\nmax_size_d = 0.19231\n"},
+  std::ofstream(finer_scene) << default_scene_with({{"edge_length_d = 0.195", "edge_length_d = 0.15"},
+                                                    {"contact_edge_length_d = 0.065", "contact_edge_length_d = 0.05"},
+                                                    {"cells_per_gap = 3.0769", "cells_per_gap = 4"},
+                                                    {"max_size_d = 0.325", "max_size_d = 0.25"},
                                                     {"levels = 3", "levels = 0"}});
   const fs::path finer = fresh_dir("default_finer");
   const Result f = bedforge("--quiet run " + finer_scene.string() + small + " -o " + finer.string());
