@@ -382,6 +382,7 @@ def default_path(tmp, reference_levels):
             "printed": printed[printed.rfind("answer: "):].rstrip().splitlines(),
             "study": case["convergence"], "d_m": case["d_ref_m"], "ratio": ratio,
             "treatment": rep["scene"]["contacts"]["treatment"], "edge_d": rep["scene"]["surface"]["edge_length_d"],
+            "cells": rep["scene"]["case"]["cells"],
             "reference": {"wall_s": ref_wall, "edge_d": rep["scene"]["surface"]["edge_length_d"] / ratio,
                           "study": ref["convergence"], "answer": ref["answer"]}}
 
@@ -1389,7 +1390,7 @@ def default_lines(r, same_settings=None):
     g_ref = ref["study"].get("grid_convergence", {})
     lines = ["## The README's path: scenes/default.toml, from scene to answer", "",
              f"Made at commit {r['commit']} on {r['date']}: `bedforge run scenes/default.toml` as shipped "
-             f"({r['treatment']} contacts, surface edge {r['edge_d']:g} d, {len(r['study']['levels'])} levels of "
+             f"({r['treatment']} contacts, " + (f"{r['cells']}, " if "cells" in r else "") + f"surface edge {r['edge_d']:g} d, {len(r['study']['levels'])} levels of "
              f"ratio {r['ratio']:g}), {r['wall_s'] / 60:.1f} min wall from scene to answer (bed, surface, mesh, "
              f"case and every solve), peak {r['peak_mb'] / 1024:.1f} GB. It printed:", "", "```",
              *r["printed"], "```", "",
@@ -1398,7 +1399,9 @@ def default_lines(r, same_settings=None):
         lines.append(f"| {lv['level']} | {lv.get('cells', 'failed')} | "
                      + (f"{lv['cell_size_m'] / r['d_m']:.4f} | {lv['pressure_gradient_bed_pa_m']:.4g} | {lv['own_time_s']:.0f} |"
                         if "failure" not in lv else f"| {lv['failure']} | |"))
-    if same_settings and len(same_settings["study"]["levels"]) == len(r["study"]["levels"]):
+    # Only a run with the same edge and cells times the same work (runs before 2026-12-04 recorded no cells).
+    if same_settings and len(same_settings["study"]["levels"]) == len(r["study"]["levels"]) and \
+            (same_settings["edge_d"], same_settings.get("cells")) == (r["edge_d"], r.get("cells")):
         then = [lv.get("own_time_s", 0) for lv in same_settings["study"]["levels"]]
         now = [lv.get("own_time_s", 0) for lv in r["study"]["levels"]]
         lines += ["", f"The study_gaps run below has these settings; made at {same_settings['commit']} on "
