@@ -320,9 +320,12 @@ const char* kAllclean =
 
 // 0/U and 0/p, and the fluid's properties: laminar flow of kinematic viscosity `nu` (m2/s) up
 // from the inlet at the superficial velocity `u` (m/s), out at zero pressure; walls and
-// particles without slip unless the walls slip.
+// particles without slip unless the walls slip. An inlet that cuts through the bed (a clip
+// window's) holds only the fluid's part of the section: there the flow rate `inlet_flow` (m3/s)
+// is set instead (flowRateInletVelocity), else the superficial velocity would fall by the
+// plane's void fraction.
 void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu, double d_ref,
-                  std::optional<double> ubar, const std::string& note) {
+                  std::optional<double> ubar, std::optional<double> inlet_flow, const std::string& note) {
   auto field_dict = [&](const std::string& cls, const std::string& object, const std::string& body) {
     return foam_header(cls, "0", object, note, false) + body;
   };
@@ -331,10 +334,15 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
                         fmt::format("// superficial velocity {:.6g} m/s: Re_p = {} with d = {:.6g} m, nu = {:.6g} m2/s\n"
                                     "dimensions      [0 1 -1 0 0 0 0];\n\ninternalField   uniform (0 0 {:.12g});\n\n",
                                     u, p.reynolds, d_ref, nu, ubar.value_or(u)) +
-                            boundary_field(ubar ? kCyclic
-                                                : fmt::format("        type            fixedValue;\n"
-                                                              "        value           uniform (0 0 {:.12g});\n",
-                                                              u),
+                            boundary_field(ubar          ? kCyclic
+                                           : inlet_flow ? fmt::format("        type            flowRateInletVelocity;\n"
+                                                                      "        volumetricFlowRate constant {:.12g};  // the "
+                                                                      "superficial velocity times the section\n"
+                                                                      "        value           uniform (0 0 {:.12g});\n",
+                                                                      *inlet_flow, u)
+                                                        : fmt::format("        type            fixedValue;\n"
+                                                                      "        value           uniform (0 0 {:.12g});\n",
+                                                                      u),
                                            ubar ? kCyclic
                                                 : "        type            inletOutlet;\n"
                                                   "        inletValue      uniform (0 0 0);\n"
@@ -597,6 +605,11 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                        "snappyHexMesh set-up");
     ubar = u * g.cross_section_area * (g.outlet_z - g.inlet_z) / *fluid_volume;
   }
+  // A clip window's inlet plane cuts spheres: the flow rate is set, not the velocity over its fluid.
+  const bool inlet_in_bed = !g.periodic && std::any_of(bed.centres.begin(), bed.centres.end(), [&](const Eigen::Vector3d& c) {
+    return std::abs(c.z() - g.inlet_z) < 0.5 * bed.diameters[&c - bed.centres.data()];
+  });
+  const std::optional<double> inlet_flow = inlet_in_bed ? std::optional(u * g.cross_section_area) : std::nullopt;
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
@@ -618,7 +631,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
-    write_fields(tmp, p, u, nu, g.d_ref, ubar, note);
+    write_fields(tmp, p, u, nu, g.d_ref, ubar, inlet_flow, note);
     write_control_dict(tmp, p, section, bed.size() > 0, g.periodic, note);
     write_solver_settings(tmp, p, g.periodic, note);
     write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
