@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 
 namespace bedforge {
 
@@ -25,5 +26,18 @@ double sphere_cylinder_volume(double r, double s, double zc, double rho, double 
 // so the relative error is about 1e-7 (tested against the cap's closed form), far below the
 // sampling noise of a profile. Profiles next to the flat walls of a box.
 double sphere_halfspace_volume(double r, double xc, double zc, double x_max, double z1, double z2);
+
+// A solid of revolution between the horizontal planes z = z1 and z = z2 (z1 <= z2): its axis
+// passes through a point at height `origin_z` with unit direction of z component `axis_z`, and
+// at distance t along it (t0 <= t <= t1) its section is a disk of radius radius(t) >= 0. The
+// integral over t of that disk's area between the planes (in the disk's plane they are two
+// parallel lines, so the area is a difference of circular segments, closed form), split where
+// a line meets the disk's rim, each piece mapped so that its ends' square-root kinks are smooth
+// and integrated by 24-point Gauss-Legendre. `radius` must be smooth on [t0, t1]: a spherical
+// cap (radius sqrt(r^2 - t^2) from its base at t0 to the pole at r) or a cylinder (constant).
+// Relative error below 1e-9 in the tests against closed forms (sphere_halfspace_volume, the
+// comparison for caps, is good to about 1e-7).
+double revolution_slab_volume(double origin_z, double axis_z, double t0, double t1,
+                              const std::function<double(double)>& radius, double z1, double z2);
 
 }  // namespace bedforge

@@ -61,6 +61,7 @@ void ContactTreatment::pair(std::size_t i, std::size_t j, const NeighbourList& n
     cut.removed = [ci, a, cut_i](const Eigen::Vector3d& q) { return (q - ci).dot(a) < cut_i; };
     add_cut(j, std::move(cut), fmt::format("union with sphere {}", i), std::acos(std::clamp(cut_j / rj, -1.0, 1.0)));
     volume_ -= cap_volume(rj, rj - cut_j);
+    between_volume_ -= cap_between(cj, rj, -a, cut_j);
     area_ -= cap_area(rj, rj - cut_j);
     const Eigen::Vector3d q = f.to_world(Eigen::Vector3d(rho, 0.0, 0.0));
     wedge(kPi - std::acos(std::clamp(((q - ci) / ri).dot((q - cj) / rj), -1.0, 1.0)));
@@ -91,6 +92,8 @@ void ContactTreatment::pair(std::size_t i, std::size_t j, const NeighbourList& n
   cut.removed = [centre_j = cj, a, cut_j](const Eigen::Vector3d& q) { return (q - centre_j).dot(-a) > cut_j; };
   add_cut(j, std::move(cut), fmt::format("bridge to sphere {}", i), std::acos(std::clamp(cut_j / rj, -1.0, 1.0)));
   volume_ += kPi * bridge_radius * bridge_radius * L - cap_volume(rj, rj - cut_j);
+  between_volume_ += between(from, a, 0.0, L, [bridge_radius](double) { return bridge_radius; }) -
+                     cap_between(cj, rj, -a, cut_j);
   area_ += 2.0 * kPi * bridge_radius * L - cap_area(rj, rj - cut_j);
   out_.parts.push_back(tube_mesh(f, bridge_radius, n, length, edge_c_, true, "particles"));
   wedge(0.5 * kPi + std::asin(bridge_radius / std::max(ri, rj)));

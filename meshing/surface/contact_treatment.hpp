@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "core/neighbour_list.hpp"
+#include "core/intersection_volumes.hpp"
 #include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/contacts.hpp"
 
@@ -88,7 +91,10 @@ struct ClipContext {
 // a wall or a clip plane, adds the bridges, caps and unions, and measures what is left.
 class ContactTreatment {
  public:
-  ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip = {});
+  // `between` (z1, z2; m): also measure the treated solid between those heights
+  // (TreatedBed::solid_volume_between_m3), as exactly as the whole.
+  ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip = {},
+                   std::optional<std::array<double, 2>> between = std::nullopt);
   TreatedBed run();
   const ContactExtents& extents() const { return extents_; }
 
@@ -122,6 +128,11 @@ class ContactTreatment {
   Marks mark(std::size_t i, std::size_t j) const;
   // The z extent of what the contact (i, j) added since `m` (the cut caps included), widened by `pad`.
   void record(long long k, const Marks& m, std::size_t i, std::size_t j, double pad);
+  // The counts a contact adds (treated pairs and walls, bridges, caps, unions), and, with heights
+  // measured, those of contact k (recorded) that reach between them, since `before`.
+  using Counts = std::array<long, 5>;
+  Counts counts() const { return {treated_pp_, treated_pw_, bridges_, caps_, unions_}; }
+  void count_between(long long k, const Counts& before);
   // With clip planes: true when the contact (as surveyed) lies wholly beyond them, so is left
   // out; InputError when it crosses one (the planes were placed clear of every contact).
   bool beyond_planes(long long k, const std::string& who) const;
@@ -138,6 +149,12 @@ class ContactTreatment {
   // of their angular radii.
   void check_cuts(std::size_t i);
   void wedge(double angle) { min_wedge_ = std::min(min_wedge_, angle); }
+  // Of the solid of revolution about the axis from `c` along `a` (unit), radius(t) from t0 to t1,
+  // the part between the heights measured (`between`; 0 without them).
+  double between(const Eigen::Vector3d& c, const Eigen::Vector3d& a, double t0, double t1,
+                 const std::function<double(double)>& radius) const;
+  // The cap of the sphere about `c` of radius r beyond distance h along a, between them.
+  double cap_between(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, double h) const;
 
   // contact_pairs.cpp
   // Spheres i and j: a contact closer than the treatment's gap is capped, joined or bridged
@@ -172,12 +189,15 @@ class ContactTreatment {
   double d_ = 0.0, edge_c_ = 0.0, scale_ = 1.0;
   TreatedBed out_;
   double volume_ = 0.0, area_ = 0.0, volume0_ = 0.0, area0_ = 0.0;
+  long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0, opened_pp_ = 0, opened_pw_ = 0;
+  std::optional<std::array<double, 2>> between_;
+  double between_volume_ = 0.0, between_volume0_ = 0.0;  // treated and untreated, between the heights
+  Counts between_counts_{};
   long grown_to_wall_ = 0, grown_to_sphere_ = 0;  // enlarged spheres grown further to join a wall, pairs grown to join
   double min_pair_gap_ = std::numeric_limits<double>::infinity(), min_wall_gap_ = min_pair_gap_, min_gap_ = min_pair_gap_;
   double min_concave_wall_gap_ = min_pair_gap_;
   double min_wedge_ = std::numeric_limits<double>::infinity();
   std::string gap_error_;
-  long treated_pp_ = 0, treated_pw_ = 0, bridges_ = 0, caps_ = 0, unions_ = 0, opened_pp_ = 0, opened_pw_ = 0;
   std::vector<std::vector<double>> cut_angle_;  // per sphere and cut, see add_cut
 };
 

@@ -16,8 +16,9 @@ namespace bedforge::meshing {
 
 namespace contact_parts {
 
-ContactTreatment::ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip)
-    : bed_(bed), p_(p), planes_(planes), clip_(clip), walls_(walls_of(*bed.container)) {
+ContactTreatment::ContactTreatment(const Bed& bed, const SurfaceParams& p, DomainPlanes planes, ClipContext clip,
+                                   std::optional<std::array<double, 2>> between)
+    : bed_(bed), p_(p), planes_(planes), clip_(clip), walls_(walls_of(*bed.container)), between_(between) {
   d_ = reference_diameter(bed);
   edge_c_ = p.contact_edge_length_d * d_;
   scale_ = p.treatment == SurfaceParams::Treatment::shrink    ? p.shrink_factor
@@ -42,6 +43,10 @@ ContactTreatment::ContactTreatment(const Bed& bed, const SurfaceParams& p, Domai
     area_ += 4.0 * kPi * out_.radius[i] * out_.radius[i];
     volume0_ += 4.0 / 3.0 * kPi * std::pow(0.5 * bed.diameters[i], 3);
     area0_ += kPi * bed.diameters[i] * bed.diameters[i];
+    if (between_) {
+      between_volume_ += sphere_slab_volume(out_.radius[i], z, (*between_)[0], (*between_)[1]);
+      between_volume0_ += sphere_slab_volume(0.5 * bed.diameters[i], z, (*between_)[0], (*between_)[1]);
+    }
   }
 }
 
@@ -66,19 +71,24 @@ TreatedBed ContactTreatment::run() {
     for (int j : partners)
       if (static_cast<std::size_t>(j) > i) {
         const Marks m = mark(i, j);
+        const Counts before = counts();
         pair(i, j, nl);
         record(key(i, j), m, i, j, 0.0);
+        count_between(key(i, j), before);
       }
     for (const Wall& w : walls_) {
       const Marks m = mark(i, i);
+      const Counts before = counts();
       wall(i, w, nl);
       record(key(i, n + w.index), m, i, i, wall_pad);
+      count_between(key(i, n + w.index), before);
     }
     ends(i);
   }
   for (std::size_t i = 0; i < n; ++i) check_cuts(i);
   if (!(min_gap_ > 0.0)) throw InputError(gap_error_);
   out_.solid_volume = volume_;
+  if (between_) out_.solid_volume_between_m3 = between_volume_, out_.untreated_volume_between_m3 = between_volume0_;
   out_.min_concave_wall_gap = out_.bed_min_concave_wall_gap = min_concave_wall_gap_;
   auto angle = [](double a) { return std::isfinite(a) ? nlohmann::json(a * 180.0 / kPi) : nlohmann::json(nullptr); };
   out_.report = {
@@ -94,6 +104,12 @@ TreatedBed ContactTreatment::run() {
       {"smallest_gap_d", {{"particle_particle", min_pair_gap_ / d_}, {"particle_wall", min_wall_gap_ / d_}}},
       {"smallest_fluid_wedge_angle_deg", angle(min_wedge_)},
       {"solid_volume_exact_m3", volume_}};
+  if (between_) {
+    const Counts& b = between_counts_;
+    out_.report["contacts_treated_between"] = {{"particle_particle", b[0]},
+                                               {"particle_wall", b[1]},
+                                               {"by_kind", {{"bridge", b[2]}, {"cap", b[3]}, {"union", b[4]}}}};
+  }
   if (clip_.opening)
     out_.report["opened_at_clip_planes"] = {{"particle_particle", opened_pp_}, {"particle_wall", opened_pw_}};
   return std::move(out_);
@@ -199,6 +215,14 @@ void ContactTreatment::record(long long k, const Marks& m, std::size_t i, std::s
   if (lo <= hi) extents_[k] = {lo - pad, hi + pad};
 }
 
+void ContactTreatment::count_between(long long k, const Counts& before) {
+  if (!between_) return;
+  const auto it = extents_.find(k);
+  if (it == extents_.end() || it->second.second < (*between_)[0] || it->second.first > (*between_)[1]) return;
+  const Counts now = counts();
+  for (std::size_t q = 0; q < now.size(); ++q) between_counts_[q] += now[q] - before[q];
+}
+
 bool ContactTreatment::beyond_planes(long long k, const std::string& who) const {
   if (!clip_.surveyed) return false;
   const auto it = clip_.surveyed->find(k);
@@ -239,8 +263,18 @@ Frame ContactTreatment::plane_cut(std::size_t i, const Eigen::Vector3d& a, doubl
   cut.removed = [c, a, h](const Eigen::Vector3d& q) { return (q - c).dot(a) > h; };
   add_cut(i, std::move(cut), name, std::acos(std::clamp(h / r, -1.0, 1.0)));
   volume_ -= cap_volume(r, r - h);
+  between_volume_ -= cap_between(c, r, a, h);
   area_ -= cap_area(r, r - h);
   return f;
+}
+
+double ContactTreatment::between(const Eigen::Vector3d& c, const Eigen::Vector3d& a, double t0, double t1,
+                                 const std::function<double(double)>& radius) const {
+  return between_ ? revolution_slab_volume(c.z(), a.z(), t0, t1, radius, (*between_)[0], (*between_)[1]) : 0.0;
+}
+
+double ContactTreatment::cap_between(const Eigen::Vector3d& c, double r, const Eigen::Vector3d& a, double h) const {
+  return between(c, a, h, r, [r](double t) { return std::sqrt(std::max(0.0, r * r - t * t)); });
 }
 
 void ContactTreatment::check_cuts(std::size_t i) {
@@ -257,6 +291,12 @@ void ContactTreatment::check_cuts(std::size_t i) {
 }
 
 }  // namespace contact_parts
+
+TreatedBed treat_contacts_measured_between(const Bed& bed, const SurfaceParams& p, double z1, double z2) {
+  const double inf = std::numeric_limits<double>::infinity();
+  return contact_parts::ContactTreatment(bed, p, {-inf, inf, false}, {.record_extents = true}, std::array<double, 2>{z1, z2})
+      .run();
+}
 
 TreatedBed treat_contacts(const Bed& bed, const SurfaceParams& p, DomainPlanes planes) {
   if (!planes.clip) return contact_parts::ContactTreatment(bed, p, planes).run();

@@ -97,3 +97,49 @@ TEST(SphereHalfspace, CapClosedFormsAndSplitByHeight) {
   }
   EXPECT_NEAR(sphere_halfspace_volume(0.5, 2.0, 1.0, 1.0, 0.0, 3.0), 0.0, 1e-15);  // beyond the plane
 }
+
+// A whole sphere as a solid of revolution about any axis: between two planes it is the closed
+// form's slab, whatever the axis's tilt (the planes cut its disks in segments).
+TEST(RevolutionSlab, SphereAboutAnyAxisIsTheClosedFormSlab) {
+  const double r = 0.7, zc = 1.3;
+  const auto section = [r](double t) { return std::sqrt(std::max(0.0, r * r - t * t)); };
+  for (double axis_z : {0.0, 0.3, std::sqrt(0.5), 0.95, 1.0, -0.6})
+    for (auto [z1, z2] : {std::pair{1.0, 1.5}, std::pair{0.0, 1.2}, std::pair{1.9, 3.0}, std::pair{-1.0, 5.0}}) {
+      // The axis through the centre, t measured from it.
+      const double v = revolution_slab_volume(zc, axis_z, -r, r, section, z1, z2);
+      EXPECT_NEAR(v, sphere_slab_volume(r, zc, z1, z2), 1e-9 * sphere_slab_volume(r, zc, -10, 10))
+          << "axis_z " << axis_z << ", planes " << z1 << " " << z2;
+    }
+}
+
+// A cap cut off by a vertical plane x = x_max, between two planes: the sphere's slab less the
+// part left of that plane (sphere_halfspace_volume, integrated another way).
+TEST(RevolutionSlab, HorizontalCapAgainstTheHalfSpace) {
+  const double r = 0.5, xc = 0.2, zc = 0.0;
+  for (double h : {0.1, 0.3, 0.45})
+    for (auto [z1, z2] : {std::pair{-0.2, 0.1}, std::pair{0.05, 0.4}, std::pair{-1.0, 1.0}}) {
+      const double cap = revolution_slab_volume(zc, 0.0, h, r, [r](double t) { return std::sqrt(std::max(0.0, r * r - t * t)); },
+                                                z1, z2);
+      const double expected = sphere_slab_volume(r, zc, z1, z2) - sphere_halfspace_volume(r, xc, zc, xc + h, z1, z2);
+      EXPECT_NEAR(cap, expected, 1e-7 * (kPi * r * r * r)) << "h " << h << ", planes " << z1 << " " << z2;
+    }
+}
+
+// Cylinders: lying down, each unit of length holds the disk's segment between the planes; standing,
+// the length between the planes times the disk.
+TEST(RevolutionSlab, CylindersLyingAndStanding) {
+  const double rho = 0.1, L = 0.4;
+  const auto constant = [rho](double) { return rho; };
+  // Lying (axis horizontal, centre line at z = 0), the planes at -0.05 and 1: the disk above
+  // z = -0.05, a segment of half-angle acos(0.5) cut off below.
+  const double below = rho * rho * std::acos(0.5) - 0.05 * std::sqrt(rho * rho - 0.05 * 0.05);
+  EXPECT_NEAR(revolution_slab_volume(0.0, 0.0, 0.0, L, constant, -0.05, 1.0), L * (kPi * rho * rho - below),
+              1e-12);
+  // Standing from z = 0.2 to 0.6, the planes at 0.3 and 2: 0.3 of its length.
+  EXPECT_NEAR(revolution_slab_volume(0.2, 1.0, 0.0, L, constant, 0.3, 2.0), 0.3 * kPi * rho * rho, 1e-9);
+  // Tilted, wholly between the planes: the whole cylinder.
+  EXPECT_NEAR(revolution_slab_volume(0.0, 0.6, 0.0, L, constant, -0.5, 0.5), L * kPi * rho * rho, 1e-12);
+  // Nothing between planes it does not reach, nor between planes in the wrong order.
+  EXPECT_EQ(revolution_slab_volume(0.0, 0.6, 0.0, L, constant, 1.0, 2.0), 0.0);
+  EXPECT_EQ(revolution_slab_volume(0.0, 0.6, 0.0, L, constant, 0.3, -0.3), 0.0);
+}
