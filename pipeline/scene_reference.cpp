@@ -151,6 +151,12 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "or `cut` them through as treated (a surface built over two periods and cut at one plane; a period of at least "
         "twice max(4 edge_length_d, 0.5) d; enlarge too). `cut` left 5-14 cells of 290 k failing checkMesh at the planes where `open` left none "
         "(docs/findings.md, 2026-12-01), so `open` is the default"}},
+      {"contacts.at_clip_planes",
+       {"clip window (surface.clip_window_d), bridges, caps and unions: what its planes do to the treated contacts "
+        "they cross where they find no height clear of them: `open` them (their spheres shrunk by shrink_factor, the "
+        "contact left a gap; not enlarge) or `cut` them through as treated (the window's spheres laid out whole and "
+        "their surface cut at each plane, as the slabs between pieces are; the planes then go to the widest gap "
+        "between the spheres' ends and the contacts' rims within clip_shift_d)"}},
       {"contacts.shrink_factor", {"shrink: sphere scale", "1"}},
       {"contacts.enlarge_factor", {"enlarge: sphere scale", "1"}},
       {"contacts.enlarge_join_gap_d",

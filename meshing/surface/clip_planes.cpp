@@ -166,6 +166,28 @@ CutWindow spheres_between(const Bed& bed, const SurfaceParams& p, double lo, dou
   return out;
 }
 
+std::vector<double> plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts) {
+  const double d = reference_diameter(bed);
+  std::vector<double> ends;
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    for (double r : {0.5 * bed.diameters[i], 0.5 * p.shrink_factor * bed.diameters[i]})
+      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
+  if (through_contacts)
+    for (double z : treated_heights(bed, p)) ends.push_back(z / d);
+  std::sort(ends.begin(), ends.end());
+  return ends;
+}
+
+double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid) {
+  double best = asked, widest = -1.0;
+  for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
+    const double mid = 0.5 * (ends[j] + ends[j + 1]);
+    if (ends[j] <= avoid && avoid <= ends[j + 1]) continue;
+    if (std::abs(mid - asked) <= shift && ends[j + 1] - ends[j] > widest) best = mid, widest = ends[j + 1] - ends[j];
+  }
+  return best;
+}
+
 CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, double hi, std::vector<double> rings_d) {
   const double d = reference_diameter(bed), inf = std::numeric_limits<double>::infinity();
   CutWindow out = spheres_between(bed, p, lo, hi);
@@ -182,6 +204,8 @@ CutWindow window_for_cuts(const Bed& bed, const SurfaceParams& p, double lo, dou
   q.clip_top_d = std::isinf(hi) ? (p.clip ? p.clip_top_d : bed_height(bed) / d + p.outlet_length_d)
                                 : (out.bed.size() > 0 ? highest + pad : hi) / d;
   q.wall_rings_d = std::move(rings_d);
+  // Planes of its own cut nothing; only the scene's own plane (an infinite side) may need a cut.
+  if (!std::isinf(lo) && !std::isinf(hi)) q.cut_at_clip_planes = false;
   return out;
 }
 

@@ -89,6 +89,16 @@ std::vector<double> survey_stretches(const Bed& bed, std::size_t spheres);
 std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p,
                                     std::size_t spheres_per_window = kSpheresPerSurveyWindow);
 
+// The heights (d above the floor) a plane between slabs or a clip plane keeps clear of: the
+// spheres' tops and bottoms at their own and their shrunk radius, and, for a plane cut through
+// the treated contacts (`through_contacts`), treated_heights too; sorted.
+std::vector<double> plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts);
+// The middle of the widest interval between successive `ends` (sorted, d) whose middle lies
+// within `shift` of `asked`, leaving out the interval that holds `avoid` (NaN: none); `asked`
+// itself when there is no such interval: where a plane meets the surface at its widest angles,
+// away from the near-tangent cuts that leave slivers.
+double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid);
+
 // A window of `bed` whose surface is cut at planes inside it through its treated contacts (a
 // slab's or a piece's, a periodic section's). Its own clip planes must cut no contact, which a
 // plane through a packed bed cannot promise (a bed of a = 14 had no height 0.005 d clear of

@@ -21,6 +21,7 @@
 #include "core/point_key.hpp"
 #include "core/version.hpp"
 #include "meshing/surface/defect_locations.hpp"
+#include "meshing/surface/clip_cut.hpp"
 #include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/periodic_cut.hpp"
 #include "meshing/surface/contacts.hpp"
@@ -63,6 +64,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
   p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
   p.cut_at_periodic_planes = c.choice("at_periodic_planes", "open", {"open", "cut"}) == "cut";
+  p.cut_at_clip_planes = c.choice("at_clip_planes", "open", {"open", "cut"}) == "cut";
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
@@ -99,6 +101,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"bridge_gap_d", p.bridge_gap_d},
           {"cap_gap_d", p.cap_gap_d},
           {"at_periodic_planes", p.cut_at_periodic_planes ? "cut" : "open"},
+          {"at_clip_planes", p.cut_at_clip_planes ? "cut" : "open"},
           {"edge_length_d", p.edge_length_d},
           {"contact_edge_length_d", p.contact_edge_length_d},
           {"growth", p.growth},
@@ -289,6 +292,17 @@ LaidOut lay_out(const Bed& bed, const SurfaceParams& p) {
     TreatedBed tb = treat_periodic_section(*u, p);
     return {std::move(u), std::move(tb), bed};
   }
+  if (cuts_contacts_at_clip_planes(p)) {
+    // Sized as cut through (build_cut_clip_surface): every contact treated, the solid between
+    // the planes asked, the spheres beyond them left out.
+    const DomainPlanes planes = asked_planes(bed, p);
+    TreatedBed tb = treat_contacts_measured_between(bed, p, planes.z0, planes.z1);
+    tb.solid_volume = tb.solid_volume_between_m3;
+    tb.planes = planes;
+    for (std::size_t i = 0; i < bed.size(); ++i)
+      tb.kept[i] = bed.centres[i].z() + tb.radius[i] > planes.z0 && bed.centres[i].z() - tb.radius[i] < planes.z1;
+    return {std::nullopt, std::move(tb), bed};
+  }
   return {std::nullopt, treat_contacts(bed, p, asked_planes(bed, p)), bed};
 }
 
@@ -329,8 +343,12 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
   if (p.contact_edge_length_d < p.edge_length_d) {
     const double graded = 0.5 * (p.contact_edge_length_d + p.edge_length_d) * d;
     const double weight = std::min(2.0 * (1.0 - p.contact_edge_length_d / p.edge_length_d), 1.0);
+    // A clip window cut through its contacts is sized from the whole bed's treatment: the loops
+    // beyond its planes are left out.
+    const bool beyond = cuts_contacts_at_clip_planes(p);
     auto add = [&](const auto& loop, double spacing) {
       if (!(spacing < graded) || loop.empty()) return;
+      if (beyond && (loop.front().z() < tb.planes.z0 || loop.front().z() > tb.planes.z1)) return;
       const int b = std::clamp(static_cast<int>(std::floor((loop.front().z() - out.z0) / height)), 0, bins - 1);
       out.loop_edges[b] += weight * static_cast<double>(loop.size());
       out.size.contact_loop_edges += weight * static_cast<double>(loop.size());
@@ -356,6 +374,7 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
 
 FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   if (cuts_contacts_at_periodic_planes(given, p)) return build_cut_periodic_surface(given, p);
+  if (cuts_contacts_at_clip_planes(p)) return build_cut_clip_surface(given, p);
   const double top = bed_height(given);
   LaidOut laid = lay_out(given, p);
   const Bed& bed = laid.bed();

@@ -31,6 +31,9 @@ struct SurfaceParams {
   // On a periodic section: the bridges and caps its planes cross are cut through (true) or
   // opened there, their spheres shrunk (false; see treat_periodic_section, build_cut_periodic_surface).
   bool cut_at_periodic_planes = false;
+  // With a clip window: the bridges, caps and unions its planes cross are cut through (true;
+  // build_cut_clip_surface) or opened there, their spheres shrunk (false; treat_contacts).
+  bool cut_at_clip_planes = false;
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
   double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
   double growth = 1.5;                  // edge growth per ring away from those loops

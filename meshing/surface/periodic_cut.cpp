@@ -247,19 +247,6 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
         m / d, closed.defects.size(), describe_defects(closed)));
 
   // 6. What the surface stage reports of it.
-  for (std::size_t t = 0; t < f.triangles.size(); ++t)
-    if (f.patches[f.patch[t]] == "particles") {
-      std::array<int, 3> tri = f.triangles[t];
-      std::swap(tri[1], tri[2]);
-      const int first = static_cast<int>(out.bed.points.size());
-      for (int k = 0; k < 3; ++k) out.bed.points.push_back(f.points[tri[k]]);
-      out.bed.triangles.push_back({first, first + 1, first + 2});
-      out.bed.patch.push_back(out.bed.patch_index("particles"));
-    }
-  out.bed.weld();
-  SurfacePiece all;
-  all.first = 0, all.last = f.triangles.size();
-  out.pieces.push_back(all);
   out.report = whole.report;
   for (const char* key : {"clip", "domain_m", "triangles", "min_angle_deg", "min_edge_d", "max_edge_d"})
     out.report.erase(key);
@@ -277,11 +264,7 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
                                      {"contacts_opened", 0},
                                      {"seam_depth_d", m / d},
                                      {"cut", to_json(cut)}};
-  const MeshQuality quality = mesh_quality(f);
-  out.report["triangles"] = f.triangles.size();
-  out.report["min_angle_deg"] = quality.min_angle_deg;
-  out.report["min_edge_d"] = quality.min_edge / d;
-  out.report["max_edge_d"] = quality.max_edge / d;
+  finish_cut_surface(out, d);
   return out;
 }
 

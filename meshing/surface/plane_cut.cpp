@@ -167,6 +167,29 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
   return flips;
 }
 
+void finish_cut_surface(FluidSurface& out, double d) {
+  const TriangleMesh& f = out.fluid;
+  out.bed = TriangleMesh();
+  for (std::size_t t = 0; t < f.triangles.size(); ++t)
+    if (f.patches[f.patch[t]] == "particles") {
+      std::array<int, 3> tri = f.triangles[t];
+      std::swap(tri[1], tri[2]);
+      const int first = static_cast<int>(out.bed.points.size());
+      for (int k = 0; k < 3; ++k) out.bed.points.push_back(f.points[tri[k]]);
+      out.bed.triangles.push_back({first, first + 1, first + 2});
+      out.bed.patch.push_back(out.bed.patch_index("particles"));
+    }
+  out.bed.weld();
+  SurfacePiece all;
+  all.first = 0, all.last = f.triangles.size();
+  out.pieces = {all};
+  const MeshQuality quality = mesh_quality(f);
+  out.report["triangles"] = f.triangles.size();
+  out.report["min_angle_deg"] = quality.min_angle_deg;
+  out.report["min_edge_d"] = quality.min_edge / d;
+  out.report["max_edge_d"] = quality.max_edge / d;
+}
+
 nlohmann::json to_json(const PlaneCut& c) {
   return {{"loops", c.loops},
           {"vertices_snapped", c.vertices_snapped},

@@ -98,6 +98,12 @@ long flip_towards_delaunay(const std::vector<Eigen::Vector3d>& x, const std::vec
 
 PlaneCut cut_by_plane(const TriangleMesh& surface, double z, const PlaneCutParams& p);
 
+// A fluid surface made by cutting (`out.fluid`, m; d the reference diameter, m) made ready for
+// the surface stage: its bed solid (the particle triangles turned to face out of the solid), one
+// piece of no known shape (the self-intersection test then takes every pair near), and the
+// triangles' count and quality in `out.report`.
+void finish_cut_surface(FluidSurface& out, double d);
+
 // What a report says of a cut: its counts (loops, plane triangles, vertices snapped, ...).
 nlohmann::json to_json(const PlaneCut& c);
 

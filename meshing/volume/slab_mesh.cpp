@@ -163,34 +163,6 @@ nlohmann::json cut_json(const PlaneCut& c, double plane_d) {
   return j;
 }
 
-// The spheres' tops and bottoms (d above the floor), at their own and their shrunk radius, and
-// where the slabs are cut through treated contacts the heights such a cut keeps clear of
-// (treated_heights), sorted.
-std::vector<double> sphere_ends_d(const Bed& bed, const SurfaceParams& s) {
-  const double d = reference_diameter(bed);
-  std::vector<double> ends;
-  for (std::size_t i = 0; i < bed.size(); ++i)
-    for (double r : {0.5 * bed.diameters[i], 0.5 * s.shrink_factor * bed.diameters[i]})
-      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
-  if (!slabs_from_clip_windows(s))
-    for (double z : treated_heights(bed, s)) ends.push_back(z / d);
-  std::sort(ends.begin(), ends.end());
-  return ends;
-}
-
-// The middle of the widest interval between successive `ends` (sorted, d) whose middle lies
-// within `shift` of `asked`, leaving out the interval that holds `avoid` (NaN: none); `asked`
-// itself when there is no such interval.
-double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid) {
-  double best = asked, widest = -1.0;
-  for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
-    const double mid = 0.5 * (ends[j] + ends[j + 1]);
-    if (ends[j] <= avoid && avoid <= ends[j + 1]) continue;
-    if (std::abs(mid - asked) <= shift && ends[j + 1] - ends[j] > widest) best = mid, widest = ends[j + 1] - ends[j];
-  }
-  return best;
-}
-
 // Slab `k` of `slabs` from its closed surface, quietly, its failure naming it by `heights_d`
 // (asked, d above the floor); the report adds those heights, the surface's triangles and the cells.
 VolumeMesh mesh_slab_surface(const TriangleMesh& surface, const Bed& bed, double d_ref, const VolumeMeshParams& p,
@@ -318,7 +290,7 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
   std::vector<double> below(bins + 1, 0.0);  // cells below each bin's bottom
   std::partial_sum(profile.cells.begin(), profile.cells.end(), below.begin() + 1);
   const double height = (profile.z1 - profile.z0) / bins;
-  const std::vector<double> ends = sphere_ends_d(bed, s);
+  const std::vector<double> ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
   for (int k = 1; k < slabs; ++k) {
     // Where the cells below reach k / slabs of them, within its bin by linear interpolation.
     const double target = below.back() * k / slabs;
@@ -333,7 +305,7 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
 
 std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes,
                                         const std::vector<int>& failed) {
-  const std::vector<double> ends = sphere_ends_d(bed, s);
+  const std::vector<double> ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
   const auto named = [&](int slab) { return std::find(failed.begin(), failed.end(), slab) != failed.end(); };
   std::vector<double> moved = planes;
   for (int j = 0; j < static_cast<int>(planes.size()); ++j)  // plane j lies between slabs j and j + 1

@@ -320,6 +320,39 @@ TEST(OpenFoamCase, AWalledBoxGivesACaseCheckMeshPasses) {
   EXPECT_LT(eps_mesh, 1.0 - (1.0 - eps_bed) * kept + 0.01) << eps_bed << " " << kept;
 }
 
+// A clip window of a bridged bed, its planes given no room (clip_shift_d 0.02) and cut through
+// the contacts they cross (contacts.at_clip_planes = "cut"): solved, its inlet (the fluid's part
+// of a plane through the bed) carries the superficial velocity times the whole section, not the
+// velocity over the fluid's part (which once gave 0.6 of the flow rate and 0.31 x Eisfeld &
+// Schnitzlein on the default bed's window); nothing is opened; and dp/L lies where the small
+// bed's one-mesh dp/L lies (the band of SmallBedPressureDropAgreesWithEisfeldSchnitzlein below).
+TEST(OpenFoamCase, AClipWindowCutThroughItsBridgesCarriesTheFlowRateSet) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam) not on PATH";
+  Result r;
+  const fs::path out = run_scene_text(
+      "clip_cut",
+      "[container]\ndiameter_d = 4.0\n[particles]\ncount = 60\ndiameter_m = 0.003\n[packing]\nseed = 1\n"
+      "[contacts]\ntreatment = \"bridge\"\nat_clip_planes = \"cut\"\n"
+      "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\ncells_per_gap = 0\nclip_window_d = [1.0, 3.0]\n"
+      "clip_shift_d = 0.02\n"
+      "[case]\ncells = \"tetrahedra\"\nprocessors = 1\nrun = true\nconvergence = {levels = 0}\n"
+      "[outputs]\nfiles = [\"case\"]\n",
+      r);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto report = nlohmann::json::parse(read(out / "report.json"));
+  const auto& clip = report["stages"]["surface"]["clip"];
+  for (const char* plane : {"inlet", "outlet"}) {
+    EXPECT_EQ(clip[plane]["contacts_opened"].get<long>(), 0) << clip.dump();
+    EXPECT_GT(clip[plane]["cut"]["loops"].get<long>(), 1) << plane << ": the plane cuts spheres, not only the wall";
+  }
+  EXPECT_NE(read(out / "case/0/U").find("flowRateInletVelocity"), std::string::npos);
+  const auto& flow = report["stages"]["case"]["flow"];
+  EXPECT_LT(std::abs(flow["flow_rate_relative_error"].get<double>()), 1e-3) << flow.dump();
+  const double ratio = flow["ratio_to_eisfeld_schnitzlein_bed"].get<double>();
+  EXPECT_GT(ratio, 0.8 * 0.65) << flow.dump();
+  EXPECT_LT(ratio, 1.2) << flow.dump();
+}
+
 TEST(OpenFoamCase, SmallBedPressureDropAgreesWithEisfeldSchnitzlein) {
   // scenes/examples/small_bed_flow.toml: a = 4, N = 40, 0.1 d mesh, Re_p = 1, on two cores.
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (simpleFoam) not on PATH";

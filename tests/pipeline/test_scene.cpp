@@ -105,13 +105,17 @@ TEST(Scene, ContactTreatmentsAndTheirErrors) {
   EXPECT_EQ(s.surface.treatment, meshing::SurfaceParams::Treatment::cap);
   EXPECT_EQ(s.surface.wall_treatment, meshing::SurfaceParams::Treatment::cap);  // "same" by default
   EXPECT_DOUBLE_EQ(s.surface.cap_gap_d, 0.03);
+  EXPECT_FALSE(s.surface.cut_at_clip_planes);  // a clip window opens the contacts it cannot avoid unless told
+  EXPECT_TRUE(read(base + "[contacts]\nat_clip_planes = \"cut\"\n[surface]\nclip_window_d = [1, 3]\n").surface.cut_at_clip_planes);
   EXPECT_EQ(read(base + "[contacts]\ntreatment = \"bridge\"\nwall_treatment = \"none\"\n").surface.wall_treatment,
             meshing::SurfaceParams::Treatment::none);
   for (const auto& [bad, names] : std::vector<std::pair<std::string, std::string>>{
            {"treatment = \"glue\"", "contacts.treatment"},
            {"treatment = \"shrink\"\nwall_treatment = \"bridge\"", "contacts.wall_treatment"},
            {"bridge_diameter_d = 0.9", "contacts.bridge_diameter_d"},
-           {"cap_gap_d = 0", "contacts.cap_gap_d"}}) {
+           {"cap_gap_d = 0", "contacts.cap_gap_d"},
+           {"at_clip_planes = \"slice\"", "contacts.at_clip_planes"},
+           {"at_clip_planes = \"cut\"", "contacts.at_clip_planes = \"cut\" without surface.clip_window_d"}}) {
     try {
       read(base + "[contacts]\n" + bad + "\n");
       ADD_FAILURE() << bad << " accepted";
