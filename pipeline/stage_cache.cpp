@@ -30,7 +30,9 @@ std::string downstream_key(const nlohmann::json& scene, const std::string& upstr
 }  // namespace
 
 Wants run_wants(const Scene& scene) {
-  return {scene.wants("positions"), scene.wants("vtp"),  scene.wants("analysis"),
+  // A case in pieces: its ranks read the bed from bed.csv, asked for or not.
+  const bool pieces = scene.wants("case") && scene.mesh.pieces > 1;
+  return {scene.wants("positions") || pieces, scene.wants("vtp"),  scene.wants("analysis"),
           scene.wants("stl") || scene.case_params.snappy, scene.wants("mesh"), scene.wants("case"),
           !scene.case_params.snappy_cells, scene.case_params.convergence.levels > 0};
 }

@@ -33,13 +33,15 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
                                  "contacts, leave no window ({:.4g} to {:.4g} d); allowed: a taller window",
                                  p.clip_bottom_d, p.clip_top_d, lo / d, hi / d));
 
-  // 2. The spheres within piece_margin_d of the window, whole, their walls ringed at the planes,
-  // its own planes half a diameter beyond the spheres' ends (and beyond the window's), cutting
-  // nothing.
+  // 2. The spheres within piece_margin_d of the window, whole, their walls ringed at the planes
+  // (and where `p` rings them: a slab of a window in pieces, cut again at its planes), its own
+  // planes half a diameter beyond the spheres' ends (and beyond the window's), cutting nothing.
   SurfaceParams plain = p;
   plain.cut_at_clip_planes = false;
   const double margin = piece_margin_d(bed, p) * d, pad = 0.5 * largest_diameter(bed);
-  CutWindow window = window_for_cuts(bed, plain, lo - margin, hi + margin, {lo / d, hi / d});
+  std::vector<double> rings = p.wall_rings_d;
+  rings.insert(rings.end(), {lo / d, hi / d});
+  CutWindow window = window_for_cuts(bed, plain, lo - margin, hi + margin, std::move(rings));
   SurfaceParams& q = window.surface;
   q.clip_bottom_d = std::min(q.clip_bottom_d, (lo - pad) / d);
   q.clip_top_d = std::max(q.clip_top_d, (hi + pad) / d);
