@@ -95,6 +95,10 @@ const std::vector<Flag>& table() {
        "heights above the floor in diameters whose planes become the inlet and outlet, cutting the spheres there, "
        "instead of the empty sections",
        static_cast<unsigned>(Command::surface), 2},
+      {"--at-clip-planes", {"contacts.at_clip_planes"},
+       "what the clip window's planes do to the bridges, caps and unions they cross: open them (spheres shrunk) or "
+       "cut them through",
+       static_cast<unsigned>(Command::surface)},
       {"--algorithm", {"mesh.algorithm"}, "first 3D algorithm tried, the other is the fallback",
        static_cast<unsigned>(Command::mesh)},
       {"--max-size-d", {"mesh.max_size_d"}, "largest cell edge in diameters", static_cast<unsigned>(Command::mesh)},

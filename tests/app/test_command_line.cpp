@@ -371,6 +371,15 @@ TEST(CommandLine, SurfaceStageOnAPackedBed) {
               s["clip"]["outlet"]["used_d"].get<double>() / s["clip"]["inlet"]["used_d"].get<double>(), 1e-9);
   EXPECT_NEAR(s["clip"]["inlet"]["used_d"].get<double>(), 1.0, 0.25);
   EXPECT_NEAR(s["clip"]["outlet"]["used_d"].get<double>(), 3.0, 0.25);
+  // Cut through the bridges its planes cross instead of opening them: none opened.
+  const Result cut = bedforge("--quiet surface " + dir.string() +
+                              " --clip-window-d 1 3 --edge-length-d 0.15 --contacts bridge --at-clip-planes cut");
+  ASSERT_EQ(cut.status, 0) << cut.output;
+  std::ifstream cut_report(dir / "report.json");
+  const auto c = nlohmann::json::parse(cut_report)["stages"]["surface"];
+  EXPECT_EQ(c["parameters"]["at_clip_planes"], "cut");
+  EXPECT_EQ(c["clip"]["inlet"]["contacts_opened"].get<long>() + c["clip"]["outlet"]["contacts_opened"].get<long>(), 0);
+  EXPECT_EQ(bedforge("surface " + dir.string() + " --at-clip-planes slice").status, 2);
   const Result reversed = bedforge("surface " + dir.string() + " --clip-window-d 3 1");
   EXPECT_EQ(reversed.status, 2);
   EXPECT_NE(reversed.output.find("surface.clip_window_d"), std::string::npos) << reversed.output;
