@@ -251,9 +251,6 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
-  if (sc.surface.cut_at_clip_planes && !sc.surface.clip)
-    throw InputError("contacts.at_clip_planes = \"cut\" without surface.clip_window_d: there are no clip planes; "
-                     "allowed: \"open\" (the default), or a clip window");
   if (sc.surface.cut_at_periodic_planes && sc.container->axial_period() == 0.0)
     throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "
                      "periodic planes; allowed: \"open\" (the default), or a periodic section");

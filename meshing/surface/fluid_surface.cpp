@@ -64,7 +64,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.bridge_gap_d = c.number("bridge_gap_d", p.bridge_gap_d, Range{0.0, 0.5, false, false});
   p.cap_gap_d = c.number("cap_gap_d", p.cap_gap_d, Range{0.0, 0.2, true, false});
   p.cut_at_periodic_planes = c.choice("at_periodic_planes", "open", {"open", "cut"}) == "cut";
-  p.cut_at_clip_planes = c.choice("at_clip_planes", "open", {"open", "cut"}) == "cut";
+  p.cut_at_clip_planes = c.choice("at_clip_planes", "cut", {"open", "cut"}) == "cut";
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
@@ -88,6 +88,9 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.clip_shift_d = s.number("clip_shift_d", p.clip_shift_d, Range::closed(0.0, 1.0));
   p.clip_clearance_d = s.number("clip_clearance_d", p.clip_clearance_d, Range::closed(0.0, 0.1));
   p.min_angle_deg = s.number("min_angle_deg", p.min_angle_deg, Range::closed(0.0, 30.0));
+  if (c.has("at_clip_planes") && p.cut_at_clip_planes && !p.clip)
+    throw InputError("contacts.at_clip_planes = \"cut\" without surface.clip_window_d: there are no clip planes; "
+                     "allowed: no contacts.at_clip_planes, or a clip window");
   return p;
 }
 

@@ -31,8 +31,9 @@ struct SurfaceParams {
   // On a periodic section: the bridges and caps its planes cross are cut through (true) or
   // opened there, their spheres shrunk (false; see treat_periodic_section, build_cut_periodic_surface).
   bool cut_at_periodic_planes = false;
-  // With a clip window: the bridges, caps and unions its planes cross are cut through (true;
-  // build_cut_clip_surface) or opened there, their spheres shrunk (false; treat_contacts).
+  // With a clip window: the bridges, caps and unions its planes cross are cut through (true, a
+  // scene's default; build_cut_clip_surface) or opened there, their spheres shrunk (false;
+  // treat_contacts).
   bool cut_at_clip_planes = false;
   double edge_length_d = 0.1;           // target triangle edge, walls and spheres
   double contact_edge_length_d = 0.033; // edge on the loops where treated contacts meet (refinement near contacts)
@@ -68,8 +69,8 @@ const char* treatment_name(SurfaceParams::Treatment t);
 // A scene's defaults are those of a pressure-drop run, where they differ from the struct's (the
 // plain geometry a caller of this library starts from): bridged contacts (they change the bed's
 // solid by +0.2 %, shrink by -3 %), a 0.15 d edge, a third of it at contacts and 4 cells across
-// narrow gaps, the settings whose studies on a = 5, N = 500 converge in the asymptotic range
-// (docs/defaults.md).
+// narrow gaps, the settings whose studies on a = 5, N = 500 converge in the asymptotic range; and
+// clip windows cut through their contacts (docs/defaults.md).
 inline constexpr double kSceneEdgeLengthD = 0.15, kSceneContactEdgeLengthD = 0.05, kSceneCellsPerGap = 4.0;
 SurfaceParams read_surface_params(SceneSection& contacts, SceneSection& surface);
 nlohmann::json to_json(const SurfaceParams& p);

@@ -105,8 +105,9 @@ TEST(Scene, ContactTreatmentsAndTheirErrors) {
   EXPECT_EQ(s.surface.treatment, meshing::SurfaceParams::Treatment::cap);
   EXPECT_EQ(s.surface.wall_treatment, meshing::SurfaceParams::Treatment::cap);  // "same" by default
   EXPECT_DOUBLE_EQ(s.surface.cap_gap_d, 0.03);
-  EXPECT_FALSE(s.surface.cut_at_clip_planes);  // a clip window opens the contacts it cannot avoid unless told
-  EXPECT_TRUE(read(base + "[contacts]\nat_clip_planes = \"cut\"\n[surface]\nclip_window_d = [1, 3]\n").surface.cut_at_clip_planes);
+  // A clip window cuts through the contacts its planes cross unless told to open them.
+  EXPECT_TRUE(read(base + "[surface]\nclip_window_d = [1, 3]\n").surface.cut_at_clip_planes);
+  EXPECT_FALSE(read(base + "[contacts]\nat_clip_planes = \"open\"\n[surface]\nclip_window_d = [1, 3]\n").surface.cut_at_clip_planes);
   EXPECT_EQ(read(base + "[contacts]\ntreatment = \"bridge\"\nwall_treatment = \"none\"\n").surface.wall_treatment,
             meshing::SurfaceParams::Treatment::none);
   for (const auto& [bad, names] : std::vector<std::pair<std::string, std::string>>{
