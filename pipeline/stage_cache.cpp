@@ -31,7 +31,11 @@ std::string downstream_key(const nlohmann::json& scene, const std::string& upstr
 
 Wants run_wants(const Scene& scene) {
   // A case in pieces: its ranks read the bed from bed.csv, asked for or not.
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
   const bool pieces = scene.wants("case") && scene.mesh.pieces > 1;
+#else
+  const bool pieces = false;  // no mesh stage, so no pieces
+#endif
   return {scene.wants("positions") || pieces, scene.wants("vtp"),  scene.wants("analysis"),
           scene.wants("stl") || scene.case_params.snappy, scene.wants("mesh"), scene.wants("case"),
           !scene.case_params.snappy_cells, scene.case_params.convergence.levels > 0};
