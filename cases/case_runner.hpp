@@ -68,18 +68,19 @@ struct FlowResult {
 // empty when all are.
 std::string missing_openfoam_program(int processors);
 
-// Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
-// reads back the solver's convergence and the pressure drop, compared with Eisfeld &
-// Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
-// while it runs. ConvergenceError when snappyHexMesh's cells lost the inlet or the outlet (the
-// fluid they kept does not reach it), naming the settings that make finer cells;
-// std::runtime_error naming the log and Allrun's last words when another step fails.
 // The most the flow rate through the outlet may differ from the superficial velocity times the
 // section on gmsh's cells outside a periodic section before run_case calls it a defect: the
 // inlet's faceting takes off a few per cent on coarse meshes (-0.64 % on the empty tube of 2 d at
 // 0.2 d, -2.3 % on its coarsest level of 0.4 d; an 8-gon would lose 10 %), a clip window's
 // inlet that carried only the fluid's share took off 60 %.
 inline constexpr double kFlowRateTolerance = 0.1;
+
+// Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
+// reads back the solver's convergence and the pressure drop, compared with Eisfeld &
+// Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
+// while it runs. ConvergenceError when snappyHexMesh's cells lost the inlet or the outlet (the
+// fluid they kept does not reach it), naming the settings that make finer cells;
+// std::runtime_error naming the log and Allrun's last words when another step fails.
 FlowResult run_case(const CaseInfo& c, Progress& progress);
 
 }  // namespace bedforge::cases

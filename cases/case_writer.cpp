@@ -606,9 +606,9 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
     ubar = u * g.cross_section_area * (g.outlet_z - g.inlet_z) / *fluid_volume;
   }
   // A clip window's inlet plane cuts spheres: the flow rate is set, not the velocity over its fluid.
-  const bool inlet_in_bed = !g.periodic && std::any_of(bed.centres.begin(), bed.centres.end(), [&](const Eigen::Vector3d& c) {
-    return std::abs(c.z() - g.inlet_z) < 0.5 * bed.diameters[&c - bed.centres.data()];
-  });
+  bool inlet_in_bed = false;
+  for (std::size_t i = 0; i < bed.size() && !g.periodic; ++i)
+    inlet_in_bed = inlet_in_bed || std::abs(bed.centres[i].z() - g.inlet_z) < 0.5 * bed.diameters[i];
   const std::optional<double> inlet_flow = inlet_in_bed ? std::optional(u * g.cross_section_area) : std::nullopt;
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
