@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #ifdef BEDFORGE_HAVE_CGAL
 #include "meshing/surface/clip_planes.hpp"
+#include "meshing/surface/periodic_box.hpp"
 #include "meshing/surface/periodic_cut.hpp"
 #endif
 
@@ -127,6 +128,11 @@ void check_periodic_surface(const Scene& sc) {
   if (sc.wants("case") && sc.case_params.snappy)
     throw InputError("case.mesher = \"snappy\" (or case.snappy) on a periodic section: its cyclic patches are made "
                      "from gmsh's cells; allowed: case.mesher = \"gmsh\"");
+  // The tetrahedra's gradients are fitted over the cells sharing a vertex, a stencil OpenFOAM v1912
+  // does not carry across cyclic patches ("Coupled patches with transformations not supported").
+  if (sc.wants("case") && !sc.case_params.polyhedra)
+    throw InputError("case.cells = \"tetrahedra\" on a periodic section: their point-neighbour gradients do not "
+                     "cross OpenFOAM v1912's cyclic patches; allowed: case.cells = \"polyhedra\"");
   if (sc.mesh.layers.count > 0)
     throw InputError(fmt::format("mesh.layers.count = {} on a periodic section: layers beside the periodic planes are "
                                  "not matched yet; allowed: 0",
@@ -250,6 +256,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
 #endif
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (sc.needs_surface()) meshing::check_periodic_box(*sc.container, sc.surface);
   if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
   if (sc.surface.cut_at_periodic_planes && sc.container->axial_period() == 0.0)
     throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "core/version.hpp"
 #include "meshing/surface/stl_io.hpp"
@@ -20,12 +21,13 @@ SurfaceStage surface_stage(const Bed& bed, const meshing::SurfaceParams& p, cons
       "surface ({}, {} contacts treated): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, "
       "min angle {:.1f} deg, smallest gap {:.3g} d",
       meshing::treatment_name(p.treatment),
-      j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"]["particle_wall"].get<long>(),
+      j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"].value("particle_wall", 0L),
       built->fluid.triangles.size(),
       check.self_intersection_test != meshing::SelfIntersectionTest::skip ? "no self-intersection" : "self-intersections not checked",
       (check.volume - built->exact_volume_m3) / built->exact_volume_m3, j["chordal_deviation_d"].get<double>(),
       j["min_angle_deg"].get<double>(),
-      std::min(j["smallest_gap_d"]["particle_particle"].get<double>(), j["smallest_gap_d"]["particle_wall"].get<double>()));
+      std::min(j["smallest_gap_d"]["particle_particle"].get<double>(),
+               j["smallest_gap_d"].value("particle_wall", std::numeric_limits<double>::infinity())));
   if (j.contains("clip")) {
     line += fmt::format(", clipped at {:.3f}-{:.3f} d", j["clip"]["inlet"]["used_d"].get<double>(),
                         j["clip"]["outlet"]["used_d"].get<double>());

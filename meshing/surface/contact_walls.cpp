@@ -17,10 +17,13 @@ std::vector<Wall> walls_of(const Container& c) {
   if (const auto* ann = dynamic_cast<const Annulus*>(&c))
     return {Wall{"wall", 0, false, ann->outer_radius()}, Wall{"inner wall", 1, false, ann->inner_radius(), true}};
   if (const auto* box = dynamic_cast<const Box*>(&c)) {
+    // A box periodic on both sides has no walls (build_periodic_box_surface; its period along z
+    // may be unwrapped when the fluid domain is sized); one periodic on one side only is not meshed.
+    if (box->periodicity().lx > 0.0 && box->periodicity().ly > 0.0) return {};
     if (box->periodicity().lateral())
-      throw InputError("container.periodic_x/periodic_y = true: the surface stage meshes walled boxes only (a periodic "
-                       "fluid domain needs matching periodic patches, not made here); allowed: a box with walls on "
-                       "every side, a cylinder or an annulus");
+      throw InputError("container.periodic_x/periodic_y = true: the surface stage meshes a box periodic on every side "
+                       "(periodic_x, periodic_y and period_z) or walled on every side; allowed: both periodic_x and "
+                       "periodic_y with container.period_z_d, or neither");
     const double hx = 0.5 * box->size_x(), hy = 0.5 * box->size_y();
     auto side = [](const char* name, int index, Eigen::Vector3d n, double k) {
       Wall w{name, index, true};

@@ -23,6 +23,7 @@
 #include "meshing/surface/defect_locations.hpp"
 #include "meshing/surface/clip_cut.hpp"
 #include "meshing/surface/clip_planes.hpp"
+#include "meshing/surface/periodic_box.hpp"
 #include "meshing/surface/periodic_cut.hpp"
 #include "meshing/surface/contacts.hpp"
 #include "meshing/surface/delaunay_walls.hpp"
@@ -376,6 +377,7 @@ FluidDomainProfile fluid_domain_profile(const Bed& given, const SurfaceParams& p
 }
 
 FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
+  if (is_fully_periodic_box(*given.container)) return build_periodic_box_surface(given, p);
   if (cuts_contacts_at_periodic_planes(given, p)) return build_cut_periodic_surface(given, p);
   if (cuts_contacts_at_clip_planes(p)) return build_cut_clip_surface(given, p);
   const double top = bed_height(given);

@@ -327,7 +327,10 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
     canonical_flat_facets(faces, kp);
     m.triangles.clear();
     for (auto t : faces) {
-      if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) continue;
+      if (owner[t[0]] >= 0 && owner[t[0]] == owner[t[1]] && owner[t[0]] == owner[t[2]]) {
+        const SphereCut& cut = cuts[owner[t[0]]];
+        if (!cut.spans || cut.spans(pts.points[t[0]], pts.points[t[1]], pts.points[t[2]])) continue;
+      }
       std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
       m.triangles.push_back(t);
     }

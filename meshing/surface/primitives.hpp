@@ -59,6 +59,10 @@ struct SphereCut {
   double jitter = kBreakCocircular;               // of the rings graded from the loop
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, from the centre into the removed part
   std::function<bool(const Eigen::Vector3d&)> removed;
+  // Whether a hull face whose three vertices all lie on this loop spans the removed part (and is
+  // dropped); unset: every such face does. A loop along two planes (a sphere cut at a box's edge)
+  // also holds faces on the sphere that turn its corners, which are kept.
+  std::function<bool(const Eigen::Vector3d&, const Eigen::Vector3d&, const Eigen::Vector3d&)> spans;
 };
 
 // Thrown when cuts on one sphere overlap or leave a loop edge out of the mesh; the caller

@@ -174,7 +174,8 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   for (const auto& [extra, key] : std::vector<std::pair<std::string, std::string>>{
            {"[mesh]\nslabs = 2\n", "mesh.slabs = 2"},
            {"[mesh.layers]\ncount = 2\n", "mesh.layers.count = 2"},
-           {"[case]\nmesher = \"snappy\"\n", "case.mesher"}}) {
+           {"[case]\nmesher = \"snappy\"\n", "case.mesher"},
+           {"[case]\ncells = \"tetrahedra\"\n", "case.cells = \"tetrahedra\""}}) {
     const std::string m = message(meshed + extra);
     EXPECT_NE(m.find(key), std::string::npos) << m;
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
@@ -207,6 +208,29 @@ TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   EXPECT_NE(short_period.find("at least 7.2 d"), std::string::npos) << short_period;
 #endif
 }
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+// A box periodic on every side is meshed with its spheres apart (none or shrink); one periodic on
+// one side, or on both without a period along z, is not meshed; each refused by key.
+TEST(Scene, ABoxPeriodicOnEverySideRefusesWhatItCannotBeGiven) {
+  const std::string box = "[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiodic_x = true\n"
+                          "periodic_y = true\nperiod_z_d = 4\n[particles]\ncount = 40\n[packing]\n"
+                          "algorithm = \"monte-carlo\"\n[outputs]\nfiles = [\"case\"]\n";
+  EXPECT_EQ(read(box + "[contacts]\ntreatment = \"shrink\"\n").surface.treatment, meshing::SurfaceParams::Treatment::shrink);
+  for (const auto& [text, says] : std::vector<std::pair<std::string, std::string>>{
+           {box, "contacts.treatment = \"bridge\" in a box periodic on every side"},
+           {"[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiodic_x = true\nperiod_z_d = 4\n"
+            "[particles]\ncount = 40\n[contacts]\ntreatment = \"shrink\"\n[outputs]\nfiles = [\"stl\"]\n",
+            "periodic_y = false"},
+           {"[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiodic_x = true\nperiodic_y = true\n"
+            "[particles]\ncount = 40\n[contacts]\ntreatment = \"shrink\"\n[outputs]\nfiles = [\"stl\"]\n",
+            "period_z_d not set"}}) {
+    const std::string m = message(text);
+    EXPECT_NE(m.find(says), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed"), std::string::npos) << m;
+  }
+}
+#endif
 
 TEST(Scene, ATargetVoidFractionMakesAPeriodicSection) {
   // 212 unit spheres in a = 5 at 0.4347: the period of scenes/examples/periodic_section.toml, 10 d.
