@@ -31,6 +31,21 @@ inline double wall_wetted_area_share(double eps, double aspect_ratio) {
   return (a_w - 1.0) / a_w;
 }
 
+// Stokes flow through random arrays of equal spheres (no wall), van der Hoef, Beetstra & Kuipers
+// (2005, J. Fluid Mech. 528, 233), their fit to lattice-Boltzmann drag at solid fractions
+// phi = 0.1-0.6: F = 10 phi / (1 - phi)^2 + (1 - phi)^2 (1 + 1.5 sqrt(phi)), the mean drag per sphere
+// over Stokes's 3 pi mu d U (U superficial) without the mean pressure gradient's buoyancy-like
+// share; the gradient holding the spheres is then n 3 pi mu d U F / (1 - phi), n = 6 phi / (pi d^3):
+//   dp/L = 18 mu U phi F / (d^2 (1 - phi))   (Pa/m; mu Pa s, U m/s, d m).
+// Its first term alone is Carman-Kozeny's 180 mu U phi^2 / (d^2 (1 - phi)^3), as the authors put it;
+// the fit's accuracy against their simulations is not copied here (the paper is not at hand).
+inline double van_der_hoef_f(double phi) {
+  return 10.0 * phi / ((1.0 - phi) * (1.0 - phi)) + (1.0 - phi) * (1.0 - phi) * (1.0 + 1.5 * std::sqrt(phi));
+}
+inline double van_der_hoef_gradient(double phi, double viscosity, double velocity, double diameter) {
+  return 18.0 * viscosity * velocity * phi * van_der_hoef_f(phi) / (diameter * diameter * (1.0 - phi));
+}
+
 // Ergun (1952): F = 150 / Re_m + 1.75, for a > 10 and 1 < Re_m < ~700.
 inline double ergun_f(double reynolds_p, double eps) { return 150.0 * (1.0 - eps) / reynolds_p + 1.75; }
 

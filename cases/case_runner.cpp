@@ -51,6 +51,10 @@ nlohmann::json FlowResult::to_json() const {
             {"push_inlet_outlet_n", push_inlet_outlet_n},
             {"wall_share", wall_share_of_drag},
             {"force_balance_relative_error", force_balance_relative_error}}}};
+  if (van_der_hoef_pa_m) {
+    j["van_der_hoef_pa_m"] = *van_der_hoef_pa_m;
+    j["ratio_to_van_der_hoef"] = *ratio_to_van_der_hoef;
+  }
   if (exact_pa_m) {
     j["exact_pa_m"] = *exact_pa_m;
     j["relative_error_to_exact"] = relative_error_to_exact;
@@ -374,7 +378,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
                                          "the case",
                                          case_dir.string(), flow, 100.0 * r.flow_rate_relative_error,
                                          u * c.inlet_area_m2));
-  const ForceZ walls = last_force_z(case_dir, "forceWalls");
+  const ForceZ walls = c.walls ? last_force_z(case_dir, "forceWalls") : ForceZ{};
   const ForceZ particles = c.particles ? last_force_z(case_dir, "forceParticles") : ForceZ{};
   r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
   r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
@@ -387,6 +391,10 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const double drag = r.drag_walls_n + r.drag_particles_n;
   r.wall_share_of_drag = r.drag_walls_n / drag;
   r.force_balance_relative_error = drag / r.push_inlet_outlet_n - 1.0;
+  if (c.stokes_array) {
+    r.van_der_hoef_pa_m = c.stokes_array->pa_m;
+    r.ratio_to_van_der_hoef = gradient / c.stokes_array->pa_m;
+  }
   if (c.exact_pressure_gradient_pa_m) {
     r.exact_pa_m = c.exact_pressure_gradient_pa_m;
     r.relative_error_to_exact = gradient / *r.exact_pa_m - 1.0;

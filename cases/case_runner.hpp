@@ -49,6 +49,9 @@ struct FlowResult {
   // error dp/L / exact - 1. Otherwise unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;
   double relative_error_to_exact = 0.0;
+  // A random array's Stokes drag (CaseInfo::stokes_array): van der Hoef et al.'s gradient and
+  // dp/L over it.
+  std::optional<double> van_der_hoef_pa_m, ratio_to_van_der_hoef;
   // The correlation at the section's meshed void fraction, when known (not on snappyHexMesh's cells).
   std::optional<double> eisfeld_schnitzlein_pa_m, ratio_to_eisfeld_schnitzlein, void_fraction_section;
   // The same at the section's exact void fraction of the spheres as packed: the bed the

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "analysis/laminar_duct.hpp"
+#include "analysis/pressure_drop.hpp"
 #include "analysis/stokes_arrays.hpp"
 #include "analysis/void_fraction.hpp"
 #include "cases/poly_mesh_io.hpp"
@@ -120,6 +121,11 @@ nlohmann::json CaseInfo::to_json() const {
           {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr},
           {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr},
+          {"walls", walls},
+          {"stokes_array", stokes_array ? nlohmann::json{{"solid_fraction", stokes_array->solid_fraction},
+                                                         {"diameter_m", stokes_array->diameter_m},
+                                                         {"van_der_hoef_pa_m", stokes_array->pa_m}}
+                                        : nlohmann::json()},
           {"polyhedra_quality", polyhedra_quality ? polyhedra_quality->to_json(d_ref_m) : nullptr}};
 }
 
@@ -377,7 +383,7 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
 // controlDict: the iteration cap and, as function objects, the pressure averaged over the inlet,
 // the outlet and the section's planes, the flow rate and the forces on every solid patch.
 void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSection& section, bool particles,
-                        bool periodic, const std::string& note) {
+                        bool walls, bool periodic, const std::string& note) {
   const std::string fmt_word = p.binary ? "binary" : "ascii";
   // A periodic section's pressure is periodic: the gradient is meanVelocityForce's, and the
   // cyclic patches carry no force.
@@ -388,7 +394,8 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
                       surface_value("pBedBottom", plane_region("bedBottom", section.z_low), "areaAverage", "p") +
                       surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p")) +
       surface_value("flowRate", patch_region("outlet"), "sum", "phi") +
-      forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) +
+      // Without walls no patch matches, and OpenFOAM's forces then takes the particles again.
+      (walls ? forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) : std::string()) +
       (particles ? forces("forceParticles", "particles", p.density_kg_m3) : std::string()) +
       (periodic ? std::string()
                 : forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3));
@@ -450,7 +457,7 @@ void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool period
                               // A cyclic pair's faces on one process: else each keeps none of the patch itself
                               // (they become processorCyclic faces) and the flow rate over it has no faces.
                               periodic ? "\nconstraints\n{\n    cyclics\n    {\n        type            preservePatches;\n"
-                                         "        patches         (inlet outlet);\n    }\n}\n"
+                                         "        patches         (inlet outlet \"(x|y)_(min|max)\");\n    }\n}\n"
                                        : "")));
 }
 
@@ -573,7 +580,7 @@ void put_pieces_back(const fs::path& aside, const fs::path& case_dir, int pieces
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const fs::path& fluid_stl, bool spheres_as_packed) {
+                    const std::string& bed_csv, const fs::path& fluid_stl, double sphere_scale) {
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
   if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
@@ -621,18 +628,18 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                                   case_dir.parent_path() /
                                                       fmt::format("bad_polyhedra_{}.vtk", case_dir.filename().string()));
       polyhedra_quality->ears_cut = static_cast<long>(ears.size());
-      if (g.periodic) meshing::match_cyclic_patches(dual, "inlet", "outlet");
+      if (g.periodic) meshing::match_every_cyclic_pair(dual);
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
     } else if (mesh && g.periodic) {
       meshing::PolyMesh cyclic = *mesh;
-      meshing::match_cyclic_patches(cyclic, "inlet", "outlet");
+      meshing::match_every_cyclic_pair(cyclic);
       write_poly_mesh(tmp / "constant/polyMesh", cyclic, p.binary, note);
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
     write_fields(tmp, p, u, nu, g.d_ref, ubar, inlet_flow, note);
-    write_control_dict(tmp, p, section, bed.size() > 0, g.periodic, note);
+    write_control_dict(tmp, p, section, bed.size() > 0, bed.container->wall_perimeter() > 0.0, g.periodic, note);
     write_solver_settings(tmp, p, g.periodic, note);
     write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
     write_text(tmp / "Allclean", kAllclean, true);
@@ -644,15 +651,26 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   CaseInfo info{case_dir, p, u, nu, cells, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;
+  info.walls = bed.container->wall_perimeter() > 0.0;
   info.mean_velocity_m_s = ubar;
   info.polyhedra_quality = polyhedra_quality;
   if (!info.particles && !p.slip_walls)
     info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
   // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
-  if (info.particles && spheres_as_packed && p.slip_walls && p.reynolds <= 0.01)
+  if (info.particles && sphere_scale == 1.0 && p.slip_walls && p.reynolds <= 0.01)
     info.exact_pressure_gradient_pa_m =
         analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
+  // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
+  // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
+  // size and solid fraction as solved.
+  const bool equal = info.particles && std::all_of(bed.diameters.begin(), bed.diameters.end(),
+                                                   [&bed](double x) { return x == bed.diameters[0]; });
+  if (equal && !info.walls && bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01) {
+    const double phi = (1.0 - section.void_fraction_bed) * sphere_scale * sphere_scale * sphere_scale;
+    const double d = bed.diameters[0] * sphere_scale;
+    info.stokes_array = CaseInfo::StokesArray{phi, d, analysis::van_der_hoef_gradient(phi, p.viscosity_pa_s, u, d)};
+  }
   return info;
 }
 

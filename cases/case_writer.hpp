@@ -80,6 +80,14 @@ struct CaseInfo {
   // other beds, which are compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
   bool particles = false;                // the bed has spheres (a particles patch)
+  bool walls = true;                     // the container has walls (a box periodic on every side has none)
+  // A random array of equal spheres in a box periodic on every side at Re_p <= 0.01: van der Hoef
+  // et al.'s Stokes drag (analysis::van_der_hoef_gradient) at the spheres' solid fraction and
+  // diameter (m) as solved, and its gradient (Pa/m). Compared beside Eisfeld & Schnitzlein.
+  struct StokesArray {
+    double solid_fraction = 0.0, diameter_m = 0.0, pa_m = 0.0;
+  };
+  std::optional<StokesArray> stokes_array;
   // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
   // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
   std::optional<double> mean_velocity_m_s = std::nullopt;
@@ -96,12 +104,14 @@ struct CaseInfo {
 // flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, the records
 // `bedforge/scene.toml` and `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
 // (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
-// `spheres_as_packed`: the mesh's spheres are the bed's own (no contact treatment changed them),
-// the condition for comparing a bed with a known answer (a simple cubic column's).
+// `sphere_scale`: the one scale the contact treatment gave every sphere (1: the bed's own, the
+// condition for comparing a bed with a known answer, a simple cubic column's; 0: not one scale),
+// with which a box periodic on every side of equal spheres at Re_p <= 0.01 is compared with van der
+// Hoef et al.'s Stokes drag at the spheres solved (CaseInfo::stokes_array).
 CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, bool spheres_as_packed);
+                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, double sphere_scale);
 
 // The pieces an earlier run of a case left (processor*/ and piece_layers/) moved out of
 // case_dir while the case is written anew (returns where to), and put back after it, those of

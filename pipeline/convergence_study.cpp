@@ -158,7 +158,7 @@ CaseStage write_level_in_pieces(const Scene& scene, const Bed& bed, const LevelL
   params.run = false;  // sized first, solved once
   const CasePieces pieces = case_pieces(bed, lengths.surface, scene.mesh.pieces, level_dir, console);
   return case_stage(nullptr, nullptr, bed, params, prov, toml_text, {}, level_dir / "case", true,
-                    scene.surface.keeps_spheres(), console, &pieces);
+                    scene.surface.sphere_scale(), console, &pieces);
 }
 
 // Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
@@ -217,7 +217,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       params.snappy = false;  // a coarser level is solved on its gmsh cells only
       const meshing::PolyMesh* cells = &m->volume->mesh;
       c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {}, case_dir,
-                     true, scene.surface.keeps_spheres(), console);
+                     true, scene.surface.sphere_scale(), console);
     }
     StudyLevel solved = study_level(*c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);

@@ -90,6 +90,10 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.reference_accuracy = analysis::kEisfeldSchnitzleinAccuracy;
     a.void_fraction_bed = flow["void_fraction_section_bed"].get<double>();
   }
+  if (const nlohmann::json array = entry.value("stokes_array", nlohmann::json()); array.is_object()) {
+    a.stokes_array_pa_m = array["van_der_hoef_pa_m"].get<double>();
+    a.stokes_array_solid_fraction = array["solid_fraction"].get<double>();
+  }
   const double solver_peak_mb = flow.value("solver_peak_memory_mb", 0.0);
   if (!study) {
     if (entry["fluid_volume_m3"].is_number())  // gmsh's cells (snappyHexMesh's volume is not known beforehand)
@@ -143,6 +147,12 @@ std::vector<std::string> PressureDropAnswer::lines() const {
                         "fraction of the spheres as packed, {:.4f}",
                         reference_name, reference_pa_m, 100.0 * *reference_accuracy, void_fraction_bed.value_or(0.0))
           : fmt::format("  {}: {:.6g} Pa/m", reference_name, reference_pa_m);
+  const std::string stokes_array =
+      stokes_array_pa_m
+          ? fmt::format("  van der Hoef, Beetstra & Kuipers (2005), Stokes drag of random arrays: {:.4g} Pa/m at the "
+                        "solid fraction of the spheres as solved, {:.4f} (their fit's accuracy not stated here)",
+                        *stokes_array_pa_m, stokes_array_solid_fraction.value_or(0.0))
+          : std::string();
   if (best_pa_m) {
     out.push_back("answer: " + where);
     out.push_back(fmt::format("  best estimate: {:.4g} Pa/m, the Richardson extrapolation of the three finest meshes "
@@ -153,6 +163,7 @@ std::vector<std::string> PressureDropAnswer::lines() const {
                               *band_low_pa_m, *band_high_pa_m, finest_pa_m, finest_cells, 100.0 * gci_fine));
     out.push_back(reference);
     out.push_back(fmt::format("  best estimate / reference: {:.3f}", *best_pa_m / reference_pa_m));
+    if (stokes_array_pa_m) out.push_back(stokes_array + fmt::format("; best estimate / it: {:.3f}", *best_pa_m / *stokes_array_pa_m));
   } else {
     out.push_back("answer: " + where + ": no error band, so no best estimate");
     out.push_back(fmt::format("  finest mesh: {:.4g} Pa/m ({} cells), {}", finest_pa_m, finest_cells,
@@ -160,6 +171,7 @@ std::vector<std::string> PressureDropAnswer::lines() const {
     out.push_back("  why: " + why_no_estimate);
     out.push_back("  to get one: " + advice);
     out.push_back(reference);
+    if (stokes_array_pa_m) out.push_back(stokes_array);
   }
   // Said beside the answer, which rests on those meshes (not refused: meshing::check_polyhedra).
   if (!failing_check_mesh.empty()) {
@@ -188,6 +200,10 @@ nlohmann::json PressureDropAnswer::to_json() const {
                         {"relative_accuracy", reference_accuracy ? nlohmann::json(*reference_accuracy) : nullptr},
                         {"void_fraction_bed", void_fraction_bed ? nlohmann::json(*void_fraction_bed) : nullptr}}},
                       {"lines", lines()}};
+  if (stokes_array_pa_m)
+    j["stokes_array"] = {{"name", "van der Hoef, Beetstra & Kuipers (2005)"},
+                         {"pa_m", *stokes_array_pa_m},
+                         {"solid_fraction", *stokes_array_solid_fraction}};
   if (best_pa_m) {
     j["best_estimate_pa_m"] = *best_pa_m;
     j["best_estimate_source"] = "Richardson extrapolation of the three finest levels (Celik et al. 2008)";

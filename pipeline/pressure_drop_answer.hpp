@@ -38,6 +38,9 @@ struct PressureDropAnswer {
   double reference_pa_m = 0.0;
   std::optional<double> reference_accuracy;          // relative, e.g. 0.2; none for an exact answer
   std::optional<double> void_fraction_bed;           // where the correlation was taken
+  // A random array in a box periodic on every side (cases::CaseInfo::stokes_array): van der Hoef et
+  // al.'s Stokes drag (Pa/m) at the solid fraction of the spheres as solved, said beside the reference.
+  std::optional<double> stokes_array_pa_m, stokes_array_solid_fraction;
   // Without a best estimate: why not, and what to change, with its cost by this run's own levels.
   std::string why_no_estimate;
   // The levels given a value whose polyhedra fail checkMesh's limits: (level, cells failing).

@@ -64,6 +64,14 @@ struct SurfaceParams {
   double min_angle_deg = 2.0;
   // No treatment changes a sphere: the surface's spheres are the bed's own.
   bool keeps_spheres() const { return treatment == Treatment::none && wall_treatment == Treatment::none; }
+  // The one scale every sphere takes: 1 when kept, shrink_factor when every sphere and contact
+  // is shrunk; 0 when the treatment joins, cuts or grows them.
+  double sphere_scale() const {
+    if (keeps_spheres()) return 1.0;
+    const bool shrunk = treatment == Treatment::shrink &&
+                        (wall_treatment == Treatment::shrink || wall_treatment == Treatment::none);
+    return shrunk ? shrink_factor : 0.0;
+  }
 };
 const char* treatment_name(SurfaceParams::Treatment t);
 // A scene's defaults are those of a pressure-drop run, where they differ from the struct's (the

@@ -30,12 +30,13 @@ void set_faces(PolyhedralMesh& m, int first, const std::vector<std::vector<int>>
 }  // namespace
 
 template <class Mesh>
-double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::string& upper_name) {
+double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::string& upper_name, int axis) {
   PolyMesh::Patch& lower = m.patches[patch_number(m, lower_name)];
   PolyMesh::Patch& upper = m.patches[patch_number(m, upper_name)];
   using XY = std::pair<double, double>;
-  auto xy = [&](int p) { return XY{m.points[p].x(), m.points[p].y()}; };
-  // The lower patch's points by x and y, and each lower face by its sorted points.
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  auto xy = [&](int p) { return XY{m.points[p][u], m.points[p][v]}; };
+  // The lower patch's points by their other two coordinates, and each lower face by its sorted points.
   std::map<XY, int> lower_point;
   std::map<std::vector<int>, int> lower_face;
   for (int f = lower.start; f < lower.start + lower.size; ++f) {
@@ -84,22 +85,35 @@ double match_cyclic_patches(Mesh& m, const std::string& lower_name, const std::s
     owner[k] = m.owner[f];
   }
   if (unmatched > 0)
-    throw std::runtime_error(fmt::format("cyclic patches: {} faces of {} have no twin on {} with the same points in x "
-                                         "and y; the first, {}; please report it with the bed",
-                                         unmatched, upper_name, lower_name, first));
+    throw std::runtime_error(fmt::format("cyclic patches: {} faces of {} have no twin on {} with the same points in "
+                                         "{}{}; the first, {}; please report it with the bed",
+                                         unmatched, upper_name, lower_name, "xyz"[u], "xyz"[v], first));
   set_faces(m, upper.start, faces);
   std::copy(owner.begin(), owner.end(), m.owner.begin() + upper.start);
   // Each patch is flat: any point of either gives the period.
-  const double period = m.points[points_of(m, upper.start)[0]].z() - m.points[points_of(m, lower.start)[0]].z();
+  const double period = m.points[points_of(m, upper.start)[0]][axis] - m.points[points_of(m, lower.start)[0]][axis];
   for (auto [p, other, sign] : {std::tuple{&lower, &upper, 1.0}, std::tuple{&upper, &lower, -1.0}}) {
     p->type = "cyclic";
     p->neighbour = other->name;
-    p->separation = Eigen::Vector3d(0.0, 0.0, sign * period);
+    p->separation = sign * period * Eigen::Vector3d::Unit(axis);
   }
   return period;
 }
 
-template double match_cyclic_patches(PolyMesh&, const std::string&, const std::string&);
-template double match_cyclic_patches(PolyhedralMesh&, const std::string&, const std::string&);
+template <class Mesh>
+int match_every_cyclic_pair(Mesh& m) {
+  auto has = [&m](const char* name) {
+    return std::any_of(m.patches.begin(), m.patches.end(), [name](const auto& patch) { return patch.name == name; });
+  };
+  int matched = 0;
+  for (const CyclicPair& pair : kCyclicPairs)
+    if (has(pair.lower) && has(pair.upper)) match_cyclic_patches(m, pair.lower, pair.upper, pair.axis), ++matched;
+  return matched;
+}
+
+template double match_cyclic_patches(PolyMesh&, const std::string&, const std::string&, int);
+template double match_cyclic_patches(PolyhedralMesh&, const std::string&, const std::string&, int);
+template int match_every_cyclic_pair(PolyMesh&);
+template int match_every_cyclic_pair(PolyhedralMesh&);
 
 }  // namespace bedforge::meshing

@@ -11,8 +11,10 @@ using namespace bedforge::meshing;
 namespace {
 
 // A unit cube cut into six tetrahedra about its diagonal from (0,0,0) to (1,1,1): its bottom and
-// top are both split along x = y, so they are the same triangles one unit apart.
-PolyMesh cube(double top_x_nudge = 0.0) {
+// top are both split along x = y, so they are the same triangles one unit apart (and so are its
+// other opposite sides). Patches inlet (z = 0), outlet (z = 1), and the four others one wall, or
+// with `every_side` each its own: x_min, x_max, y_min, y_max.
+PolyMesh cube(double top_x_nudge = 0.0, bool every_side = false) {
   std::vector<Eigen::Vector3d> p;
   for (int k = 0; k < 8; ++k) p.emplace_back(k & 1, (k >> 1) & 1, (k >> 2) & 1);
   p[5].x() += top_x_nudge;  // (1, 0, 1)
@@ -39,9 +41,12 @@ PolyMesh cube(double top_x_nudge = 0.0) {
           for (int v : t) on = on && (((v >> axis) & 1) == side);
           if (!on) continue;
           boundary.push_back(Face(t));
-          patch.push_back(axis == 2 ? side : 2);
+          patch.push_back(axis == 2 ? side : every_side ? 2 + 2 * axis + side : 2);
         }
     }
+  if (every_side)
+    return poly_mesh_from_cells(p, cells, boundary, patch, {"inlet", "outlet", "x_min", "x_max", "y_min", "y_max"},
+                                {"patch", "patch", "patch", "patch", "patch", "patch"});
   return poly_mesh_from_cells(p, cells, boundary, patch, {"inlet", "outlet", "wall"}, {"patch", "patch", "wall"});
 }
 
@@ -72,4 +77,25 @@ TEST(CyclicPatches, TheUpperFacesTurnToFaceTheLowerOnes) {
 TEST(CyclicPatches, AFaceWithoutATwinIsRefused) {
   PolyMesh m = cube(1e-12);
   EXPECT_THROW(match_cyclic_patches(m, "inlet", "outlet"), std::runtime_error);
+}
+
+// A box periodic on every side: its three pairs matched, each along its own axis.
+TEST(CyclicPatches, EveryPairOfABoxPeriodicOnEverySideIsMatchedAlongItsAxis) {
+  PolyMesh m = cube(0.0, true);
+  EXPECT_EQ(match_every_cyclic_pair(m), 3);
+  for (const CyclicPair& pair : kCyclicPairs) {
+    const PolyMesh::Patch& lower = m.patches[patch_number(m, pair.lower)];
+    const PolyMesh::Patch& upper = m.patches[patch_number(m, pair.upper)];
+    EXPECT_EQ(lower.type, "cyclic");
+    EXPECT_EQ(lower.neighbour, pair.upper);
+    EXPECT_EQ(lower.separation, Eigen::Vector3d::Unit(pair.axis));
+    EXPECT_EQ(upper.separation, -Eigen::Vector3d::Unit(pair.axis));
+    for (int k = 0; k < lower.size; ++k)
+      for (int j = 0; j < 3; ++j)
+        EXPECT_EQ(m.points[m.faces[upper.start + k][j]],
+                  m.points[m.faces[lower.start + k][(3 - j) % 3]] + Eigen::Vector3d::Unit(pair.axis))
+            << pair.lower << ", face " << k << " point " << j;
+  }
+  PolyMesh walled = cube();
+  EXPECT_EQ(match_every_cyclic_pair(walled), 1);  // inlet and outlet only
 }
