@@ -40,4 +40,24 @@ std::optional<double> simple_cubic_column_gradient(const Bed& bed, double viscos
   return 3.0 * kPi * viscosity * d * *k * velocity / (L * L * L);
 }
 
+std::optional<double> simple_cubic_array_gradient(const Bed& bed, double viscosity, double velocity) {
+  const Periodicity per = bed.container->periodicity();
+  if (bed.centres.empty() || !dynamic_cast<const Box*>(bed.container.get()) || !(per.lx > 0.0 && per.ly > 0.0 && per.lz > 0.0))
+    return std::nullopt;
+  const double side = per.lx, d = bed.diameters.front();
+  const long m = std::lround(std::cbrt(static_cast<double>(bed.size())));
+  const double L = side / static_cast<double>(m), tolerance = 1e-6 * L;
+  if (m * m * m != static_cast<long>(bed.size()) || std::abs(per.ly - side) > tolerance || std::abs(per.lz - side) > tolerance)
+    return std::nullopt;
+  // Every centre a lattice point from the first: its offset from it a whole number of spacings.
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const Eigen::Vector3d steps = (bed.centres[i] - bed.centres[0]) / L;
+    if ((steps - steps.array().round().matrix()).norm() * L > tolerance || std::abs(bed.diameters[i] - d) > tolerance)
+      return std::nullopt;
+  }
+  const std::optional<double> k = zick_homsy_simple_cubic(kPi * d * d * d / (6.0 * L * L * L));
+  if (!k) return std::nullopt;
+  return 3.0 * kPi * viscosity * d * *k * velocity / (L * L * L);
+}
+
 }  // namespace bedforge::analysis

@@ -24,4 +24,10 @@ std::optional<double> zick_homsy_simple_cubic(double solid_fraction);
 std::optional<double> simple_cubic_column_gradient(const Bed& bed, double viscosity, double velocity, double z_low,
                                                    double z_high);
 
+// The same array whole: a box periodic on every side, a cube of side m L, holding m^3 equal spheres
+// on a cubic lattice of spacing L (at any offset, within 1e-6 L). Its gradient is n F =
+// 6 pi mu a K U / L^3, K from zick_homsy_simple_cubic; none when the bed is not such an array or
+// its solid fraction is not tabulated. Stokes flow only, as above.
+std::optional<double> simple_cubic_array_gradient(const Bed& bed, double viscosity, double velocity);
+
 }  // namespace bedforge::analysis

@@ -661,12 +661,14 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   if (info.particles && sphere_scale == 1.0 && p.slip_walls && p.reynolds <= 0.01)
     info.exact_pressure_gradient_pa_m =
         analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
+  if (info.particles && sphere_scale == 1.0 && !info.walls && p.reynolds <= 0.01)
+    info.exact_pressure_gradient_pa_m = analysis::simple_cubic_array_gradient(bed, p.viscosity_pa_s, u);
   // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
   // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
-  // size and solid fraction as solved.
+  // size and solid fraction as solved; not a lattice, whose answer is known.
   const bool equal = info.particles && std::all_of(bed.diameters.begin(), bed.diameters.end(),
                                                    [&bed](double x) { return x == bed.diameters[0]; });
-  if (equal && !info.walls && bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01) {
+  if (equal && !info.exact_pressure_gradient_pa_m && !info.walls && bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01) {
     const double phi = (1.0 - section.void_fraction_bed) * sphere_scale * sphere_scale * sphere_scale;
     const double d = bed.diameters[0] * sphere_scale;
     info.stokes_array = CaseInfo::StokesArray{phi, d, analysis::van_der_hoef_gradient(phi, p.viscosity_pa_s, u, d)};

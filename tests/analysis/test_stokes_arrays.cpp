@@ -8,6 +8,7 @@
 #include <memory>
 
 using namespace bedforge;
+using bedforge::analysis::simple_cubic_array_gradient;
 using bedforge::analysis::simple_cubic_column_gradient;
 using bedforge::analysis::zick_homsy_simple_cubic;
 
@@ -88,4 +89,41 @@ TEST(SimpleCubicColumn, AnythingElseHasNoKnownAnswer) {
   Bed shuffled = good;  // the order of the rows does not matter
   std::swap(shuffled.centres[0], shuffled.centres[4]);
   EXPECT_TRUE(gradient(shuffled));
+}
+
+namespace {
+
+// 27 spheres of diameter kD on a cubic lattice at solid fraction `phi`, offset by `offset`
+// (in spacings), in a cube of three spacings periodic on every side.
+Bed cubic_array(double phi, const Eigen::Vector3d& offset) {
+  const double L = kD * std::cbrt(kPi / (6.0 * phi));
+  Bed b;
+  auto box = std::make_shared<Box>(3.0 * L, 3.0 * L, true, true);
+  box->set_axial_period(3.0 * L);
+  b.container = box;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k)
+        b.centres.push_back(L * (Eigen::Vector3d(i - 1, j - 1, k) + offset)), b.diameters.push_back(kD);
+  return b;
+}
+
+}  // namespace
+
+// The whole array in a box periodic on every side: the same drag per sphere as the column's, at
+// any offset of the lattice; a sphere off it, unequal spheres or an untabulated fraction none.
+TEST(SimpleCubicArray, ABoxPeriodicOnEverySideHoldsTheWholeArray) {
+  const Bed good = cubic_array(0.216, {0.3, 0.1, 0.45});
+  const double L = good.container->periodicity().lx / 3.0;
+  const auto g = simple_cubic_array_gradient(good, kMu, kU);
+  ASSERT_TRUE(g);
+  EXPECT_NEAR(*g * L * L * L / (6.0 * kPi * kMu * 0.5 * kD * *zick_homsy_simple_cubic(0.216) * kU), 1.0, 1e-12);
+  Bed moved = good;
+  moved.centres[13].y() += 1e-3 * L;
+  EXPECT_FALSE(simple_cubic_array_gradient(moved, kMu, kU));
+  Bed mixed = good;
+  mixed.diameters[5] *= 0.9;
+  EXPECT_FALSE(simple_cubic_array_gradient(mixed, kMu, kU));
+  EXPECT_FALSE(simple_cubic_array_gradient(cubic_array(0.2, {0.5, 0.5, 0.5}), kMu, kU));
+  EXPECT_FALSE(simple_cubic_array_gradient(column(0.216, 6), kMu, kU));  // walls that slip: the column's own rule
 }

@@ -441,6 +441,40 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   expect_converging_to_zick_homsy(c);
 }
 
+// The same array whole in a box periodic on every side (scenes/examples/
+// periodic_box_cubic_verification.toml: 27 spheres, three cyclic pairs): checkMesh matches each
+// pair's points and finds the mesh OK, and the three levels fall towards Zick & Homsy's drag as
+// the cells refine. On these polyhedra the finest level read -13.5 and -13.6 % and the study's
+// order 0.95 and 1.07 (two runs, 2026-12-04; gmsh's meshes differ between runs), so the order is
+// not asserted here and the finest error is bounded by 16 %, above both.
+TEST(RunScene, ABoxPeriodicOnEverySideConvergesToZickAndHomsy) {
+  const fs::path dir = test_support::fresh_dir("periodic_box_cubic");
+  const RunOutcome r = run(example_scene("periodic_box_cubic_verification.toml"), dir);
+  const nlohmann::json& c = r.stages["case"];
+  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
+  const double side = d * std::cbrt(pi / (6.0 * 0.216)), exact = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
+  ASSERT_TRUE(c["exact_pressure_gradient_pa_m"].is_number()) << c.dump();
+  EXPECT_NEAR(c["exact_pressure_gradient_pa_m"].get<double>(), exact, 1e-9 * exact);
+  const nlohmann::json& study = c["convergence"];
+  ASSERT_EQ(study["levels"].size(), 3u) << study.dump();
+  double coarser_error = -1.0;
+  for (auto level = study["levels"].rbegin(); level != study["levels"].rend(); ++level) {
+    ASSERT_FALSE(level->contains("failure")) << level->dump();
+    const double error = (*level)["relative_error_to_exact"].get<double>();
+    EXPECT_LT(error, 0.0) << level->dump();
+    EXPECT_GT(error, coarser_error) << level->dump();
+    coarser_error = error;
+  }
+  EXPECT_GT(coarser_error, -0.16) << study.dump();
+  std::stringstream boundary, check;
+  boundary << std::ifstream(dir / "case/constant/polyMesh/boundary").rdbuf();
+  for (const char* neighbour : {"x_max", "y_max", "outlet"})
+    EXPECT_NE(boundary.str().find(fmt::format("neighbourPatch  {};", neighbour)), std::string::npos) << neighbour;
+  check << std::ifstream(dir / "case/log.checkMesh").rdbuf();
+  EXPECT_NE(check.str().find("Coupled point location match"), std::string::npos) << check.str();
+  EXPECT_NE(check.str().find("Mesh OK."), std::string::npos) << check.str();
+}
+
 // On gmsh's tetrahedra the pressure's cell-to-cell noise, read by gradients from the four face
 // neighbours, drove the same tube's pressure drop +12 to +17 % above the exact one on 5 k to 160 k
 // tetrahedra (measured 2026-11-24; +15.9 % on this mesh, 2026-12-03); fitted over the cells that
