@@ -46,7 +46,12 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"container.size_x_m", {"the same in metres"}},
       {"container.size_y_d", {"box side along y; this or `size_y_m` is required for a box"}},
       {"container.size_y_m", {"the same in metres"}},
-      {"container.periodic_x", {"the box's two sides normal to x are periodic instead of walls"}},
+      {"container.periodic_x", {"the box's two sides normal to x are periodic instead of walls; meshed (a surface, "
+                                "mesh or case) only with periodic_y and period_z too, a box periodic on every side: "
+                                "its sides three cyclic pairs, its spheres cut where they cross them and apart "
+                                "(contacts.treatment \"none\" or \"shrink\"), compared at Re_p <= 0.01 with van der "
+                                "Hoef et al.'s Stokes drag of random arrays (or Zick & Homsy's, a simple cubic "
+                                "lattice); on polyhedra"}},
       {"container.periodic_y", {"the box's two sides normal to y are periodic instead of walls"}},
       {"container.period_z_d",
        {"axial period: the bed repeats along z every period, with neither floor nor top (a periodic section of a long "
