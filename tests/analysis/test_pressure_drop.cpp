@@ -52,3 +52,18 @@ TEST(PressureDrop, GradientHasTheUnitsOfTheDefinition) {
 
 }  // namespace
 }  // namespace bedforge::analysis
+
+// van der Hoef et al.'s Stokes drag as a gradient: its first term is Carman-Kozeny's creeping-flow
+// law (F = 180 / Re_m, the table in docs/reference.md), its second the dilute array's drag over the
+// spheres' number density; at vanishing solid fraction each sphere carries Stokes's 3 pi mu d U.
+TEST(VanDerHoef, ItsGradientIsCarmanKozenyPlusTheDiluteTerm) {
+  const double mu = 1e-3, rho = 1000.0, u = 1e-5, d = 0.003, pi = std::acos(-1.0);
+  for (double phi : {0.1, 0.3, 0.4, 0.6}) {
+    const double eps = 1.0 - phi, re_p = rho * u * d / mu, re_m = re_p / (1.0 - eps);
+    const double carman = bedforge::analysis::pressure_gradient(180.0 / re_m, eps, rho, u, d);
+    const double dilute = 18.0 * mu * u * phi * eps * (1.0 + 1.5 * std::sqrt(phi)) / (d * d);
+    EXPECT_NEAR(bedforge::analysis::van_der_hoef_gradient(phi, mu, u, d), carman + dilute, 1e-12 * carman) << phi;
+  }
+  const double phi = 1e-8, n = 6.0 * phi / (pi * d * d * d);
+  EXPECT_NEAR(bedforge::analysis::van_der_hoef_gradient(phi, mu, u, d) / (n * 3.0 * pi * mu * d * u), 1.0, 1e-3);
+}
