@@ -191,3 +191,21 @@ TEST(PressureDropAnswer, APictureWithoutACellSizeHasFiniteAxes) {
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   EXPECT_EQ(svg.find("inf"), std::string::npos);
 }
+
+// A random array's case carries van der Hoef et al.'s drag beside the reference: said with its
+// solid fraction, and the best estimate over it (30 / 25 = 1.2); a case without one says nothing.
+TEST(PressureDropAnswer, ARandomArraysStokesDragIsSaidBesideTheReference) {
+  const ConvergenceStudy study = study_of(30.0, -10.0, 2.0);
+  nlohmann::json entry = case_entry(20.0);
+  entry["stokes_array"] = {{"solid_fraction", 0.389}, {"diameter_m", 0.00297}, {"van_der_hoef_pa_m", 25.0}};
+  const auto a = pressure_drop_answer(scene_with(), entry, &study);
+  ASSERT_TRUE(a.has_value());
+  const std::vector<std::string> lines = a->lines();
+  EXPECT_TRUE(has(lines, "van der Hoef, Beetstra & Kuipers (2005), Stokes drag of random arrays: 25 Pa/m"));
+  EXPECT_TRUE(has(lines, "0.3890"));
+  EXPECT_TRUE(has(lines, "best estimate / it: 1.200"));
+  EXPECT_EQ(a->to_json()["stokes_array"]["pa_m"].get<double>(), 25.0);
+  const auto plain = pressure_drop_answer(scene_with(), case_entry(20.0), &study);
+  EXPECT_FALSE(has(plain->lines(), "van der Hoef"));
+  EXPECT_FALSE(plain->to_json().contains("stokes_array"));
+}
