@@ -259,6 +259,9 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   if (sc.needs_surface()) meshing::check_periodic_box(*sc.container, sc.surface);
+  if (sc.needs_surface() && sc.count == 0 && meshing::is_fully_periodic_box(*sc.container))
+    throw InputError("particles.count = 0 in a box periodic on every side: nothing holds the flow back (no wall, no "
+                     "sphere); allowed: particles.count > 0");
   if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
   if (sc.surface.cut_at_periodic_planes && sc.container->axial_period() == 0.0)
     throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "

@@ -291,7 +291,8 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
   // sides a grading from the circles' spacing up to the surface edge.
   std::vector<Eigen::Vector3d> near_centres;
   std::vector<double> near_radii;
-  const double reach = std::max(p.cells_per_gap, 1.0) * edge + 2.0 * *std::max_element(radii.begin(), radii.end());
+  const double largest = n > 0 ? *std::max_element(radii.begin(), radii.end()) : 0.0;
+  const double reach = std::max(p.cells_per_gap, 1.0) * edge + 2.0 * largest;
   for (std::size_t i = 0; i < n; ++i) near_centres.push_back(spheres[i].c), near_radii.push_back(spheres[i].r);
   for (std::size_t i = 0; i < n; ++i)
     for (int kx = -1; kx <= 1; ++kx)

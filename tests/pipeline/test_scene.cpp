@@ -224,7 +224,10 @@ TEST(Scene, ABoxPeriodicOnEverySideRefusesWhatItCannotBeGiven) {
             "periodic_y = false"},
            {"[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiodic_x = true\nperiodic_y = true\n"
             "[particles]\ncount = 40\n[contacts]\ntreatment = \"shrink\"\n[outputs]\nfiles = [\"stl\"]\n",
-            "period_z_d not set"}}) {
+            "period_z_d not set"},
+           {"[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiodic_x = true\nperiodic_y = true\n"
+            "period_z_d = 4\n[particles]\ncount = 0\n[contacts]\ntreatment = \"shrink\"\n[outputs]\nfiles = [\"case\"]\n",
+            "particles.count = 0"}}) {
     const std::string m = message(text);
     EXPECT_NE(m.find(says), std::string::npos) << m;
     EXPECT_NE(m.find("allowed"), std::string::npos) << m;
