@@ -1849,7 +1849,7 @@ def main():
     ap.add_argument("--slices", type=int, default=3, help="periodic_slice: slices that reach their period")
     ap.add_argument("--slice-full-exclude", type=float, default=2.0,
                     help="periodic_slice: the full beds' dp/L section, clear of floor and top (d)")
-    ap.add_argument("--array-fractions", type=float, nargs="+", default=[0.3, 0.4],
+    ap.add_argument("--array-fractions", type=float, nargs="+", default=[0.3, 0.4, 0.5, 0.6],
                     help="random_arrays: solid fractions as packed")
     ap.add_argument("--array-seeds", type=int, nargs="+", default=[1, 2, 3], help="random_arrays: seeds")
     ap.add_argument("--pieces-ranks", type=int, nargs="+", default=[1, 2, 4, 8], help="pieces: ranks (pieces) to run")
