@@ -122,7 +122,8 @@ TEST(CommandLine, EveryShippedSceneRuns) {
   // A new example that makes a case needs a test of its own there.
   EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml",
                                                 "empty_tube_verification.toml", "simple_cubic_verification.toml",
-                                                "periodic_section_flow.toml", "periodic_cubic_verification.toml"}));
+                                                "periodic_section_flow.toml", "periodic_cubic_verification.toml",
+                                                "periodic_box_cubic_verification.toml", "random_array_stokes.toml"}));
 #endif
 }
 
