@@ -617,6 +617,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   for (std::size_t i = 0; i < bed.size() && !g.periodic; ++i)
     inlet_in_bed = inlet_in_bed || std::abs(bed.centres[i].z() - g.inlet_z) < 0.5 * bed.diameters[i];
   const std::optional<double> inlet_flow = inlet_in_bed ? std::optional(u * g.cross_section_area) : std::nullopt;
+  const bool walls = bed.container->wall_perimeter() > 0.0;  // a box periodic on every side has none
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
@@ -639,7 +640,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
     write_fields(tmp, p, u, nu, g.d_ref, ubar, inlet_flow, note);
-    write_control_dict(tmp, p, section, bed.size() > 0, bed.container->wall_perimeter() > 0.0, g.periodic, note);
+    write_control_dict(tmp, p, section, bed.size() > 0, walls, g.periodic, note);
     write_solver_settings(tmp, p, g.periodic, note);
     write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
     write_text(tmp / "Allclean", kAllclean, true);
@@ -651,7 +652,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   CaseInfo info{case_dir, p, u, nu, cells, section, g.aspect_ratio,
                 g.cross_section_area, g.d_ref, fluid_volume, std::nullopt, std::nullopt};
   info.particles = bed.size() > 0;
-  info.walls = bed.container->wall_perimeter() > 0.0;
+  info.walls = walls;
   info.mean_velocity_m_s = ubar;
   info.polyhedra_quality = polyhedra_quality;
   if (!info.particles && !p.slip_walls)

@@ -21,7 +21,7 @@ SurfaceStage surface_stage(const Bed& bed, const meshing::SurfaceParams& p, cons
       "surface ({}, {} contacts treated): {} triangles, closed, {}, volume error {:.2e}, chordal deviation {:.2e} d, "
       "min angle {:.1f} deg, smallest gap {:.3g} d",
       meshing::treatment_name(p.treatment),
-      j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"].value("particle_wall", 0L),
+      j["contacts_treated"]["particle_particle"].get<long>() + j["contacts_treated"]["particle_wall"].get<long>(),
       built->fluid.triangles.size(),
       check.self_intersection_test != meshing::SelfIntersectionTest::skip ? "no self-intersection" : "self-intersections not checked",
       (check.volume - built->exact_volume_m3) / built->exact_volume_m3, j["chordal_deviation_d"].get<double>(),
