@@ -161,7 +161,7 @@ void piece_directory(const fs::path& dir, const std::vector<Override>& overrides
   const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
   const MeshEstimate estimate =
       estimate_mesh(surface, mesh, params, meshing::slab_domain_size(d.bed, surface, planes, piece, kEstimateVolumePerCell),
-                    reference_diameter(d.bed));
+                    reference_diameter(d.bed), *d.bed.container);
   refuse_piece_beyond_memory(estimate, surface, piece, pieces, local ? std::atoi(local) : 1, available_memory_bytes());
   // The seed from bed.csv: a run starts its ranks before it writes report.json.
   const nlohmann::json& seed = d.bed_header.value("seed", nlohmann::json());

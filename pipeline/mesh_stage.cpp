@@ -20,7 +20,7 @@ MeshStage mesh_stage(const meshing::TriangleMesh& surface, double exact_volume_m
   const StageMeter meter;
   std::filesystem::create_directories(bad_cells_path.parent_path());
   Progress progress("mesh", console.progress);
-  const int slabs = meshing::slab_count(surface.triangles.size(), surface_params, p);
+  const int slabs = meshing::slab_count(surface.triangles.size(), surface_params, p, *bed.container);
   auto vm = std::make_shared<meshing::VolumeMesh>(
       slabs > 1 ? meshing::build_slabbed_volume_mesh(bed, surface_params, &surface, slabs, reference_diameter(bed), p,
                                                      msh_path, bad_cells_path, progress)
@@ -66,9 +66,9 @@ constexpr double kDensestVoidFraction = 0.36;
 constexpr double kSolverBytesPerCellDual = 850.0, kSolverBytesPerCellTetrahedra = 3300.0;
 
 MeshEstimate with_cells(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                        const cases::CaseParams& c, const meshing::FluidDomainSize& fluid, double d) {
-  const bool in_slabs = meshing::slabs_possible(mesh) &&
-                        (mesh.slabs > 1 || (mesh.slabs == 0 && meshing::slabs_from_clip_windows(surface)));
+                        const cases::CaseParams& c, const meshing::FluidDomainSize& fluid, double d,
+                        const Container& container) {
+  const bool in_slabs = meshing::meshes_in_slabs(surface, mesh, container);
   const double mesh_bytes = in_slabs ? 300.0 : 460.0;
   const bool solver = c.run && !c.snappy_cells;
   const double h = std::min(surface.edge_length_d, mesh.max_size_d) * d;  // the edge away from the surfaces
@@ -143,19 +143,20 @@ MeshEstimate estimate_mesh(const Scene& scene) {
     const double bed_height = solid / (area * (1.0 - kDensestVoidFraction));
     fluid = area * (bed_height + (s.inlet_length_d + s.outlet_length_d) * d) - solid;
   }
-  return with_cells(scene.surface, scene.mesh, scene.case_params, {fluid, 0.0, 0.0, 0.0}, d);
+  return with_cells(scene.surface, scene.mesh, scene.case_params, {fluid, 0.0, 0.0, 0.0}, d, *scene.container);
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d) {
-  return with_cells(surface, mesh, case_params, fluid, d);
+                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d,
+                           const Container& container) {
+  return with_cells(surface, mesh, case_params, fluid, d, container);
 }
 
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, const Bed& bed) {
   return estimate_mesh(surface, mesh, case_params,
                        meshing::fluid_domain_profile(bed, surface, kEstimateVolumePerCell, 1).size,
-                       reference_diameter(bed));
+                       reference_diameter(bed), *bed.container);
 }
 
 MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed) {

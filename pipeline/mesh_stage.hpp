@@ -75,9 +75,10 @@ MeshEstimate estimate_mesh(const Scene& scene, const Bed& bed);
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
                            const cases::CaseParams& case_params, const Bed& bed);
 // The same from the fluid domain's size as meshing::fluid_domain_profile gives it at
-// kEstimateVolumePerCell (m^3, cells), `d` the bed's reference diameter (m).
+// kEstimateVolumePerCell (m^3, cells), `d` the bed's reference diameter (m), in `container`.
 MeshEstimate estimate_mesh(const meshing::SurfaceParams& surface, const meshing::VolumeMeshParams& mesh,
-                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d);
+                           const cases::CaseParams& case_params, const meshing::FluidDomainSize& fluid, double d,
+                           const Container& container);
 // The estimate's volume per cell in the bulk, edge^3 (above).
 inline constexpr double kEstimateVolumePerCell = 0.24;
 // The estimate's cells per edge of a graded loop (above).

@@ -172,10 +172,16 @@ void ContactTreatment::gap_left(double gap, const Wall* wall, const std::string&
   if (wall && wall->concave()) min_concave_wall_gap_ = std::min(min_concave_wall_gap_, gap);
   if (gap < min_gap_) {
     min_gap_ = gap;
-    gap_error_ = fmt::format("{} still touch{} or overlap{} by {:.3g} d after the '{}' treatment; allowed: a "
-                             "treatment that opens or joins every contact (contacts.treatment, "
-                             "contacts.wall_treatment, their factors and gaps)",
-                             what, wall ? "es" : "", wall ? "s" : "", -gap / d_, treatment_name(p_.treatment));
+    // A box with periodic sides (periodic on every side, here laid out along z) takes spheres
+    // apart only (build_periodic_box_surface).
+    const std::string allowed =
+        bed_.container->periodicity().lateral()
+            ? "contacts.treatment = \"shrink\" with a contacts.shrink_factor that parts them (a box periodic on "
+              "every side joins no contact)"
+            : "a treatment that opens or joins every contact (contacts.treatment, contacts.wall_treatment, their "
+              "factors and gaps)";
+    gap_error_ = fmt::format("{} still touch{} or overlap{} by {:.3g} d after the '{}' treatment; allowed: {}", what,
+                             wall ? "es" : "", wall ? "s" : "", -gap / d_, treatment_name(p_.treatment), allowed);
   }
 }
 

@@ -202,9 +202,15 @@ bool pieces_possible(const SurfaceParams& s, const Container& container) {
   return slabs_from_clip_windows(s) || dynamic_cast<const Box*>(&container) == nullptr;
 }
 
-int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const VolumeMeshParams& p) {
+bool meshes_in_slabs(const SurfaceParams& s, const VolumeMeshParams& p, const Container& container) {
+  if (!slabs_possible(p) || container.axial_period() > 0.0) return false;
+  return p.slabs > 1 || (p.slabs == 0 && slabs_from_clip_windows(s));
+}
+
+int slab_count(std::size_t surface_triangles, const SurfaceParams& s, const VolumeMeshParams& p,
+               const Container& container) {
+  if (!meshes_in_slabs(s, p, container)) return 1;
   if (p.slabs > 0) return p.slabs;
-  if (!slabs_possible(p) || !slabs_from_clip_windows(s)) return 1;
   return std::max(1, static_cast<int>(std::ceil(static_cast<double>(surface_triangles) / kSurfaceTrianglesPerSlab)));
 }
 

@@ -41,11 +41,18 @@ bool slabs_from_clip_windows(const SurfaceParams& surface);
 // the walls can be ringed (a cylinder or annulus; a box's flat sides are not).
 bool pieces_possible(const SurfaceParams& surface, const Container& container);
 
-// How many slabs: params.slabs when set; else, when slabs_possible and slabs_from_clip_windows,
-// one per kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles
-// makes about 2.7 M cells; a = 10, N = 4000 at 0.1 d: 3.2 M triangles, 4 slabs); else 1.
+// Whether the mesh stage meshes a bed in `container` in slabs: asked (params.slabs > 1) or left
+// to it (params.slabs = 0) where slabs_from_clip_windows; never with prism layers
+// (slabs_possible), nor a periodic section, whose planes are its period's (its inlet and outlet
+// one cyclic pair, which slabs' clip windows would make walls).
+bool meshes_in_slabs(const SurfaceParams& surface, const VolumeMeshParams& params, const Container& container);
+
+// How many slabs: 1 unless meshes_in_slabs; then params.slabs when set, else one per
+// kSurfaceTrianglesPerSlab of the whole fluid surface (a slab of a million triangles makes about
+// 2.7 M cells; a = 10, N = 4000 at 0.1 d: 3.2 M triangles, 4 slabs).
 constexpr double kSurfaceTrianglesPerSlab = 1.0e6;
-int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, const VolumeMeshParams& params);
+int slab_count(std::size_t surface_triangles, const SurfaceParams& surface, const VolumeMeshParams& params,
+               const Container& container);
 
 // Heights above the floor (d) of the planes between `slabs` slabs: the fluid domain (from its
 // inlet to its outlet, or a clip window's ends) cut into slabs of about equal cells by the

@@ -108,6 +108,16 @@ TEST(PeriodicBox, WhatItCannotMeshIsRefusedByKey) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("\"shrink\""), std::string::npos) << e.what();
   }
+  // The treatment's own check (the mesh estimate treats the bed before the surface) says the same
+  // of spheres touching inside the box.
+  Bed inside = touching;
+  inside.centres = {{-0.5, 0.0, 1.0}, {0.5, 0.0, 1.0}};
+  try {
+    fluid_domain_profile(inside, plain(), 0.24, 1);
+    ADD_FAILURE() << "touching spheres were treated";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"shrink\""), std::string::npos) << e.what();
+  }
   SurfaceParams shrunk = plain();
   shrunk.treatment = shrunk.wall_treatment = SurfaceParams::Treatment::shrink;
   EXPECT_NO_THROW(build_periodic_box_surface(touching, shrunk));

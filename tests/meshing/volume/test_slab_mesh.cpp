@@ -97,6 +97,27 @@ TEST(SlabMesh, SlabsJoinIntoOneConformingMeshFillingTheirSurfaces) {
 // 43.7 k, 38.6 k, 47.3 k (largest over smallest 1.22) against 48.4 k, 31.5 k, 48.7 k (1.55) for
 // planes at a third and two thirds of the bed's height; allowed 1.3 (gmsh's threads vary a
 // slab's cells by about 1 % run to run), and less spread than those planes.
+// The mesh stage chooses slabs by the surface's size (slab_count), but never for a periodic
+// section: its inlet and outlet are one cyclic pair, which a slab's clip window would make walls
+// (a box periodic on every side with 1.19 M triangles stopped on "slabs 1 and 2 do not
+// triangulate their shared plane alike", 2026-12-04).
+TEST(SlabMesh, APeriodicSectionIsMeshedInOnePieceWhateverItsSize) {
+  SurfaceParams sp;  // shrink: slabs made from clip windows
+  VolumeMeshParams vp;  // slabs = 0: the stage chooses
+  const std::size_t triangles = static_cast<std::size_t>(3.5 * kSurfaceTrianglesPerSlab);
+  Cylinder tube(0.01);
+  EXPECT_TRUE(meshes_in_slabs(sp, vp, tube));
+  EXPECT_EQ(slab_count(triangles, sp, vp, tube), 4);
+  Cylinder section(0.01);
+  section.set_axial_period(0.02);
+  Box periodic_box(0.01, 0.01, true, true);
+  periodic_box.set_axial_period(0.01);
+  for (const Container* c : {static_cast<const Container*>(&section), static_cast<const Container*>(&periodic_box)}) {
+    EXPECT_FALSE(meshes_in_slabs(sp, vp, *c)) << c->kind();
+    EXPECT_EQ(slab_count(triangles, sp, vp, *c), 1) << c->kind();
+  }
+}
+
 TEST(SlabMesh, SlabsHoldAboutEqualCells) {
   const Bed b = test_support::packed_bed(80, 4.0, 1);
   SurfaceParams sp;  // shrink
