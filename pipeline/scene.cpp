@@ -53,12 +53,39 @@ void set_period_from_void_fraction(const Scene& sc, Container& c, double d_max) 
                                  key, sc.count, c.axial_period(), 3.0 * d_max));
 }
 
+// An imported bed's periodicity is the bed's own (it was packed so): a scene's [container] gives
+// the walls and keeps the file's axial period, which it may repeat but not change; sides the file
+// has periodic stay periodic (a bed packed across them has no wall there).
+void keep_file_periodicity(Container& c, const Container& file, const std::filesystem::path& path, double d_max) {
+  const Periodicity from_file = file.periodicity(), given = c.periodicity();
+  if ((from_file.lx > 0.0 && !(given.lx > 0.0)) || (from_file.ly > 0.0 && !(given.ly > 0.0)))
+    throw InputError(fmt::format("[container] (or --container-diameter-m) with packing.file {}: the file's box is "
+                                 "periodic across {}, where this container has walls; allowed: no [container] "
+                                 "section (the file's box is the container), or a box with container.periodic_x "
+                                 "and periodic_y as in the file",
+                                 path.string(), from_file.lx > 0.0 && from_file.ly > 0.0 ? "x and y"
+                                                : from_file.lx > 0.0                   ? "x"
+                                                                                       : "y"));
+  if (!(from_file.lz > 0.0)) return;
+  if (c.axial_period() > 0.0 && std::abs(c.axial_period() - from_file.lz) > 1e-9 * from_file.lz)
+    throw InputError(fmt::format("container.period_z: {:.6g} m, but the bed in packing.file {} repeats every {:.6g} m "
+                                 "along z; allowed: no period_z (the file's is kept) or the file's",
+                                 c.axial_period(), path.string(), from_file.lz));
+  c.set_axial_period(from_file.lz);
+  if (c.axial_period() < 3.0 * d_max * (1.0 - 1e-12))
+    throw InputError(fmt::format("packing.file {}: its bed repeats every {:.4g} m along z, shorter than 3 largest "
+                                 "diameters ({:.4g} m), which the minimum-image rule of the analysis needs; allowed: "
+                                 "a bed with a longer period",
+                                 path.string(), from_file.lz, 3.0 * d_max));
+}
+
 // What a periodic section (container.period_z) can be packed by: a packer that needs no floor (the
 // accelerated soft-sphere packer, the Monte Carlo packer compressing instead of settling), or an
 // imported bed.
 void check_periodic_section(const Scene& sc, const toml::table& table) {
+  const bool from_file = !table["container"]["period_z_m"] && !table["container"]["period_z_d"];
   const std::string key = sc.soft_sphere.target_void_fraction > 0.0 ? "packing.soft_sphere.target_void_fraction"
-                          : !table.contains("container")             ? "the bed file's container record, period_z,"
+                          : from_file                                ? "the bed file's period along z"
                           : table["container"]["period_z_m"]          ? "container.period_z_m"
                                                                      : "container.period_z_d";
   if (sc.algorithm == "soft-sphere" && sc.soft_sphere.mode == packer::SoftSphereParams::Mode::faithful)
@@ -110,10 +137,10 @@ void check_pieces(const Scene& sc) {
 
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the
 // periodic planes, the bridges and caps they cross opened or cut through (enlarge only cut
-// through), one piece.
-void check_periodic_surface(const Scene& sc) {
+// through), one piece; d_ref is the bed's reference diameter (m), the drawn sizes' or an imported bed's.
+void check_periodic_surface(const Scene& sc, double d_ref) {
   if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
-  if (sc.surface.cut_at_periodic_planes) meshing::check_periodic_cut(*sc.container, sc.surface, sc.sizes.sauter_mean());
+  if (sc.surface.cut_at_periodic_planes) meshing::check_periodic_cut(*sc.container, sc.surface, d_ref);
   // Enlarged box sections cut through failed on 2 of 3 beds of 64 spheres where bridges and caps
   // passed on all (docs/findings.md, 2026-12-03): refused until that is understood.
   if (sc.surface.cut_at_periodic_planes && sc.surface.treatment == meshing::SurfaceParams::Treatment::enlarge &&
@@ -213,6 +240,8 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   SceneSection container = root.sub("container");
   if (table.contains("container") || !sc.import.bed || !sc.import.bed->bed.container) {
     std::unique_ptr<Container> c = read_container(container, d_ref, d_max);
+    if (sc.import.bed && sc.import.bed->bed.container)
+      keep_file_periodicity(*c, *sc.import.bed->bed.container, sc.import.file, d_max);
     if (sc.soft_sphere.target_void_fraction > 0.0) set_period_from_void_fraction(sc, *c, d_max);
     sc.container = std::move(c);
   } else {
@@ -262,7 +291,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   if (sc.needs_surface() && sc.count == 0 && meshing::is_fully_periodic_box(*sc.container))
     throw InputError("particles.count = 0 in a box periodic on every side: nothing holds the flow back (no wall, no "
                      "sphere); allowed: particles.count > 0");
-  if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc);
+  if (sc.container->axial_period() > 0.0 && sc.needs_surface()) check_periodic_surface(sc, d_ref);
   if (sc.surface.cut_at_periodic_planes && sc.container->axial_period() == 0.0)
     throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "
                      "periodic planes; allowed: \"open\" (the default), or a periodic section");

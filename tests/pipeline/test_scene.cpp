@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "core/error.hpp"
+#include "support/temp_dir.hpp"
 
 using namespace bedforge;
 using namespace bedforge::pipeline;
@@ -76,6 +79,48 @@ TEST(Scene, ImportPathIsRelativeToTheSceneFile) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nowhere/scenes/bed.txt"), std::string::npos) << e.what();
   }
+}
+
+// A DEM bed periodic along z (LAMMPS `ff ff pp`) imported into a scene's own container keeps the
+// file's period: it was packed so, and without it the bed gained a floor and a top (found
+// 2026-12-04: an imported periodic section solved as a bed with ends, 0.56 x Eisfeld &
+// Schnitzlein). A period the scene repeats is taken; another is refused, and so is a container
+// with walls where the file's box is periodic.
+TEST(Scene, AnImportedBedKeepsTheFilesPeriodInTheScenesContainer) {
+  const std::filesystem::path dir = test_support::fresh_dir("scene_import_period", true);
+  const auto dump = [&](const std::string& name, const std::string& flags) {
+    std::ofstream(dir / name) << "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS " << flags
+                              << "\n-2 2\n-2 2\n0 4\nITEM: ATOMS id type x y z diameter\n"
+                                 "1 1 0 0 0.5 1\n2 1 0.5 0 1.6 1\n3 1 -0.5 0 2.7 1\n";
+  };
+  dump("section.dump", "ff ff pp");
+  dump("box.dump", "pp pp pp");
+  const auto scene = [](const std::string& file, const std::string& container) {
+    return "[packing]\nalgorithm = \"import\"\nformat = \"lammps-dump\"\nunits = \"mm\"\nfile = \"" + file + "\"\n" +
+           container + "[outputs]\nfiles = [\"positions\"]\n";
+  };
+  const Scene section = read(scene("section.dump", "[container]\ndiameter_d = 4\n"), dir);
+  EXPECT_NE(dynamic_cast<const Cylinder*>(section.container.get()), nullptr);
+  EXPECT_DOUBLE_EQ(section.container->axial_period(), 0.004);
+  EXPECT_DOUBLE_EQ(read(scene("section.dump", "[container]\ndiameter_d = 4\nperiod_z_d = 4\n"), dir)
+                       .container->axial_period(),
+                   0.004);
+  const auto refused = [&](const std::string& text) {
+    try {
+      read(text, dir);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string other = refused(scene("section.dump", "[container]\ndiameter_d = 4\nperiod_z_d = 5\n"));
+  EXPECT_NE(other.find("container.period_z"), std::string::npos) << other;
+  EXPECT_NE(other.find("0.004"), std::string::npos) << other;
+  const std::string walls = refused(scene("box.dump", "[container]\ndiameter_d = 4\n"));
+  EXPECT_NE(walls.find("periodic across x and y"), std::string::npos) << walls;
+  // Without a [container] the file's box is the container, periodic where the file is.
+  const Periodicity box = read(scene("box.dump", ""), dir).container->periodicity();
+  EXPECT_TRUE(box.lx > 0.0 && box.ly > 0.0 && box.lz > 0.0);
 }
 
 TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
