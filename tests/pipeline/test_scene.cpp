@@ -118,6 +118,13 @@ TEST(Scene, AnImportedBedKeepsTheFilesPeriodInTheScenesContainer) {
   EXPECT_NE(other.find("0.004"), std::string::npos) << other;
   const std::string walls = refused(scene("box.dump", "[container]\ndiameter_d = 4\n"));
   EXPECT_NE(walls.find("periodic across x and y"), std::string::npos) << walls;
+#ifdef BEDFORGE_HAVE_CGAL
+  // Cut through at its planes, its seam depth is in the file's diameters (it read NaN before).
+  std::string stl = scene("section.dump", "[container]\ndiameter_d = 4\n");
+  stl.replace(stl.find("\"positions\""), 11, "\"stl\"");
+  const std::string cut = refused(stl + "[contacts]\ntreatment = \"bridge\"\nat_periodic_planes = \"cut\"\n");
+  EXPECT_EQ(cut, "accepted");
+#endif
   // Without a [container] the file's box is the container, periodic where the file is.
   const Periodicity box = read(scene("box.dump", ""), dir).container->periodicity();
   EXPECT_TRUE(box.lx > 0.0 && box.ly > 0.0 && box.lz > 0.0);
