@@ -221,12 +221,12 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"mesh.slabs",
        {"axial slabs meshed one after the other by gmsh and joined into one conforming mesh, so gmsh's memory follows "
         "a slab, not the bed; 0: one slab per million surface triangles when `contacts.treatment` is shrink or none "
-        "and there are no prism layers, else 1. Under shrink or none each slab's surface is built on its own; under "
-        "bridge, cap or enlarge each is cut, through the contacts the planes cross, from the surface of the spheres "
-        "within a few diameters of its slab, held whole (in a box: from the whole surface); the planes keep clear of "
-        "the contacts' rims where they can. No "
-        "prism layers (a plane would cut them open). Slabs that cannot be cut from the bed or fail the quality gate are "
-        "meshed once more with their planes moved to other gaps between the spheres' ends",
+        "and there are no prism layers and no periodic planes, else 1. Under shrink or none each slab's surface is "
+        "built on its own; under bridge, cap or enlarge each is cut, through the contacts the planes cross, from the "
+        "surface of the spheres within a few diameters of its slab, held whole (in a box: from the whole surface); the "
+        "planes keep clear of the contacts' rims where they can. No prism layers (a plane would cut them open). "
+        "Slabs that cannot be cut from the bed or fail the quality gate are meshed once more with their planes moved "
+        "to other gaps between the spheres' ends",
         "", kWhySlabs}},
       {"mesh.pieces",
        {"the case written in this many axial pieces, each meshed by its own Open MPI rank (`mpirun -np N bedforge "
