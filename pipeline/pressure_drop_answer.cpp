@@ -173,6 +173,12 @@ std::vector<std::string> PressureDropAnswer::lines() const {
     out.push_back(reference);
     if (stokes_array_pa_m) out.push_back(stokes_array);
   }
+  if (reynolds > kUnsteadyFlowReynolds)
+    out.push_back(fmt::format("  flow: steady laminar (simpleFoam), but at Re_p = {:g} a packed bed's flow is unsteady "
+                              "(from a pore Reynolds number of about {:g}, chaotic past about 300: Dybbs & Edwards "
+                              "1984, docs/reference.md); the bed does not settle to this solution, and neither the "
+                              "band nor the reference says how far the two differ",
+                              reynolds, kUnsteadyFlowReynolds));
   // Said beside the answer, which rests on those meshes (not refused: meshing::check_polyhedra).
   if (!failing_check_mesh.empty()) {
     std::vector<std::string> said;

@@ -51,6 +51,13 @@ struct PressureDropAnswer {
   nlohmann::json to_json() const;
 };
 
+// The particle Reynolds number past which a packed bed's flow is no longer steady: Dybbs & Edwards
+// (1984) saw unsteady laminar flow from a pore Reynolds number of about 150 (on the pores' mean
+// size and velocity; docs/reference.md), which at a void fraction of 0.4 is about Re_p (pore
+// velocity u / eps, pore size (2/3) eps / (1 - eps) d: 1.1 Re_p). Past it simpleFoam's steady
+// solution is not the flow the bed has, and the answer says so.
+inline constexpr double kUnsteadyFlowReynolds = 150.0;
+
 // What a finer study would cost, from this study's levels: a study whose every mesh length is
 // 1 / ratio of this one's (level_lengths(scene, 1 / ratio)).
 struct FinerStudyCost {

@@ -253,7 +253,10 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "outlet",
         "1", kWhyLayers}},
       // [case]
-      {"case.reynolds", {"particle Reynolds number of the superficial velocity, rho u d / mu", "1"}},
+      {"case.reynolds",
+       {"particle Reynolds number of the superficial velocity, rho u d / mu; the flow is solved steady and laminar, "
+        "and past 150 the answer says that a packed bed's flow is unsteady there (docs/reference.md)",
+        "1"}},
       {"case.density_kg_m3", {"the fluid's density"}},
       {"case.viscosity_pa_s", {"the fluid's dynamic viscosity"}},
       {"case.iterations", {"simpleFoam's iteration cap"}},

@@ -209,3 +209,16 @@ TEST(PressureDropAnswer, ARandomArraysStokesDragIsSaidBesideTheReference) {
   EXPECT_FALSE(has(plain->lines(), "van der Hoef"));
   EXPECT_FALSE(plain->to_json().contains("stokes_array"));
 }
+
+// Past the steady regime of packed beds (Dybbs & Edwards 1984) the steady answer says what it is;
+// at Re_p = 100, inside it, nothing is added.
+TEST(PressureDropAnswer, AReynoldsNumberPastSteadyFlowIsSaidBesideTheAnswer) {
+  const ConvergenceStudy study = study_of(30.0, -10.0, 2.0);
+  for (const double re : {100.0, 1000.0}) {
+    nlohmann::json entry = case_entry(20.0);
+    entry["parameters"]["reynolds"] = re;
+    const auto a = pressure_drop_answer(scene_with(), entry, &study);
+    ASSERT_TRUE(a.has_value());
+    EXPECT_EQ(has(a->lines(), "Dybbs & Edwards"), re > kUnsteadyFlowReynolds) << "Re_p " << re;
+  }
+}
