@@ -126,6 +126,8 @@ nlohmann::json CaseInfo::to_json() const {
                                                          {"diameter_m", stokes_array->diameter_m},
                                                          {"van_der_hoef_pa_m", stokes_array->pa_m}}
                                         : nlohmann::json()},
+          {"stokes_array_not_compared",
+           stokes_array_not_compared.empty() ? nlohmann::json() : nlohmann::json(stokes_array_not_compared)},
           {"polyhedra_quality", polyhedra_quality ? polyhedra_quality->to_json(d_ref_m) : nullptr}};
 }
 
@@ -667,12 +669,16 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
   // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
   // size and solid fraction as solved; not a lattice, whose answer is known.
-  const bool equal = info.particles && std::all_of(bed.diameters.begin(), bed.diameters.end(),
-                                                   [&bed](double x) { return x == bed.diameters[0]; });
-  if (equal && !info.exact_pressure_gradient_pa_m && !info.walls && bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01) {
+  const bool random_array = info.particles && !info.exact_pressure_gradient_pa_m && !info.walls &&
+                            bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01;
+  const bool equal = std::all_of(bed.diameters.begin(), bed.diameters.end(),
+                                 [&bed](double x) { return x == bed.diameters[0]; });
+  if (random_array && equal) {
     const double phi = (1.0 - section.void_fraction_bed) * sphere_scale * sphere_scale * sphere_scale;
     const double d = bed.diameters[0] * sphere_scale;
     info.stokes_array = CaseInfo::StokesArray{phi, d, analysis::van_der_hoef_gradient(phi, p.viscosity_pa_s, u, d)};
+  } else if (random_array) {
+    info.stokes_array_not_compared = "their fit is for equal spheres, and this bed's differ in size";
   }
   return info;
 }

@@ -94,6 +94,8 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.stokes_array_pa_m = array["van_der_hoef_pa_m"].get<double>();
     a.stokes_array_solid_fraction = array["solid_fraction"].get<double>();
   }
+  if (const nlohmann::json why = entry.value("stokes_array_not_compared", nlohmann::json()); why.is_string())
+    a.stokes_array_not_compared = why.get<std::string>();
   const double solver_peak_mb = flow.value("solver_peak_memory_mb", 0.0);
   if (!study) {
     if (entry["fluid_volume_m3"].is_number())  // gmsh's cells (snappyHexMesh's volume is not known beforehand)
@@ -152,7 +154,10 @@ std::vector<std::string> PressureDropAnswer::lines() const {
           ? fmt::format("  van der Hoef, Beetstra & Kuipers (2005), Stokes drag of random arrays: {:.4g} Pa/m at the "
                         "solid fraction of the spheres as solved, {:.4f} (their fit's accuracy not stated here)",
                         *stokes_array_pa_m, stokes_array_solid_fraction.value_or(0.0))
-          : std::string();
+          : stokes_array_not_compared.empty()
+              ? std::string()
+              : "  van der Hoef, Beetstra & Kuipers (2005), Stokes drag of random arrays: not compared, " +
+                    stokes_array_not_compared;
   if (best_pa_m) {
     out.push_back("answer: " + where);
     out.push_back(fmt::format("  best estimate: {:.4g} Pa/m, the Richardson extrapolation of the three finest meshes "
@@ -163,7 +168,10 @@ std::vector<std::string> PressureDropAnswer::lines() const {
                               *band_low_pa_m, *band_high_pa_m, finest_pa_m, finest_cells, 100.0 * gci_fine));
     out.push_back(reference);
     out.push_back(fmt::format("  best estimate / reference: {:.3f}", *best_pa_m / reference_pa_m));
-    if (stokes_array_pa_m) out.push_back(stokes_array + fmt::format("; best estimate / it: {:.3f}", *best_pa_m / *stokes_array_pa_m));
+    if (stokes_array_pa_m)
+      out.push_back(stokes_array + fmt::format("; best estimate / it: {:.3f}", *best_pa_m / *stokes_array_pa_m));
+    else if (!stokes_array.empty())
+      out.push_back(stokes_array);
   } else {
     out.push_back("answer: " + where + ": no error band, so no best estimate");
     out.push_back(fmt::format("  finest mesh: {:.4g} Pa/m ({} cells), {}", finest_pa_m, finest_cells,
@@ -171,7 +179,7 @@ std::vector<std::string> PressureDropAnswer::lines() const {
     out.push_back("  why: " + why_no_estimate);
     out.push_back("  to get one: " + advice);
     out.push_back(reference);
-    if (stokes_array_pa_m) out.push_back(stokes_array);
+    if (!stokes_array.empty()) out.push_back(stokes_array);
   }
   if (reynolds > kUnsteadyFlowReynolds)
     out.push_back(fmt::format("  flow: steady laminar (simpleFoam), but at Re_p = {:g} a packed bed's flow is unsteady "

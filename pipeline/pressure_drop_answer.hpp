@@ -41,6 +41,7 @@ struct PressureDropAnswer {
   // A random array in a box periodic on every side (cases::CaseInfo::stokes_array): van der Hoef et
   // al.'s Stokes drag (Pa/m) at the solid fraction of the spheres as solved, said beside the reference.
   std::optional<double> stokes_array_pa_m, stokes_array_solid_fraction;
+  std::string stokes_array_not_compared;  // such an array left without it: why (cases::CaseInfo's)
   // Without a best estimate: why not, and what to change, with its cost by this run's own levels.
   std::string why_no_estimate;
   // The levels given a value whose polyhedra fail checkMesh's limits: (level, cells failing).

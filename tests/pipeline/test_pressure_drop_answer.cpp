@@ -208,6 +208,11 @@ TEST(PressureDropAnswer, ARandomArraysStokesDragIsSaidBesideTheReference) {
   const auto plain = pressure_drop_answer(scene_with(), case_entry(20.0), &study);
   EXPECT_FALSE(has(plain->lines(), "van der Hoef"));
   EXPECT_FALSE(plain->to_json().contains("stokes_array"));
+  // A random array of unequal spheres is left without it, and the answer says why.
+  nlohmann::json unequal = case_entry(20.0);
+  unequal["stokes_array_not_compared"] = "their fit is for equal spheres, and this bed's differ in size";
+  EXPECT_TRUE(has(pressure_drop_answer(scene_with(), unequal, &study)->lines(),
+                  "Stokes drag of random arrays: not compared, their fit is for equal spheres"));
 }
 
 // Past the steady regime of packed beds (Dybbs & Edwards 1984) the steady answer says what it is;
