@@ -101,9 +101,8 @@ Eigen::Vector2d Box::sample_centre(Rng& rng, double r) const {
 }
 
 double Box::max_radius() const {
-  // A periodic period of 3 largest diameters keeps every pair within one minimum image with
-  // room for a neighbour-list skin.
-  return std::min(px_ ? lx_ / 6.0 : 0.5 * lx_, py_ ? ly_ / 6.0 : 0.5 * ly_);
+  const double k = 2.0 * Periodicity::kShortestInDiameters;
+  return std::min(px_ ? lx_ / k : 0.5 * lx_, py_ ? ly_ / k : 0.5 * ly_);
 }
 
 std::unique_ptr<Container> Box::scaled_section(double factor) const {
@@ -160,13 +159,12 @@ std::unique_ptr<Container> read_container(SceneSection& s, double d_ref_m, doubl
                                  type == "annulus" ? "gap" : type == "box" ? "side" : "diameter",
                                  c->periodicity().lateral() ? " (3 diameters for a periodic side)" : ""));
   if (const auto period = s.optional_length("period_z", Range::positive())) {
-    // The minimum-image rule of the packers and the analysis needs a period of 3 largest diameters.
     c->set_axial_period(period->metres(d_ref_m));
-    if (c->axial_period() < 3.0 * d_max_m * (1.0 - 1e-12))
+    if (c->axial_period() < Periodicity::kShortestInDiameters * d_max_m * (1.0 - 1e-12))
       throw InputError(fmt::format("{}: an axial period of {:.4g} m ({:.4g} d) is shorter than 3 largest diameters "
                                    "({:.4g} m); allowed: a period of at least that",
                                    length_key(s, "period_z"), c->axial_period(), c->axial_period() / d_ref_m,
-                                   3.0 * d_max_m));
+                                   Periodicity::kShortestInDiameters * d_max_m));
   }
   return c;
 }

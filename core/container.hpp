@@ -19,9 +19,11 @@ struct WallContact {
 
 // Periodic directions of a container: period along x, y (sides of a box) and z (the axis), 0
 // where there is a wall (or, along z, the floor and the open top). Periodic images are taken by
-// the minimum-image rule, so a period must exceed twice the interaction reach (the scene check
-// asks for 3 largest diameters).
+// the minimum-image rule, so a period must exceed twice the interaction reach.
 struct Periodicity {
+  // The shortest period allowed, in largest diameters: every pair within one minimum image, with
+  // room for a neighbour-list skin (the scene refuses a shorter one).
+  static constexpr double kShortestInDiameters = 3.0;
   double lx = 0.0, ly = 0.0, lz = 0.0;
   bool any() const { return lx > 0.0 || ly > 0.0 || lz > 0.0; }
   bool lateral() const { return lx > 0.0 || ly > 0.0; }

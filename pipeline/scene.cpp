@@ -47,10 +47,10 @@ void set_period_from_void_fraction(const Scene& sc, Container& c, double d_max) 
   if (sc.count == 0)
     throw InputError(fmt::format("{} with particles.count = 0; allowed: at least one sphere", key));
   c.set_axial_period(static_cast<double>(sc.count) * sc.sizes.mean_volume() / ((1.0 - eps) * c.cross_section_area()));
-  if (c.axial_period() < 3.0 * d_max)
+  if (c.axial_period() < Periodicity::kShortestInDiameters * d_max)
     throw InputError(fmt::format("{}: {} spheres give a period of {:.4g} m, shorter than 3 largest diameters ({:.4g} "
                                  "m); allowed: more spheres (particles.count) or a lower target",
-                                 key, sc.count, c.axial_period(), 3.0 * d_max));
+                                 key, sc.count, c.axial_period(), Periodicity::kShortestInDiameters * d_max));
 }
 
 // An imported bed's periodicity is the bed's own (it was packed so): a scene's [container] gives
@@ -72,11 +72,11 @@ void keep_file_periodicity(Container& c, const Container& file, const std::files
                                  "along z; allowed: no period_z (the file's is kept) or the file's",
                                  c.axial_period(), path.string(), from_file.lz));
   c.set_axial_period(from_file.lz);
-  if (c.axial_period() < 3.0 * d_max * (1.0 - 1e-12))
+  if (c.axial_period() < Periodicity::kShortestInDiameters * d_max * (1.0 - 1e-12))
     throw InputError(fmt::format("packing.file {}: its bed repeats every {:.4g} m along z, shorter than 3 largest "
                                  "diameters ({:.4g} m), which the minimum-image rule of the analysis needs; allowed: "
                                  "a bed with a longer period",
-                                 path.string(), from_file.lz, 3.0 * d_max));
+                                 path.string(), from_file.lz, Periodicity::kShortestInDiameters * d_max));
 }
 
 // What a periodic section (container.period_z) can be packed by: a packer that needs no floor (the
