@@ -108,6 +108,19 @@ void check_periodic_section(const Scene& sc, const toml::table& table) {
 }
 
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+// A bed file's own box with periodic sides is meshed only as a box periodic on every side; said
+// of the file, since the scene has no container key the user could change.
+void check_file_box(const Scene& sc) {
+  const Periodicity per = sc.container->periodicity();
+  if (!per.lateral() || meshing::is_fully_periodic_box(*sc.container)) return;
+  const auto side = [](double period) { return period > 0.0 ? "periodic" : "walled"; };
+  throw InputError(fmt::format("packing.file {}: its box is {} along x, {} along y and {} along z, but a box with "
+                               "periodic sides is meshed only periodic on every side; allowed: a bed file periodic "
+                               "along x, y and z (LAMMPS \"pp pp pp\") or walled along x and y, or outputs.files without "
+                               "\"stl\", \"mesh\" and \"case\" (packing and analysis only)",
+                               sc.import.file.string(), side(per.lx), side(per.ly), side(per.lz)));
+}
+
 // What a case in pieces can be given today: planes that cut no prism layers, treated contacts
 // only where the walls can be ringed, and no whole surface or mesh anywhere.
 void check_pieces(const Scene& sc) {
@@ -238,7 +251,8 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
   packing.finish();
 
   SceneSection container = root.sub("container");
-  if (table.contains("container") || !sc.import.bed || !sc.import.bed->bed.container) {
+  const bool container_from_file = !table.contains("container") && sc.import.bed && sc.import.bed->bed.container;
+  if (!container_from_file) {
     std::unique_ptr<Container> c = read_container(container, d_ref, d_max);
     if (sc.import.bed && sc.import.bed->bed.container)
       keep_file_periodicity(*c, *sc.import.bed->bed.container, sc.import.file, d_max);
@@ -287,6 +301,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
 #endif
   sc.case_params = cases::read_case_params(case_section);
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
+  if (sc.needs_surface() && container_from_file) check_file_box(sc);
   if (sc.needs_surface()) meshing::check_periodic_box(*sc.container, sc.surface);
   if (sc.needs_surface() && sc.count == 0 && meshing::is_fully_periodic_box(*sc.container))
     throw InputError("particles.count = 0 in a box periodic on every side: nothing holds the flow back (no wall, no "

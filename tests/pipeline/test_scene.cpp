@@ -95,6 +95,7 @@ TEST(Scene, AnImportedBedKeepsTheFilesPeriodInTheScenesContainer) {
   };
   dump("section.dump", "ff ff pp");
   dump("box.dump", "pp pp pp");
+  dump("lateral.dump", "pp pp ff");
   const auto scene = [](const std::string& file, const std::string& container) {
     return "[packing]\nalgorithm = \"import\"\nformat = \"lammps-dump\"\nunits = \"mm\"\nfile = \"" + file + "\"\n" +
            container + "[outputs]\nfiles = [\"positions\"]\n";
@@ -120,6 +121,16 @@ TEST(Scene, AnImportedBedKeepsTheFilesPeriodInTheScenesContainer) {
   // Without a [container] the file's box is the container, periodic where the file is.
   const Periodicity box = read(scene("box.dump", ""), dir).container->periodicity();
   EXPECT_TRUE(box.lx > 0.0 && box.ly > 0.0 && box.lz > 0.0);
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // A file's box periodic across x and y but walled along z cannot be meshed; the refusal names
+  // the file and its sides, not container keys the scene does not have.
+  std::string lateral = scene("lateral.dump", "");
+  lateral.replace(lateral.find("\"positions\""), 11, "\"stl\"");
+  const std::string walled_z = message(lateral, dir);
+  EXPECT_NE(walled_z.find("packing.file"), std::string::npos) << walled_z;
+  EXPECT_NE(walled_z.find("walled along z"), std::string::npos) << walled_z;
+  EXPECT_EQ(walled_z.find("container."), std::string::npos) << walled_z;
+#endif
 }
 
 TEST(Scene, UnknownSectionsAndOutputsAreRejected) {
