@@ -579,6 +579,35 @@ void put_pieces_back(const fs::path& aside, const fs::path& case_dir, int pieces
   fs::remove_all(aside);  // pieces beyond the count
 }
 
+void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale) {
+  const CaseParams& p = info.params;
+  const double u = info.velocity_m_s;
+  const BedSection& section = info.section;
+  if (!info.particles && !p.slip_walls)
+    info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
+  // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
+  // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
+  if (info.particles && sphere_scale == 1.0 && p.slip_walls && p.reynolds <= 0.01)
+    info.exact_pressure_gradient_pa_m =
+        analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
+  if (info.particles && sphere_scale == 1.0 && !info.walls && p.reynolds <= 0.01)
+    info.exact_pressure_gradient_pa_m = analysis::simple_cubic_array_gradient(bed, p.viscosity_pa_s, u);
+  // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
+  // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
+  // size and solid fraction as solved; not a lattice, whose answer is known.
+  const bool random_array = info.particles && !info.exact_pressure_gradient_pa_m && !info.walls &&
+                            bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01;
+  const bool equal = std::all_of(bed.diameters.begin(), bed.diameters.end(),
+                                 [&bed](double x) { return x == bed.diameters[0]; });
+  if (random_array && equal) {
+    const double phi = (1.0 - section.void_fraction_bed) * sphere_scale * sphere_scale * sphere_scale;
+    const double d = bed.diameters[0] * sphere_scale;
+    info.stokes_array = CaseInfo::StokesArray{phi, d, analysis::van_der_hoef_gradient(phi, p.viscosity_pa_s, u, d)};
+  } else if (random_array) {
+    info.stokes_array_not_compared = "their fit is for equal spheres, and this bed's differ in size";
+  }
+}
+
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,
@@ -657,29 +686,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   info.walls = walls;
   info.mean_velocity_m_s = ubar;
   info.polyhedra_quality = polyhedra_quality;
-  if (!info.particles && !p.slip_walls)
-    info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
-  // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
-  // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
-  if (info.particles && sphere_scale == 1.0 && p.slip_walls && p.reynolds <= 0.01)
-    info.exact_pressure_gradient_pa_m =
-        analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
-  if (info.particles && sphere_scale == 1.0 && !info.walls && p.reynolds <= 0.01)
-    info.exact_pressure_gradient_pa_m = analysis::simple_cubic_array_gradient(bed, p.viscosity_pa_s, u);
-  // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
-  // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
-  // size and solid fraction as solved; not a lattice, whose answer is known.
-  const bool random_array = info.particles && !info.exact_pressure_gradient_pa_m && !info.walls &&
-                            bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01;
-  const bool equal = std::all_of(bed.diameters.begin(), bed.diameters.end(),
-                                 [&bed](double x) { return x == bed.diameters[0]; });
-  if (random_array && equal) {
-    const double phi = (1.0 - section.void_fraction_bed) * sphere_scale * sphere_scale * sphere_scale;
-    const double d = bed.diameters[0] * sphere_scale;
-    info.stokes_array = CaseInfo::StokesArray{phi, d, analysis::van_der_hoef_gradient(phi, p.viscosity_pa_s, u, d)};
-  } else if (random_array) {
-    info.stokes_array_not_compared = "their fit is for equal spheres, and this bed's differ in size";
-  }
+  set_known_answers(info, bed, sphere_scale);
   return info;
 }
 

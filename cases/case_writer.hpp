@@ -98,6 +98,14 @@ struct CaseInfo {
   nlohmann::json to_json() const;        // its report.json entry
 };
 
+// The known answers and references a case is compared with, set in `info` from `bed` and what
+// info already holds (params, velocity_m_s, section, particles, walls): exact_pressure_gradient_pa_m
+// for an empty container (Hagen-Poiseuille or the duct's series) or a simple cubic column or
+// array at Re_p <= 0.01 (Zick & Homsy); else, for a box periodic on every side at Re_p <= 0.01,
+// stokes_array (equal spheres: van der Hoef et al. at the solid fraction and diameter solved) or
+// stokes_array_not_compared (why not). `sphere_scale` as write_case's. Called by write_case.
+void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale);
+
 // Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
 // an existing case is replaced (only with `overwrite`) once the new one is complete:
 // constant/polyMesh (from `mesh`, gmsh's cells, or their dual with p.polyhedra; null when
