@@ -87,9 +87,9 @@ struct CaseInfo {
   struct StokesArray {
     double solid_fraction = 0.0, diameter_m = 0.0, pa_m = 0.0;
   };
-  std::optional<StokesArray> stokes_array;
+  std::optional<StokesArray> stokes_array{};
   // Such an array left without it, and why (their fit is for equal spheres); "" otherwise.
-  std::string stokes_array_not_compared;
+  std::string stokes_array_not_compared{};
   // A periodic section: cyclic inlet and outlet, the flow driven by meanVelocityForce at this
   // volume-mean velocity (m/s; the superficial one over the cells' void fraction).
   std::optional<double> mean_velocity_m_s = std::nullopt;
