@@ -421,9 +421,10 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
 // with Gauss linear it does not) and limited corrections. On tetrahedra the pressure carries a
 // cell-to-cell noise, which gradients from the four face neighbours turn into a force (the tube
 // +16 %): there gradients fit over the cells sharing a vertex, the correction is full, without
-// which the Laplacian alone stays biased, and the flux of H/A is interpolated to the faces'
-// centres (skewCorrected): at the face's crossing with the line of centres, its error grows with
-// the shear, which made that noise and a bias that no refinement removed (docs/defaults.md).
+// which the Laplacian alone stays biased, and the flux of H/A is taken at the faces' centres
+// (skewCorrected): linear interpolation gives it where the line of centres crosses the face, an
+// error that grows with the shear and made that noise and a bias no refinement removed
+// (docs/defaults.md).
 void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool periodic, const std::string& note) {
   const std::string grad = p.polyhedra ? "leastSquares" : "pointCellsLeastSquares",
                     correction = p.polyhedra ? "limited 0.5" : "corrected",
