@@ -498,10 +498,11 @@ TEST(RunScene, TheRandomArrayExampleIsComparedWithVanDerHoef) {
 // neighbours, drove the same tube's pressure drop +12 to +17 % above the exact one on 5 k to 160 k
 // tetrahedra (measured 2026-11-24; +15.9 % on this mesh, 2026-12-03); fitted over the cells that
 // share a vertex and with the full non-orthogonal correction it settled 1.3-2.1 % low at every
-// size (2026-12-03 and 2026-12-04); with H/A's flux taken at the faces' centres it reads -0.04 to
-// +0.54 % on 7.5 k to 157 k tetrahedra (2026-12-04, docs/findings.md), where the faceted
-// section alone reads +0.2 to +1.3 % high. The bound, 1 %, is under the old bias's smallest
-// measured value and above the new one's largest.
+// size (2026-12-03 and 2026-12-04); with H/A's flux taken at the faces' centres it reads -0.08 to
+// +0.56 % on 7.5 k to 452 k tetrahedra (2026-12-04: docs/findings.md, and the generated
+// Verification of docs/mesh_case_benchmark.md), +0.14 % on this mesh, where the faceted section
+// alone reads +0.2 to +1.3 % high. The bound, 1 %, is under the old bias's smallest measured
+// value and above the new one's largest.
 TEST(RunScene, OnTetrahedraTheEmptyTubeIsWithinOnePerCentOfHagenPoiseuille) {
   const Scene scene = example_scene("empty_tube_verification.toml",
                                     {{"case.cells", std::string("tetrahedra")}, {"case.convergence.levels", 0LL}});
