@@ -48,9 +48,12 @@ default: the README's path, scenes/default.toml as shipped, one `bedforge run` t
         holding it; a GCI no wider than the study_gaps run's 32.7 % at that cost).
 solver: the bed of the studies at a surface edge of 0.2 d, 3 cells across narrow gaps, its case written
         and solved once by `bedforge run`, then solved again from the same mesh with OpenFOAM's settings
-        changed one at a time (non-orthogonal correction, gradient scheme, SIMPLE against SIMPLEC):
-        iterations, simpleFoam time and dp/L against those of the case as written, and against the
-        study_gaps extrapolation of the same bed.
+        changed one at a time (non-orthogonal correction, gradient scheme, SIMPLE against SIMPLEC,
+        gradients not kept for the iteration): iterations, simpleFoam time and dp/L against those of
+        the case as written, and against the study_gaps extrapolation of the same bed.
+solver_tetrahedra: the same on gmsh's tetrahedra (`case.cells = "tetrahedra"`, the default scene's
+        cells) at a surface edge of 0.3 d, 2 cells across narrow gaps: as written, and with the
+        gradients computed at each use.
 verification: the empty tube of scenes/examples/empty_tube_verification.toml (D = 2 d, 12 d long,
         particles.count = 0), whose exact dp/L is Hagen-Poiseuille's, through the same route on
         tetrahedra and on their polyhedral dual (case.cells): one `bedforge run` each with
@@ -127,7 +130,7 @@ from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date,
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_500", "study_reynolds", "study_treatments",
-            "default", "solver", "verification", "verification_spheres", "verification_periodic",
+            "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
             "pieces_1e4_solved", "weak_scaling_1e4",
             "projection_1e4"]
@@ -391,8 +394,10 @@ def default_path(tmp, reference_levels):
                           "study": ref["convergence"], "answer": ref["answer"]}}
 
 
-# OpenFOAM settings tried against the case as written: (name, [(file, pattern, replacement)]).
-SOLVER_VARIANTS = [
+# OpenFOAM settings tried against the case as written, per kind of cell: (name, [(file, pattern, replacement)]).
+NO_GRADIENT_CACHE = ("gradients computed at each use (no `cache` of grad(U), grad(p) in fvSolution)",
+                     [("fvSolution", r"cache\s*\{[^}]*\}\s*", "")])
+SOLVER_VARIANTS = {"polyhedra": [
     ("as written (limited 0.5 non-orthogonal correction, 1 corrector; least-squares gradients; SIMPLEC)", []),
     ("full non-orthogonal correction, 2 correctors",
      [("fvSchemes", r"Gauss linear limited 0\.5", "Gauss linear corrected"),
@@ -406,16 +411,20 @@ SOLVER_VARIANTS = [
     ("SIMPLE, not SIMPLEC (relaxation U 0.7, p 0.3)",
      [("fvSolution", r"consistent\s+yes", "consistent      no"),
       ("fvSolution", r"(U\s+)0\.9;", r"\g<1>0.7;"), ("fvSolution", r"(p\s+)1;", r"\g<1>0.3;")]),
-]
+    NO_GRADIENT_CACHE],
+    "tetrahedra": [
+    ("as written (vertex-fit least-squares gradients, full non-orthogonal correction, H/A's flux skew-corrected; SIMPLEC)",
+     []),
+    NO_GRADIENT_CACHE]}
 
 
 SOLVER_CAP = 400  # iterations: ten times what the case as written needs; a variant still going has stalled
 
 
-def solver(tmp, edge=0.2, cells_per_gap=3):
-    """The case of the studies' bed written once, solved again under each of SOLVER_VARIANTS."""
-    path = os.path.join(tmp, f"solver_bridge_5_500_{edge}_{cells_per_gap}")
-    open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, cells_per_gap))
+def solver(tmp, cells="polyhedra", edge=0.2, cells_per_gap=3):
+    """The case of the studies' bed on `cells` written once, solved again under each of SOLVER_VARIANTS[cells]."""
+    path = os.path.join(tmp, f"solver_bridge_5_500_{cells}_{edge}_{cells_per_gap}")
+    open(path + ".toml", "w").write(scene(5, 500, "bridge", edge, True, cells_per_gap, cells=cells))
     timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     flow = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]["flow"]
     case = os.path.join(path, "case")
@@ -424,7 +433,7 @@ def solver(tmp, edge=0.2, cells_per_gap=3):
     def last(run, name):  # the last value a surfaceFieldValue function object wrote
         return float(open(os.path.join(run, "postProcessing", name, "0", "surfaceFieldValue.dat")).read().split()[-1])
     rows = []
-    for name, edits in SOLVER_VARIANTS:
+    for name, edits in SOLVER_VARIANTS[cells]:
         run = os.path.join(tmp, f"solver_{len(rows)}")
         for part in ("0", "constant", "system"):  # constant holds the dual mesh Allrun made
             shutil.copytree(os.path.join(case, part), os.path.join(run, part))
@@ -447,7 +456,7 @@ def solver(tmp, edge=0.2, cells_per_gap=3):
         shutil.rmtree(run)
     for r in rows:  # bedforge's own conversion of the case as written, applied to each
         r["dp_dz_pa_m"] = flow["pressure_gradient_bed_pa_m"] * r["dp_kin"] / rows[0]["dp_kin"]
-    return {**commit_and_date(), "edge_d": edge, "cells_per_gap": cells_per_gap, "cells": flow["mesh"]["cells"],
+    return {**commit_and_date(), "kind": cells, "edge_d": edge, "cells_per_gap": cells_per_gap, "cells": flow["mesh"]["cells"],
             "bedforge_solve_s": flow["time_s"], "iteration_cap": SOLVER_CAP, "rows": rows}
 
 
@@ -1580,25 +1589,32 @@ def write(results):
                          f"{r['eps_section']:.4f} |")
         lines += ["", "On gmsh's tetrahedra, layers on the bridged a = 5 bed did not converge in simpleFoam "
                   "(2026-11-22, not regenerated): [findings.md](findings.md).", ""]
-    if "solver" in results:
-        r = results["solver"]
-        ref = results.get("study_gaps", {}).get("study", {}).get("grid_convergence", {})
-        lines += ["## OpenFOAM's settings on the same mesh", "", made_line(r), "",
+    for key in ("solver", "solver_tetrahedra"):
+        if key not in results:
+            continue
+        r = results[key]
+        kind = r.get("kind", "polyhedra")
+        # The study_gaps extrapolation is of the same bed on polyhedra.
+        ref = results.get("study_gaps", {}).get("study", {}).get("grid_convergence", {}) if kind == "polyhedra" else {}
+        lines += [f"## OpenFOAM's settings on the same mesh: {kind}", "", made_line(r), "",
                   f"The bed of the studies (a = 5, N = 500, bridges, Re_p = 1), surface edge {r['edge_d']} d with "
-                  f"{r['cells_per_gap']:g} cells across narrow gaps: {r['cells']} polyhedra, written and solved once "
+                  f"{r['cells_per_gap']:g} cells across narrow gaps: {r['cells']} {kind}, written and solved once "
                   f"by `bedforge run` (simpleFoam {r['bedforge_solve_s']:.0f} s with the Allrun steps before it), then "
                   "solved again from that mesh with one setting changed at a time, side by side in one run "
                   f"(simpleFoam alone on 2 processes, at most {r.get('iteration_cap', 3000)} iterations). dp/L as "
-                  "bedforge converts the case as written."
+                  "bedforge converts the case as written; the iteration and time ratios are each variant's over "
+                  "the case as written."
                   + (f" Reference: the study_gaps extrapolation of the same bed, {ref['extrapolated']:.4g} Pa/m "
                      f"(its GCI {100 * ref['gci_fine']:.0f} %)." if ref.get("asymptotic") else ""), "",
-                  "| settings | iterations | simpleFoam s | dp/L (Pa/m) | / as written |"
+                  "| settings | iterations | simpleFoam s | iteration ratio | time ratio | dp/L (Pa/m) | / as written |"
                   + (" / extrapolated |" if ref.get("asymptotic") else ""),
-                  "|---|---|---|---|---|" + ("---|" if ref.get("asymptotic") else "")]
+                  "|---|---|---|---|---|---|---|" + ("---|" if ref.get("asymptotic") else "")]
+        first = r["rows"][0]
         for v in r["rows"]:
             state = "" if v["converged"] else (", failed" if not v["ok"] else ", not converged")
-            lines.append(f"| {v['variant']} | {v['iterations']}{state} | {v['solve_s']:.0f} | {v['dp_dz_pa_m']:.4g} | "
-                         f"{v['dp_kin'] / r['rows'][0]['dp_kin']:.4f} |"
+            lines.append(f"| {v['variant']} | {v['iterations']}{state} | {v['solve_s']:.0f} | "
+                         f"{v['iterations'] / first['iterations']:.2f} | {v['solve_s'] / first['solve_s']:.2f} | "
+                         f"{v['dp_dz_pa_m']:.4g} | {v['dp_kin'] / first['dp_kin']:.4f} |"
                          + (f" {v['dp_dz_pa_m'] / ref['extrapolated']:.3f} |" if ref.get("asymptotic") else ""))
         lines.append("")
     if "snappy" in results:
@@ -1920,6 +1936,9 @@ def main():
             write(results)
         if "solver" in args.only:
             results["solver"] = solver(tmp)
+            write(results)
+        if "solver_tetrahedra" in args.only:
+            results["solver_tetrahedra"] = solver(tmp, "tetrahedra", edge=0.3, cells_per_gap=2)
             write(results)
         if "verification" in args.only:
             results["verification"] = verification(tmp, args.verify_edge, args.verify_levels, args.verify_ratio)
