@@ -878,7 +878,14 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
     bed_1e4_scene); for P in `reconstruct` the pieces are joined (reconstructParMesh) and checked whole.
     Each row records the scene's contacts.treatment (the section says it)."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
-    treatment = re.search(r'^treatment = "(\w+)"', make_scene(2, False, spheres), re.M).group(1)
+    text = make_scene(2, False, spheres)
+    treatment = re.search(r'^treatment = "(\w+)"', text, re.M).group(1)
+    # The mesh the section describes, as the scene sets it (the keys' defaults where it does not).
+    cells_kind = re.search(r'^cells = "(\w+)"', text, re.M)
+    edge = re.search(r"^edge_length_d = ([\d.]+)", text, re.M)
+    per_gap = re.search(r"^cells_per_gap = ([\d.]+)", text, re.M)
+    mesh = {"cells_kind": cells_kind.group(1) if cells_kind else "polyhedra", "edge_d": float(edge.group(1)) if edge else 0.15,
+            "cells_per_gap": float(per_gap.group(1)) if per_gap else 4.0}
     rows = []
     one_run = bool(solved) if one_piece is None else one_piece
     for p in ([0] if one_run else []) + ranks:
@@ -887,7 +894,7 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
         wall = 0.0 if p == 1 and one_run else timed_run(path, make_scene(p if p > 1 else 0, p in solved, spheres), env)
         rep = json.load(open(os.path.join(path, "report.json")))
         case = rep["stages"]["case"]
-        row = {"pieces": p, "spheres": spheres, "treatment": treatment, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
+        row = {"pieces": p, "spheres": spheres, "treatment": treatment, **mesh, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
                "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
         if "flow" in case and not (p == 1 and one_run):  # P = 1 shares the one-piece run's case and solve
             row["dp_pa_m"] = case["flow"]["pressure_gradient_bed_pa_m"]
@@ -1065,6 +1072,9 @@ def pieces_lines(rows):
     spheres = rows[0].get("spheres", 500)  # rows before the bed size was recorded: the default bed's
     treatment = rows[0].get("treatment", "shrink")  # rows before it was recorded: shrink
     cut = treatment in ("bridge", "cap", "enlarge")
+    # Rows made before the mesh was recorded: the default scene's of then, polyhedra at 0.15 d, 4 per gap.
+    kind, edge, per_gap = rows[0].get("cells_kind", "polyhedra"), rows[0].get("edge_d", 0.15), rows[0].get("cells_per_gap", 4.0)
+    dual = kind == "polyhedra"
     title = ((f"## A case in pieces, one per rank, {treatment} contacts cut through at the planes: memory, time and "
               "the pressure drop (issue 58)" if cut else
               "## A case in pieces, one per rank: memory, time and the pressure drop (issue 58)") if one else
@@ -1075,16 +1085,17 @@ def pieces_lines(rows):
                                                          "at its planes)")
     lines = [title, "",
              f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = {spheres}, seed 1, "
-             f"0.15 d, 4 cells per gap) with {how}, one mesh. " +
-             ("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if one else
+             f"{edge:.3g} d, {per_gap:.3g} cells per gap, {kind}) with {how}, one mesh. " +
+             (("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if dual else
+               "*One piece*: the run as today, its mesh stage then its case stage and the solve. ") if one else
               "The case written, not solved. ") +
              "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
-             "rank meshing its slab, making its dual and writing `processorK`" +
+             f"rank meshing its slab, {'making its dual ' if dual else ''}and writing `processorK`" +
              ("; P = 1 is one rank's piece of the one-piece run's case" if any(r["pieces"] == 1 for r in rows) else "") +
              ". Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up." +
              (" dp/L on 2 ranks (solved in pieces, no decomposePar) against one piece's." if one else ""), "",
-             "| route | polyhedra | largest rank's peak (MB) | x {0}/P of P = {0} | ranks' time (s) | run's wall time (s) | "
-             "checkMesh | dp/L (Pa/m) |".format(min((r["pieces"] for r in rows if r["pieces"] >= 1), default=1)),
+             "| route | {1} | largest rank's peak (MB) | x {0}/P of P = {0} | ranks' time (s) | run's wall time (s) | "
+             "checkMesh | dp/L (Pa/m) |".format(min((r["pieces"] for r in rows if r["pieces"] >= 1), default=1), kind),
              "|---|---|---|---|---|---|---|---|"]
     # The peaks are held against the fewest ranks run: one rank, or where one rank's piece would not fit, two.
     fewest = min((r for r in rows if r["pieces"] >= 1), key=lambda r: r["pieces"], default=None)
@@ -1109,6 +1120,10 @@ def pieces_lines(rows):
                      f"the cells differ by {two['cells'] - one['cells']:+d} ({100 * (two['cells'] / one['cells'] - 1):+.2f} %: "
                      "gmsh's threads make other tetrahedra on each run, and the pieces' planes change the cells "
                      "beside them; this run does not tell the two apart).")
+        if "solver_peak_mb" in two and "solver_peak_mb" in one:
+            lines.append(f"- The solve: simpleFoam's largest process {two['solver_peak_mb']:.0f} MB on 2 pieces against "
+                         f"{one['solver_peak_mb']:.0f} MB on one piece decomposed; scene to dp/L {two['wall_s']:.0f} s "
+                         f"against {one['wall_s']:.0f} s (one run each).")
     if fewest:
         lines += one_over_p_line(rows, fewest, verdict)
     checked = [r for r in rows if r["pieces"] > 1]
