@@ -76,6 +76,9 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
   const TreatedBed between = treat_contacts_measured_between(window.bed, q, lo, hi);
   FluidSurface out;
   out.fluid = std::move(fluid);
+  // A slab of this window is cut again at its pieces' planes (its wall rings): that face must be
+  // graded about the same ends as the neighbouring slab's, whose window is no clip window.
+  out.ends_near_planes = std::move(whole.ends_near_planes);
   out.report = whole.report;
   for (const char* key : {"clip", "domain_m", "opened_at_clip_planes"}) out.report.erase(key);
   out.report["parameters"] = to_json(p);
