@@ -915,7 +915,9 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
                     ["mpirun", "-np", str(p), "checkMesh", "-parallel", "-case", case_dir], capture_output=True, text=True,
                     env=dict(env, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")).stdout
                 row["check_mesh_ok"] = "Mesh OK." in log
-                row["check_mesh_failed"] = re.findall(r"^\s*\*\*\*(.*)$", log, re.M)
+                # checkMesh's own failures, or, where it stopped before judging (a crash), its last line.
+                row["check_mesh_failed"] = re.findall(r"^\s*\*\*\*(.*)$", log, re.M) or (
+                    [] if row["check_mesh_ok"] else ["stopped before its verdict: " + (log.strip().splitlines() or ["no output"])[-1]])
             if p in reconstruct:
                 case_dir = os.path.join(path, "case")
                 t_join, _ = timed(["reconstructParMesh", "-constant", "-case", case_dir])
