@@ -1092,7 +1092,7 @@ def pieces_lines(rows):
                "*One piece*: the run as today, its mesh stage then its case stage and the solve. ") if one else
               "The case written, not solved. ") +
              "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
-             f"rank meshing its slab, {'making its dual ' if dual else ''}and writing `processorK`" +
+             f"rank meshing its slab{', making its dual' if dual else ''} and writing `processorK`" +
              ("; P = 1 is one rank's piece of the one-piece run's case" if any(r["pieces"] == 1 for r in rows) else "") +
              ". Ranks beyond the 2 cores are oversubscribed, so their times are not a speed-up." +
              (" dp/L on 2 ranks (solved in pieces, no decomposePar) against one piece's." if one else ""), "",
