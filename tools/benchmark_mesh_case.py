@@ -822,9 +822,8 @@ def bed_1e4_scene(count, solve, spheres=10000):
     piece); `solve` must be False (simpleFoam on it does not fit here)."""
     if solve:
         raise SystemExit("bed_1e4_scene: the 1e4 bed is not solved on this machine at 0.1 d; bed_1e4_solved_scene is")
-    return edited(scene(14, spheres, "bridge", 0.1, False),
+    return edited(scene(14, spheres, "bridge", 0.1, False, cells="tetrahedra"),
                   [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'), ("contact_edge_length_d = 0.03333\n", ""),
-                   ("run = false", 'run = false\ncells = "tetrahedra"'),
                    ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')], "bed_1e4_scene")
 
 
@@ -867,6 +866,14 @@ def one_rank_piece(path, env):
     return time.time() - t0
 
 
+def scene_value(text, key):
+    """The value a scene's line `key = value` sets (quotes dropped); SystemExit when no line sets it."""
+    m = re.search(rf'^{key} = "?([\w.]+)"?', text, re.M)
+    if not m:
+        raise SystemExit(f"the scene sets no {key}; the pieces sections name it")
+    return m.group(1)
+
+
 def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_piece=None, reconstruct=()):
     """Issue 58 on one machine: the default bed (`spheres` of them; shrunk unless make_scene treats its
     contacts otherwise) in one piece (mesh stage, then the case stage's dual, and the solve when 0 is
@@ -879,13 +886,10 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
     Each row records the scene's contacts.treatment (the section says it)."""
     env = dict(ENV, OMPI_MCA_rmaps_base_oversubscribe="1")
     text = make_scene(2, False, spheres)
-    treatment = re.search(r'^treatment = "(\w+)"', text, re.M).group(1)
-    # The mesh the section describes, as the scene sets it (the keys' defaults where it does not).
-    cells_kind = re.search(r'^cells = "(\w+)"', text, re.M)
-    edge = re.search(r"^edge_length_d = ([\d.]+)", text, re.M)
-    per_gap = re.search(r"^cells_per_gap = ([\d.]+)", text, re.M)
-    mesh = {"cells_kind": cells_kind.group(1) if cells_kind else "polyhedra", "edge_d": float(edge.group(1)) if edge else 0.15,
-            "cells_per_gap": float(per_gap.group(1)) if per_gap else 4.0}
+    treatment = scene_value(text, "treatment")
+    # The mesh the section describes, as the scene sets it.
+    mesh = {"cells_kind": scene_value(text, "cells"), "edge_d": float(scene_value(text, "edge_length_d")),
+            "cells_per_gap": float(scene_value(text, "cells_per_gap"))}
     rows = []
     one_run = bool(solved) if one_piece is None else one_piece
     for p in ([0] if one_run else []) + ranks:
@@ -1088,9 +1092,8 @@ def pieces_lines(rows):
     lines = [title, "",
              f"Made at {rows[0]['commit']} on {rows[0]['date']}. scenes/default.toml (a = 5, N = {spheres}, seed 1, "
              f"{edge:.3g} d, {per_gap:.3g} cells per gap, {kind}) with {how}, one mesh. " +
-             (("*One piece*: the run as today, its mesh stage then its case stage (the dual) and the solve. " if dual else
-               "*One piece*: the run as today, its mesh stage then its case stage and the solve. ") if one else
-              "The case written, not solved. ") +
+             (f"*One piece*: the run as today, its mesh stage then its case stage{' (the dual)' if dual else ''} and the "
+              "solve. " if one else "The case written, not solved. ") +
              "*P pieces*: `[mesh] pieces = P`, the run writes the case and starts `mpirun -np P bedforge piece`, each "
              f"rank meshing its slab{', making its dual' if dual else ''} and writing `processorK`" +
              ("; P = 1 is one rank's piece of the one-piece run's case" if any(r["pieces"] == 1 for r in rows) else "") +
