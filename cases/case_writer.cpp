@@ -19,6 +19,7 @@
 #include "meshing/volume/cyclic_patches.hpp"
 #include "meshing/volume/dual_mesh.hpp"
 #include "meshing/volume/flat_ears.hpp"
+#include "meshing/volume/processor_patches.hpp"
 
 namespace bedforge::cases {
 
@@ -550,6 +551,7 @@ void write_piece(const fs::path& case_dir, int piece, const Mesh& mesh, bool bin
     write_poly_mesh(tmp / "constant/polyMesh", mesh, binary, note);
     fs::copy(case_dir / "0", tmp / "0", fs::copy_options::recursive);
     write_text(tmp / "bedforge_piece.json", report.dump(2) + "\n");
+    meshing::write_processor_faces(tmp / kProcessorFacesFile, meshing::processor_faces(mesh));
   });
 }
 

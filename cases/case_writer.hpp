@@ -132,8 +132,11 @@ void put_pieces_back(const std::filesystem::path& aside, const std::filesystem::
 // One piece of a decomposed case (meshing/volume/processor_patches.hpp), as decomposePar would
 // have written it: `mesh` into case_dir/processor<piece>/constant/polyMesh, the case's 0/ fields
 // copied beside it (their boundaries take the processor patches from setConstraintTypes), and
-// `report` as processor<piece>/bedforge_piece.json. Built under a temporary name and renamed,
+// `report` as processor<piece>/bedforge_piece.json, and its processor patches' faces as
+// processor<piece>/kProcessorFacesFile (meshing::write_processor_faces), which the run compares
+// with its neighbours' before OpenFOAM reads them. Built under a temporary name and renamed,
 // replacing an earlier piece only once complete. The case (case_dir/0) is written first.
+inline constexpr const char* kProcessorFacesFile = "bedforge_processor_faces.bin";
 void write_case_piece(const std::filesystem::path& case_dir, int piece, const meshing::PolyMesh& mesh, bool binary,
                       const std::string& note, const nlohmann::json& report);
 void write_case_piece(const std::filesystem::path& case_dir, int piece, const meshing::PolyhedralMesh& mesh,

@@ -91,6 +91,37 @@ nlohmann::json planes_reaching(const Bed& bed, const meshing::SurfaceParams& sur
   return out;
 }
 
+// The pieces' processor patches against their neighbours' copies, compared as OpenFOAM will
+// compare them when it reads the case: a mismatch stops the run here, naming the plane and the
+// faces (written beside the case), instead of in checkMesh or the solver.
+void check_processor_planes(const fs::path& case_dir, int pieces) {
+  std::vector<std::vector<meshing::ProcessorFaces>> sides(pieces);
+  for (int k = 0; k < pieces; ++k)
+    sides[k] = meshing::read_processor_faces(case_dir / fmt::format("processor{}", k) / cases::kProcessorFacesFile);
+  for (int k = 0; k < pieces; ++k)
+    for (const meshing::ProcessorFaces& mine : sides[k]) {
+      const int n = mine.neighbour;
+      if (n <= k) continue;  // each plane once, from the piece below it
+      const auto theirs = std::find_if(sides.at(n).begin(), sides.at(n).end(),
+                                       [k](const meshing::ProcessorFaces& p) { return p.neighbour == k; });
+      meshing::ProcessorMismatch mismatch;
+      if (theirs == sides[n].end())
+        mismatch.what = fmt::format("processor{} has no patch procBoundary{}to{}", n, n, k);
+      else
+        mismatch = meshing::compare_processor_faces(mine, *theirs);
+      if (mismatch.what.empty()) continue;
+      const fs::path faces = case_dir / fmt::format("mismatched_faces_procBoundary{}to{}.csv", k, n);
+      if (theirs != sides[n].end()) meshing::write_processor_mismatch(faces, mine, *theirs, mismatch);
+      throw std::runtime_error(fmt::format(
+          "the case's pieces {} and {} do not match at the plane between them, which OpenFOAM would refuse or read "
+          "wrong: {}{}; a defect of bedforge (please report it with the scene); the pieces are left in {} for "
+          "inspection",
+          k + 1, n + 1, mismatch.what,
+          theirs != sides[n].end() ? fmt::format("; the faces: {}", faces.string()) : std::string(),
+          case_dir.string()));
+    }
+}
+
 }  // namespace
 
 nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
@@ -146,7 +177,8 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
       {{"settings", settings}, {"planes_d", planes_reaching(bed, surface, planes, piece)}, {"piece", piece}});
   const std::string piece_key = stage_key({{"cells", cells_key}, {"case", cases::to_json(case_params)}});
   const fs::path piece_dir = case_dir / fmt::format("processor{}", piece);
-  if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json")) {
+  if (!case_params.polyhedra && fs::exists(piece_dir / "bedforge_piece.json") &&
+      fs::exists(piece_dir / cases::kProcessorFacesFile)) {
     nlohmann::json earlier = nlohmann::json::parse(read_file(piece_dir / "bedforge_piece.json"));
     if (earlier.value("key", "") == piece_key) {
       earlier["reused"] = true;
@@ -369,6 +401,7 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
         // failure says so later, if at all).
         [failed_piece] { return *failed_piece >= 0 ? std::vector<int>{*failed_piece} : std::vector<int>{}; });
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
+    check_processor_planes(info.directory, pieces);
     long cells = 0;
     double fluid = 0.0, void_fraction = 0.0;
     for (int k = 0; k < pieces; ++k) {

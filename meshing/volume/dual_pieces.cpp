@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "core/atomic_file.hpp"
+#include "core/binary_io.hpp"
 #include "core/error.hpp"
 #include "core/point_key.hpp"
 #include "meshing/volume/processor_patches.hpp"
@@ -20,29 +21,6 @@ namespace bedforge::meshing {
 namespace {
 
 constexpr char kMagic[] = "bedforge plane layer 1\n";
-
-template <class T>
-void put_vector(std::ostream& out, const std::vector<T>& v) {
-  const std::uint64_t n = v.size();
-  out.write(reinterpret_cast<const char*>(&n), sizeof n);
-  out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-}
-void put_string(std::ostream& out, const std::string& s) { put_vector(out, std::vector<char>(s.begin(), s.end())); }
-
-// Reads back what put_vector wrote; false when the file ends first.
-template <class T>
-bool get_vector(std::istream& in, std::vector<T>& v) {
-  std::uint64_t n = 0;
-  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > (std::uint64_t{1} << 40) / sizeof(T)) return false;
-  v.resize(n);
-  return static_cast<bool>(in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))));
-}
-bool get_string(std::istream& in, std::string& s) {
-  std::vector<char> c;
-  if (!get_vector(in, c)) return false;
-  s.assign(c.begin(), c.end());
-  return true;
-}
 
 // The layer file's magic and tag into `tag`; false when it is not there.
 bool read_layer_header(std::istream& in, std::string& tag) {

@@ -8,14 +8,19 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "cases/case_writer.hpp"
 #include "core/bed_io.hpp"
 #include "meshing/volume/dual_pieces.hpp"
+#include "meshing/volume/processor_patches.hpp"
 #include "meshing/volume/slab_mesh.hpp"
 #include "pipeline/piece_stage.hpp"
 #include "pipeline/scene.hpp"
@@ -242,6 +247,32 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
   const Result check = shell(kOpenFoam + "cd " + (dir / "case").string() + " && mpirun -np 2 checkMesh -parallel");
   ASSERT_EQ(check.status, 0) << check.output;
   EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
+}
+
+// The run compares each plane's two sides as OpenFOAM will, before OpenFOAM reads them: a piece
+// whose processor faces do not match its neighbour's stops the run, naming both pieces and the
+// face, with the faces in a table beside the case. (The mismatch is made by swapping two faces
+// in what piece 2 recorded of its plane; the rerun keeps both pieces' tetrahedra, so only the
+// comparison sees them again.)
+TEST(PieceStage, PiecesWhosePlaneFacesDoNotMatchStopTheRunNamingThePlane) {
+  if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
+  const fs::path dir = run("piece_mismatch", false, "tetrahedra", "[mesh]\npieces = 2\n");
+  const fs::path recorded = dir / "case/processor1" / bedforge::cases::kProcessorFacesFile;
+  std::vector<bedforge::meshing::ProcessorFaces> upper = bedforge::meshing::read_processor_faces(recorded);
+  ASSERT_EQ(upper.size(), 1u);
+  ASSERT_GT(upper[0].centres.size(), 20u);
+  std::swap(upper[0].centres[4], upper[0].centres[9]);
+  bedforge::meshing::write_processor_faces(recorded, upper);
+  const fs::path scene = fs::path(fresh_dir("piece_mismatch_scene").string() + "_again.toml");
+  std::ofstream(scene) << read(dir / "scene.toml");
+  const Result r = cli_test::bedforge("--quiet run " + scene.string() + " -o " + dir.string() + " --overwrite --force");
+  EXPECT_NE(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("pieces 1 and 2 do not match at the plane between them"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("2 of procBoundary0to1's"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("first: face 4 at"), std::string::npos) << r.output;
+  const fs::path table = dir / "case/mismatched_faces_procBoundary0to1.csv";
+  ASSERT_TRUE(fs::exists(table)) << r.output;
+  EXPECT_EQ(std::count(std::istreambuf_iterator<char>(std::ifstream(table).rdbuf()), {}, '\n'), 3);
 }
 
 // When a piece fails, only its planes move (meshing::moved_slab_planes_d, as the run's retry
