@@ -64,8 +64,8 @@ cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1
         case.cells = "polyhedra" and "tetrahedra" (--cost-levels meshes from --cost-edge d, contact edge a third,
         --cost-gap-cells per gap): each level's cells and seconds per sphere, its error against the extrapolation
         with the narrower band, and the issue's targets.
-cost_500: the same on the README's bed at the mesh settings scenes/default.toml had until 2026-12-04 (a = 5,
-        N = 500, surface edge 0.15 d, contact edge 0.05 d, 4 cells per gap, 3 levels of ratio 1.3).
+cost_500: the same on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh and study),
+        with case.cells "polyhedra" and "tetrahedra".
 verification_spheres: a column of a simple cubic array of spheres in Stokes flow (Re_p = 0.01) in a square
         box whose slip walls are the array's mirror planes, as scenes/examples/simple_cubic_verification.toml
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
@@ -342,11 +342,29 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
     path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}")
     text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells)
     open(path + ".toml", "w").write(text)
+    return study_record(path, {"a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
+                               "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap})
+
+
+def default_study(tmp, cells):
+    """scenes/default.toml as it is, its study included, on `cells` ("polyhedra" or "tetrahedra")."""
+    text, n = re.subn(r'^cells = "\w+"', f'cells = "{cells}"', open(DEFAULT_SCENE).read(), count=1, flags=re.M)
+    if n != 1:
+        raise SystemExit("scenes/default.toml: no line sets cells; update default_study")
+    path = os.path.join(tmp, f"default_study_{cells}")
+    open(path + ".toml", "w").write(text)
+    sc = lambda key: float(scene_value(text, key))
+    return study_record(path, {"a": sc("diameter_d"), "n": int(sc("count")), "treatment": scene_value(text, "treatment"),
+                               "reynolds": sc("reynolds"), "cells": cells, "edge_d": sc("edge_length_d"),
+                               "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"), "default_scene": True})
+
+
+def study_record(path, fields):
+    """Runs the scene path.toml into `path`; `fields` (what the scene was made with) and what its study gave."""
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     rep = json.load(open(os.path.join(path, "report.json")))
     case = rep["stages"]["case"]
-    return {**commit_and_date(), "a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
-            "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap, "wall_s": wall, "peak_mb": peak_mb(rep),
+    return {**commit_and_date(), **fields, "wall_s": wall, "peak_mb": peak_mb(rep),
             "study": case["convergence"], "es_pa_m": case["flow"]["eisfeld_schnitzlein_pa_m"],
             "eps_section": case["flow"]["void_fraction_section"], "d_m": case["d_ref_m"],
             "es_bed_pa_m": case["flow"]["eisfeld_schnitzlein_bed_pa_m"],
@@ -1323,10 +1341,11 @@ def cost_lines(runs):
     best = min(usable, key=lambda r: fits(r)[0]["gci_fine"]) if usable else None
     r0 = runs[0]
     n = r0["n"]
-    lines = [f"## Cost per sphere: polyhedra against tetrahedra (a = {r0['a']}, N = {n}, {r0['treatment']}, "
+    lines = [f"## Cost per sphere: polyhedra against tetrahedra (a = {r0['a']:g}, N = {n}, {r0['treatment']}, "
              f"Re_p = {r0['reynolds']:g})", "",
              f"Made at commit {r0['commit']} on {r0['date']}: "
-             + ("issue 57's bed" if n == 40 else "the README's bed at the mesh settings scenes/default.toml had until "
+             + ("issue 57's bed" if n == 40 else "the README's scene, scenes/default.toml as it is"
+                if r0.get("default_scene") else "the README's bed at the mesh settings scenes/default.toml had until "
                 "2026-12-04, when its cells were polyhedra")
              + " (seed 1), one `bedforge run` per route with "
              f"a study of {len(r0['study']['levels'])} levels, ratio {r0['ratio']}, from a surface edge of "
@@ -1942,7 +1961,7 @@ def main():
                                      cells=cells) for cells in ("polyhedra", "tetrahedra")]
             write(results)
         if "cost_500" in args.only:
-            results["cost_500"] = [study(tmp, 0.15, 3, 1.3, 4, cells=cells) for cells in ("polyhedra", "tetrahedra")]
+            results["cost_500"] = [default_study(tmp, cells) for cells in ("polyhedra", "tetrahedra")]
             write(results)
         # Runs at other Re_p or treatments are kept, so one can be redone alone.
         for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
