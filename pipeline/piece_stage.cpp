@@ -101,24 +101,25 @@ void check_processor_planes(const fs::path& case_dir, int pieces) {
   for (int k = 0; k < pieces; ++k)
     for (const meshing::ProcessorFaces& mine : sides[k]) {
       const int n = mine.neighbour;
-      if (n <= k) continue;  // each plane once, from the piece below it
-      const auto theirs = std::find_if(sides.at(n).begin(), sides.at(n).end(),
+      const auto stop = [&](const std::string& what, const std::string& faces) {
+        throw std::runtime_error(fmt::format(
+            "the case's pieces {} and {} do not match at the plane between them, which OpenFOAM would refuse or read "
+            "wrong: {}{}; a defect of bedforge (please report it with the scene); the pieces are left in {} for "
+            "inspection",
+            k + 1, n + 1, what, faces.empty() ? "" : "; the faces: " + faces, case_dir.string()));
+      };
+      if (n < 0 || n >= pieces || n == k)
+        stop(fmt::format("processor{} has a patch towards processor{}, not one of the {} pieces' others", k, n, pieces),
+             "");
+      const auto theirs = std::find_if(sides[n].begin(), sides[n].end(),
                                        [k](const meshing::ProcessorFaces& p) { return p.neighbour == k; });
-      meshing::ProcessorMismatch mismatch;
-      if (theirs == sides[n].end())
-        mismatch.what = fmt::format("processor{} has no patch procBoundary{}to{}", n, n, k);
-      else
-        mismatch = meshing::compare_processor_faces(mine, *theirs);
+      if (theirs == sides[n].end()) stop(fmt::format("processor{} has no patch procBoundary{}to{}", n, n, k), "");
+      if (n < k) continue;  // each plane's faces compared once, from the piece below it
+      const meshing::ProcessorMismatch mismatch = meshing::compare_processor_faces(mine, *theirs);
       if (mismatch.what.empty()) continue;
       const fs::path faces = case_dir / fmt::format("mismatched_faces_procBoundary{}to{}.csv", k, n);
-      if (theirs != sides[n].end()) meshing::write_processor_mismatch(faces, mine, *theirs, mismatch);
-      throw std::runtime_error(fmt::format(
-          "the case's pieces {} and {} do not match at the plane between them, which OpenFOAM would refuse or read "
-          "wrong: {}{}; a defect of bedforge (please report it with the scene); the pieces are left in {} for "
-          "inspection",
-          k + 1, n + 1, mismatch.what,
-          theirs != sides[n].end() ? fmt::format("; the faces: {}", faces.string()) : std::string(),
-          case_dir.string()));
+      meshing::write_processor_mismatch(faces, mine, *theirs, mismatch);
+      stop(mismatch.what, faces.string());
     }
 }
 

@@ -251,9 +251,9 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
 
 // The run compares each plane's two sides as OpenFOAM will, before OpenFOAM reads them: a piece
 // whose processor faces do not match its neighbour's stops the run, naming both pieces and the
-// face, with the faces in a table beside the case. (The mismatch is made by swapping two faces
-// in what piece 2 recorded of its plane; the rerun keeps both pieces' tetrahedra, so only the
-// comparison sees them again.)
+// face, with the faces in a table beside the case, and so does a piece without a patch towards
+// its neighbour. (The mismatch is made in what piece 2 recorded of its plane, two faces swapped,
+// then none; each rerun keeps both pieces' tetrahedra, so only the comparison sees them again.)
 TEST(PieceStage, PiecesWhosePlaneFacesDoNotMatchStopTheRunNamingThePlane) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
   const fs::path dir = run("piece_mismatch", false, "tetrahedra", "[mesh]\npieces = 2\n");
@@ -273,6 +273,12 @@ TEST(PieceStage, PiecesWhosePlaneFacesDoNotMatchStopTheRunNamingThePlane) {
   const fs::path table = dir / "case/mismatched_faces_procBoundary0to1.csv";
   ASSERT_TRUE(fs::exists(table)) << r.output;
   EXPECT_EQ(std::count(std::istreambuf_iterator<char>(std::ifstream(table).rdbuf()), {}, '\n'), 3);
+  // A piece that recorded no patch towards its neighbour: named from the neighbour's side.
+  bedforge::meshing::write_processor_faces(recorded, {});
+  const Result again =
+      cli_test::bedforge("--quiet run " + scene.string() + " -o " + dir.string() + " --overwrite --force");
+  EXPECT_NE(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("processor1 has no patch procBoundary1to0"), std::string::npos) << again.output;
 }
 
 // When a piece fails, only its planes move (meshing::moved_slab_planes_d, as the run's retry
