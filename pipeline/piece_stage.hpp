@@ -69,7 +69,10 @@ RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 // names it (every plane when not), so that the pieces whose windows reach no moved plane keep the
 // tetrahedra they made; the error then names both attempts. The ranks' files (case/piece_layers)
 // are removed once all have succeeded; a failed run leaves them for the next, which remakes only
-// the failed pieces.
+// the failed pieces. Then the two sides of every plane are compared as OpenFOAM will compare them
+// (meshing::compare_processor_faces, from each piece's cases::kProcessorFacesFile):
+// std::runtime_error naming the pieces and the first face when they differ, the faces written to
+// case/mismatched_faces_procBoundary<k>to<n>.csv.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
 // need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,
