@@ -356,7 +356,8 @@ def default_study(tmp, cells):
     sc = lambda key: float(scene_value(text, key))
     return study_record(path, {"a": sc("diameter_d"), "n": int(sc("count")), "treatment": scene_value(text, "treatment"),
                                "reynolds": sc("reynolds"), "cells": cells, "edge_d": sc("edge_length_d"),
-                               "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"), "default_scene": True})
+                               "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"),
+                               "contact_edge_d": sc("contact_edge_length_d"), "default_scene": True})
 
 
 def study_record(path, fields):
@@ -1349,7 +1350,10 @@ def cost_lines(runs):
                 "2026-12-04, when its cells were polyhedra")
              + " (seed 1), one `bedforge run` per route with "
              f"a study of {len(r0['study']['levels'])} levels, ratio {r0['ratio']}, from a surface edge of "
-             f"{r0['edge_d']} d, contact edge a third, {r0['cells_per_gap']:g} cells per gap, on 2 processes; "
+             f"{r0['edge_d']} d, contact edge "
+             # scene() sets a third of the edge; the default scene its own (rows before 2026-12-05: a third).
+             + (f"{r0['contact_edge_d']:g} d" if "contact_edge_d" in r0 else "a third")
+             + f", {r0['cells_per_gap']:g} cells per gap, on 2 processes; "
              "`case.cells` the only difference. Seconds per sphere are a level's wall time (surface, mesh, case and "
              "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
              "with the narrower GCI band"

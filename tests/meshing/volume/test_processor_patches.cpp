@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "core/error.hpp"
-
 #include "meshing/volume/slab_mesh.hpp"
 #include "support/packed_bed.hpp"
 #include "support/processor_faces.hpp"
