@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -57,23 +58,30 @@ std::string mpi_job(int pieces) {
 std::string layer_tag(const std::string& job, const std::string& made_from) { return job + " " + made_from; }
 std::string made_from_of(const std::string& tag) { return tag.substr(tag.find(' ') + 1); }
 
-// The layer piece `neighbour` wrote at `path`: in a job, waited for until the job's own, `tag`,
-// is there (a rank that fails ends the job, so the wait ends too); outside one, as it is (its
-// tag checked before any work).
-meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const std::string& job,
-                                    const std::string& tag, Progress& progress) {
-  if (job.empty()) return meshing::read_plane_layer(path);
-  progress.update(fmt::format("waiting for piece {}'s cells next to this one", neighbour));
+// Waits until `read_tag(path)` reads `tag`, polling the file's time: a rank of the job writes
+// it, and a rank that fails ends the job, so the wait ends too.
+void wait_for_tag(const fs::path& path, const std::string& tag,
+                  const std::function<std::string(const fs::path&)>& read_tag) {
   std::optional<fs::file_time_type> seen;
   for (;;) {
     std::error_code ec;
     const fs::file_time_type at = fs::last_write_time(path, ec);
     if (!ec && at != seen) {
       seen = at;
-      if (meshing::read_plane_layer_tag(path) == tag) return meshing::read_plane_layer(path);
+      if (read_tag(path) == tag) return;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+}
+
+// The layer piece `neighbour` wrote at `path`: in a job, waited for until the job's own, `tag`,
+// is there; outside one, as it is (its tag checked before any work).
+meshing::PlaneLayer neighbour_layer(const fs::path& path, int neighbour, const std::string& job,
+                                    const std::string& tag, Progress& progress) {
+  if (job.empty()) return meshing::read_plane_layer(path);
+  progress.update(fmt::format("waiting for piece {}'s cells next to this one", neighbour));
+  wait_for_tag(path, tag, meshing::read_plane_layer_tag);
+  return meshing::read_plane_layer(path);
 }
 
 // The planes (d) that can shape piece `piece`'s surface: its own and any other its window reaches
@@ -91,44 +99,73 @@ nlohmann::json planes_reaching(const Bed& bed, const meshing::SurfaceParams& sur
   return out;
 }
 
-// The pieces' processor patches against their neighbours' copies, compared as OpenFOAM will
-// compare them when it reads the case: a mismatch stops the run here, naming the plane and the
-// faces (written beside the case), instead of in checkMesh or the solver.
-void check_processor_planes(const fs::path& case_dir, int pieces) {
-  std::vector<std::vector<meshing::ProcessorFaces>> sides(pieces);
-  for (int k = 0; k < pieces; ++k)
-    sides[k] = meshing::read_processor_faces(case_dir / fmt::format("processor{}", k) / cases::kProcessorFacesFile);
-  for (int k = 0; k < pieces; ++k)
-    for (const meshing::ProcessorFaces& mine : sides[k]) {
-      const int n = mine.neighbour;
-      const auto stop = [&](const std::string& what, const std::string& faces) {
-        throw std::runtime_error(fmt::format(
-            "the case's pieces {} and {} do not match at the plane between them, which OpenFOAM would refuse or read "
-            "wrong: {}{}; a defect of bedforge (please report it with the scene); the pieces are left in {} for "
-            "inspection",
-            k + 1, n + 1, what, faces.empty() ? "" : "; the faces: " + faces, case_dir.string()));
-      };
-      if (n < 0 || n >= pieces || n == k)
-        stop(fmt::format("processor{} has a patch towards processor{}, not one of the {} pieces' others", k, n, pieces),
-             "");
-      const auto theirs = std::find_if(sides[n].begin(), sides[n].end(),
-                                       [k](const meshing::ProcessorFaces& p) { return p.neighbour == k; });
-      if (theirs == sides[n].end()) stop(fmt::format("processor{} has no patch procBoundary{}to{}", n, n, k), "");
-      if (n < k) continue;  // each plane's faces compared once, from the piece below it
-      const meshing::ProcessorMismatch mismatch = meshing::compare_processor_faces(mine, *theirs);
-      if (mismatch.what.empty()) continue;
-      const fs::path faces = case_dir / fmt::format("mismatched_faces_procBoundary{}to{}.csv", k, n);
-      meshing::write_processor_mismatch(faces, mine, *theirs, mismatch);
-      stop(mismatch.what, faces.string());
-    }
+// Where piece `piece` says, by the job that wrote or kept it, that its processor directory is
+// complete, for the ranks that compare their planes with it.
+fs::path written_path(const fs::path& case_dir, int piece) {
+  return case_dir / "piece_layers" / fmt::format("piece{}_written", piece);
 }
 
-}  // namespace
+// Piece `piece`'s processor patches against their copies across its planes, compared as OpenFOAM
+// will compare them when it reads the case: a mismatch stops the run here, naming the plane and
+// the faces (written beside the case), instead of in checkMesh or the solver. Every patch of the
+// piece must face another piece, and the piece and each neighbour (its patches' and the pieces
+// beside it) must have patches towards each other. In a job (`job`) the neighbours' directories
+// are waited for, and the faces of each plane compared once, by the piece below it; outside one,
+// the neighbours already written are compared, on both sides.
+void check_processor_planes(const fs::path& case_dir, int piece, int pieces, const std::string& job,
+                            Progress& progress) {
+  const auto record = [&case_dir](int k) { return case_dir / fmt::format("processor{}", k) / cases::kProcessorFacesFile; };
+  const std::vector<meshing::ProcessorFaces> mine = meshing::read_processor_faces(record(piece));
+  const auto stop = [&](int n, const std::string& what, const std::string& faces) {
+    throw std::runtime_error(fmt::format(
+        "the case's pieces {} and {} do not match at the plane between them, which OpenFOAM would refuse or read "
+        "wrong: {}{}; a defect of bedforge (please report it with the scene); the pieces are left in {} for "
+        "inspection",
+        std::min(piece, n) + 1, std::max(piece, n) + 1, what, faces.empty() ? "" : "; the faces: " + faces,
+        case_dir.string()));
+  };
+  std::vector<int> neighbours;
+  for (const int n : {piece - 1, piece + 1})
+    if (n >= 0 && n < pieces) neighbours.push_back(n);
+  for (const meshing::ProcessorFaces& p : mine) {
+    if (p.neighbour < 0 || p.neighbour >= pieces || p.neighbour == piece)
+      stop(p.neighbour, fmt::format("processor{} has a patch towards processor{}, not one of the {} pieces' others",
+                                    piece, p.neighbour, pieces), "");
+    if (std::find(neighbours.begin(), neighbours.end(), p.neighbour) == neighbours.end())
+      neighbours.push_back(p.neighbour);
+  }
+  const auto towards = [](const std::vector<meshing::ProcessorFaces>& sides, int n) {
+    return std::find_if(sides.begin(), sides.end(), [n](const meshing::ProcessorFaces& p) { return p.neighbour == n; });
+  };
+  for (const int n : neighbours) {
+    if (!job.empty()) {
+      progress.update(fmt::format("waiting for piece {} to compare the plane between them", n + 1));
+      wait_for_tag(written_path(case_dir, n), job, [](const fs::path& p) { return read_file(p); });
+    } else if (!fs::exists(record(n))) {
+      continue;  // not written yet: compared when it is
+    }
+    const std::vector<meshing::ProcessorFaces> theirs = meshing::read_processor_faces(record(n));
+    const auto to_n = towards(mine, n);
+    const auto back = towards(theirs, piece);
+    if (to_n == mine.end()) stop(n, fmt::format("processor{} has no patch procBoundary{}to{}", piece, piece, n), "");
+    if (back == theirs.end()) stop(n, fmt::format("processor{} has no patch procBoundary{}to{}", n, n, piece), "");
+    if (!job.empty() && n < piece) continue;  // compared by the piece below
+    const meshing::ProcessorFaces& lower = n > piece ? *to_n : *back;
+    const meshing::ProcessorFaces& upper = n > piece ? *back : *to_n;
+    const meshing::ProcessorMismatch mismatch = meshing::compare_processor_faces(lower, upper);
+    if (mismatch.what.empty()) continue;
+    const fs::path faces =
+        case_dir / fmt::format("mismatched_faces_procBoundary{}to{}.csv", lower.processor, upper.processor);
+    meshing::write_processor_mismatch(faces, lower, upper, mismatch);
+    stop(n, mismatch.what, faces.string());
+  }
+}
 
-nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
-                           const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
-                           const cases::CaseParams& case_params, int piece, int pieces,
-                           const std::filesystem::path& case_dir, const std::string& note, const Console& console) {
+// piece_stage's piece, made or kept, before its planes are compared; `job` as mpi_job gives it.
+nlohmann::json made_piece(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
+                          const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
+                          const cases::CaseParams& case_params, int piece, int pieces, const fs::path& case_dir,
+                          const std::string& note, const std::string& job, Progress& progress) {
   const StageMeter meter;
   if (static_cast<int>(planes.size()) + 1 != pieces)
     throw std::invalid_argument(fmt::format("piece stage: {} planes for {} pieces", planes.size(), pieces));
@@ -145,7 +182,6 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
                                  meshing::treatment_name(surface.wall_treatment), mesh.layers.count));
   // What every piece's cells are made from, and the cells at plane j (between pieces j and j + 1),
   // which both pieces' layers there must share.
-  const std::string job = mpi_job(pieces);
   const nlohmann::json settings = {{"version", kVersion}, {"bed", bed_key}, {"surface", meshing::to_json(surface)},
                                    {"mesh", meshing::to_json(mesh)}, {"pieces", pieces}};
   const auto plane_made_from = [&](int j) { return stage_key({{"settings", settings}, {"plane_d", planes[j]}}); };
@@ -170,7 +206,6 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
                                      path.string(), neighbour, piece, planes[j], allowed));
     }
   const double d = reference_diameter(bed);
-  Progress progress("piece", console.progress);
   // What the piece's tetrahedra and its processor directory are made from: a rerun keeps what
   // an earlier run made from the same, so only the pieces that failed, or whose planes moved, are
   // meshed again.
@@ -277,6 +312,25 @@ nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const mes
     cases::write_case_piece(case_dir, piece, slab.mesh, case_params.binary, note, report);
   }
   progress.update(fmt::format("piece {} of {}: {} cells written", piece + 1, pieces, report["cells"].get<long>()));
+  return report;
+}
+
+}  // namespace
+
+nlohmann::json piece_stage(const Bed& bed, const std::string& bed_key, const meshing::SurfaceParams& surface,
+                           const std::vector<double>& planes, const meshing::VolumeMeshParams& mesh,
+                           const cases::CaseParams& case_params, int piece, int pieces,
+                           const std::filesystem::path& case_dir, const std::string& note, const Console& console) {
+  const std::string job = mpi_job(pieces);
+  Progress progress("piece", console.progress);
+  const nlohmann::json report =
+      made_piece(bed, bed_key, surface, planes, mesh, case_params, piece, pieces, case_dir, note, job, progress);
+  // The job's ranks compare their planes once each has written (or kept) its directory.
+  if (!job.empty()) {
+    fs::create_directories(written_path(case_dir, piece).parent_path());
+    write_file_atomically(written_path(case_dir, piece), job);
+  }
+  check_processor_planes(case_dir, piece, pieces, job, progress);
   progress.finish();
   return report;
 }
@@ -402,7 +456,6 @@ CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, in
         // failure says so later, if at all).
         [failed_piece] { return *failed_piece >= 0 ? std::vector<int>{*failed_piece} : std::vector<int>{}; });
     fs::remove_all(layer_path(info.directory, 0, "outlet").parent_path());  // served its purpose
-    check_processor_planes(info.directory, pieces);
     long cells = 0;
     double fluid = 0.0, void_fraction = 0.0;
     for (int k = 0; k < pieces; ++k) {

@@ -26,7 +26,13 @@ namespace bedforge::pipeline {
 // layers. A rerun keeps what an earlier one made from the same inputs (`bed_key`, the bed file's
 // stage_key, the parameters, the version and the count): on gmsh's cells its processor
 // directory as it is; on polyhedra its tetrahedra (kept as case_dir/piece_layers/
-// piece<piece>_tetrahedra.bin, until the run's pieces are all done), its dual made again. Returns the piece's report (also written beside its cells): its cells, the fluid
+// piece<piece>_tetrahedra.bin, until the run's pieces are all done), its dual made again. Then
+// the piece's processor patches are compared with their copies across its planes as OpenFOAM will
+// compare them (meshing::compare_processor_faces, from each piece's cases::kProcessorFacesFile): in
+// a job with its neighbours' once they are written (each says so in
+// case_dir/piece_layers/piece<k>_written), alone with the neighbours already there; std::runtime_error
+// naming the pieces and the first face when they differ, the faces written to
+// case_dir/mismatched_faces_procBoundary<k>to<n>.csv. Returns the piece's report (also written beside its cells): its cells, the fluid
 // volume of its slab's tetrahedra (m^3) and their share of the bed section's void fraction as
 // meshed (cases::bed_section; the pieces' shares add up to it), the slab's report, time and peak
 // memory.
@@ -69,10 +75,8 @@ RanksLog read_ranks_log(const std::filesystem::path& log, int mpirun_exit_code);
 // names it (every plane when not), so that the pieces whose windows reach no moved plane keep the
 // tetrahedra they made; the error then names both attempts. The ranks' files (case/piece_layers)
 // are removed once all have succeeded; a failed run leaves them for the next, which remakes only
-// the failed pieces. Then the two sides of every plane are compared as OpenFOAM will compare them
-// (meshing::compare_processor_faces, from each piece's cases::kProcessorFacesFile):
-// std::runtime_error naming the pieces and the first face when they differ, the faces written to
-// case/mismatched_faces_procBoundary<k>to<n>.csv.
+// the failed pieces. The ranks compare the two sides of every plane (piece_stage): a mismatch
+// stops the run with the rank's message.
 // InputError naming mesh.pieces when mpirun has fewer slots than ranks (more ranks than cores
 // need OMPI_MCA_rmaps_base_oversubscribe=1). `bed` must outlive the returned CasePieces.
 CasePieces case_pieces(const Bed& bed, const meshing::SurfaceParams& surface, int pieces,

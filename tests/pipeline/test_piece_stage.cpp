@@ -249,11 +249,13 @@ TEST(PieceStage, ARerunMeshesOnlyTheFailedPiece) {
   EXPECT_NE(check.output.find("Mesh OK."), std::string::npos) << check.output;
 }
 
-// The run compares each plane's two sides as OpenFOAM will, before OpenFOAM reads them: a piece
+// Each rank compares its planes' two sides as OpenFOAM will, before OpenFOAM reads them: a piece
 // whose processor faces do not match its neighbour's stops the run, naming both pieces and the
 // face, with the faces in a table beside the case, and so does a piece without a patch towards
-// its neighbour. (The mismatch is made in what piece 2 recorded of its plane, two faces swapped,
-// then none; each rerun keeps both pieces' tetrahedra, so only the comparison sees them again.)
+// its neighbour; so do the ranks started by hand (`mpirun bedforge piece`), and a piece made
+// alone beside a neighbour already written. (The mismatch is made in what piece 2 recorded of its
+// plane, two faces swapped, then none; each rerun keeps both pieces' tetrahedra, so only the
+// comparison sees them again.)
 TEST(PieceStage, PiecesWhosePlaneFacesDoNotMatchStopTheRunNamingThePlane) {
   if (!have_openfoam()) GTEST_SKIP() << "OpenFOAM (checkMesh, mpirun) not on PATH";
   const fs::path dir = run("piece_mismatch", false, "tetrahedra", "[mesh]\npieces = 2\n");
@@ -273,6 +275,17 @@ TEST(PieceStage, PiecesWhosePlaneFacesDoNotMatchStopTheRunNamingThePlane) {
   const fs::path table = dir / "case/mismatched_faces_procBoundary0to1.csv";
   ASSERT_TRUE(fs::exists(table)) << r.output;
   EXPECT_EQ(std::count(std::istreambuf_iterator<char>(std::ifstream(table).rdbuf()), {}, '\n'), 3);
+  // The ranks by hand at the run's planes, then the lower piece alone (no job around it).
+  fs::remove(table);
+  const Result by_hand =
+      shell(kOpenFoam + "mpirun -np 2 " + BEDFORGE_BINARY + " --quiet --no-progress piece " + dir.string());
+  EXPECT_NE(by_hand.status, 0) << by_hand.output;
+  EXPECT_NE(by_hand.output.find("pieces 1 and 2 do not match at the plane between them"), std::string::npos)
+      << by_hand.output;
+  EXPECT_TRUE(fs::exists(table)) << by_hand.output;
+  const Result alone = cli_test::bedforge("--quiet piece " + dir.string() + " --piece 0 --pieces 2");
+  EXPECT_NE(alone.status, 0) << alone.output;
+  EXPECT_NE(alone.output.find("first: face 4 at"), std::string::npos) << alone.output;
   // A piece that recorded no patch towards its neighbour: named from the neighbour's side.
   bedforge::meshing::write_processor_faces(recorded, {});
   const Result again =
