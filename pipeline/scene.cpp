@@ -154,13 +154,6 @@ void check_pieces(const Scene& sc) {
 void check_periodic_surface(const Scene& sc, double d_ref) {
   if (sc.count > 0) meshing::refuse_treatments_across_periodic_planes(sc.surface);
   if (sc.surface.cut_at_periodic_planes) meshing::check_periodic_cut(*sc.container, sc.surface, d_ref);
-  // Enlarged box sections cut through failed on 2 of 3 beds of 64 spheres where bridges and caps
-  // passed on all (docs/findings.md, 2026-12-03): refused until that is understood.
-  if (sc.surface.cut_at_periodic_planes && sc.surface.treatment == meshing::SurfaceParams::Treatment::enlarge &&
-      dynamic_cast<const Box*>(sc.container.get()))
-    throw InputError("contacts.treatment = \"enlarge\" with contacts.at_periodic_planes = \"cut\" in a box: its "
-                     "surface failed on 2 of 3 beds tried (docs/findings.md, 2026-12-03); allowed: bridge or cap in a "
-                     "box, or enlarge in a cylinder or annulus");
   if (sc.surface.clip)
     throw InputError("surface.clip_window_d on a periodic section: its planes are the period's; allowed: no clip window");
   if (sc.mesh.slabs > 1)

@@ -156,11 +156,16 @@ bool meets(const WallHole& h, double z) {
 // A box side's horizontal edge at a ring, from corner `from` to corner `to` (box_edge's points,
 // `to` left out), passing each hole of `meeting` (loops that meet the ring only at vertices,
 // snap_holes_to_rings) along its arc on the side `above` or below the ring (its edge along the
-// ring where it lies on the other side): the strip's boundary there. Its points are decided on
+// ring where it lies on the other side): the strip's boundary there. Beside the holes of `near`
+// (not meeting it), its points are as close as the strip's grading from their loops makes them
+// (their spacing growing by `growth` per step away): a plane cut at the ring then meets a sphere
+// that passes the side closely (above its union with the side) with as fine a row on both sides
+// of the gap, not needles (docs/findings.md, 2026-12-05, session 81). Its points are decided on
 // the coordinate along the edge alone, so that the strips on either side of the ring, and every
 // ring a hole meets alike, take the same.
 std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double edge,
-                                       double growth, const std::vector<const WallHole*>& meeting, bool above) {
+                                       double growth, const std::vector<const WallHole*>& meeting,
+                                       const std::vector<const WallHole*>& near, bool above) {
   const double z = from.z();
   const int axis = from.x() == to.x() ? 1 : 0;
   const std::vector<Eigen::Vector3d> row = box_edge(from, to, edge);
@@ -227,6 +232,30 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
         spacing = std::min(growth * spacing, step);
       }
     }
+  // Intervals beside the holes near the ring halved until no longer than the grading there,
+  // from both corners and in ascending order, so that either direction finds the same points.
+  if (!near.empty()) {
+    const auto graded = [&](double x) {
+      double spacing = step;
+      for (const WallHole* h : near)
+        for (const Eigen::Vector3d& q : h->loop)
+          spacing = std::min(spacing, h->spacing + (growth - 1.0) * std::hypot(q[axis] - x, q.z() - z));
+      return spacing;
+    };
+    std::vector<double> ends = along;
+    ends.push_back(to[axis]);
+    std::sort(ends.begin(), ends.end());
+    const std::function<void(double, double)> halve = [&](double u, double v) {
+      const double mid = 0.5 * (u + v);
+      if (v - u <= 1.2 * std::min({graded(u), graded(mid), graded(v)})) return;
+      along.push_back(mid);
+      halve(u, mid), halve(mid, v);
+    };
+    for (std::size_t k = 0; k + 1 < ends.size(); ++k)
+      if (std::none_of(spans.begin(), spans.end(),
+                       [&](const auto& sp) { return ends[k] < sp.second && ends[k + 1] > sp.first; }))
+        halve(ends[k], ends[k + 1]);
+  }
   std::sort(along.begin(), along.end(), [sign](double u, double v) { return sign * u < sign * v; });
   std::sort(arcs.begin(), arcs.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
   std::vector<Eigen::Vector3d> out;
@@ -536,8 +565,9 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
     for (std::size_t k = 0; k < sides.size(); ++k) {
       const auto& [normal, a, b] = sides[k];
       const Frame frame = Frame::along(Eigen::Vector3d(normal.x() * hx, normal.y() * hy, 0.0), normal);
-      // Per ring, the holes meeting it; per strip, the holes within it.
-      std::vector<std::vector<const WallHole*>> meeting(strips.size());
+      // Per ring, the holes meeting it and those near it (within the reach of their grading);
+      // per strip, the holes within it.
+      std::vector<std::vector<const WallHole*>> meeting(strips.size()), near(strips.size());
       std::vector<std::vector<WallHole>> holes_of(strips.size() - 1);
       for (const WallHole& h : tb.wall_holes[k]) {
         std::vector<std::size_t> rings_met;
@@ -551,6 +581,11 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
           meeting[rings_met[0]].push_back(&h);
           continue;
         }
+        for (std::size_t j = 1; j + 1 < strips.size(); ++j)
+          if (std::any_of(h.loop.begin(), h.loop.end(), [&](const Eigen::Vector3d& q) {
+                return h.spacing + (p.growth - 1.0) * std::abs(q.z() - strips[j]) < edge;
+              }))
+            near[j].push_back(&h);
         const auto [lowest, highest] =
             std::minmax_element(h.loop.begin(), h.loop.end(), [](const auto& u, const auto& v) { return u.z() < v.z(); });
         const double mid = 0.5 * (lowest->z() + highest->z());
@@ -558,9 +593,10 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       }
       for (std::size_t j = 0; j + 1 < strips.size(); ++j) {
         const double lo = strips[j], hi = strips[j + 1];
-        std::vector<Eigen::Vector3d> loop = ring_path(corner(a, lo), corner(b, lo), edge, p.growth, meeting[j], true);
+        std::vector<Eigen::Vector3d> loop =
+            ring_path(corner(a, lo), corner(b, lo), edge, p.growth, meeting[j], near[j], true);
         for (const auto& part : {box_edge(corner(b, lo), corner(b, hi), edge),
-                                 ring_path(corner(b, hi), corner(a, hi), edge, p.growth, meeting[j + 1], false),
+                                 ring_path(corner(b, hi), corner(a, hi), edge, p.growth, meeting[j + 1], near[j + 1], false),
                                  box_edge(corner(a, hi), corner(a, lo), edge)})
           loop.insert(loop.end(), part.begin(), part.end());
         add("wall", Shape::plane, 0.0,

@@ -714,3 +714,25 @@ TEST(RunScene, APeriodicSectionOfABedIsACyclicCase) {
   EXPECT_NE(check.str().find("Coupled point location match"), std::string::npos) << check.str();
   EXPECT_NE(check.str().find("Mesh OK."), std::string::npos) << check.str();
 }
+
+// Enlarged spheres in a box section cut through at its periodic planes (a box 4 d square,
+// period 4 d, 64 spheres, edge 0.15 d, 4 cells per gap): the surface passes the stage's gate
+// (min angle 2 deg) on each of the three beds of docs/findings.md (2026-12-03, 2026-12-05), also
+// where the plane passes just above a sphere's union with a side, its section 0.005-0.01 d from
+// that side (seed 2: triangles of 1.26 deg there while the side's row at the plane kept the
+// surface edge's spacing), and the outlet is the inlet a period up.
+TEST(RunScene, EnlargedSpheresInABoxSectionAreCutThroughAtItsPlanes) {
+  for (int seed : {1, 2, 3}) {
+    const std::string text = fmt::format(
+        "[container]\ntype = \"box\"\nsize_x_d = 4\nsize_y_d = 4\nperiod_z_d = 4\n[particles]\ncount = 64\n"
+        "diameter_m = 0.003\n[packing]\nseed = {}\n[contacts]\ntreatment = \"enlarge\"\n"
+        "at_periodic_planes = \"cut\"\n[surface]\nedge_length_d = 0.15\n[outputs]\nfiles = [\"positions\", \"stl\"]\n",
+        seed);
+    const fs::path dir = test_support::fresh_dir(fmt::format("enlarged_box_section_{}", seed));
+    const RunOutcome r = run(read_scene(parse_scene_text(text, "box.toml"), "box.toml"), dir);
+    const nlohmann::json& s = r.stages["surface"];
+    EXPECT_GE(s["min_angle_deg"].get<double>(), 2.0) << "seed " << seed;
+    EXPECT_EQ(s["periodic_planes_m"]["contacts_opened"].get<long>(), 0) << "seed " << seed;
+    EXPECT_GT(s["contacts_treated"]["particle_wall"].get<long>(), 0) << "seed " << seed;
+  }
+}
