@@ -1,11 +1,16 @@
 #include "meshing/surface/periodic_cut.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "meshing/surface/clip_planes.hpp"
@@ -68,15 +73,19 @@ double seam_depth(const SurfaceParams& p, double d) {
   return std::max(kSeamDepthEdges * p.edge_length_d, kSeamDepthMinD) * d;
 }
 
-// The seam's depth below z0 (m): the least from seam_depth(p, d) up to H less that whose height,
-// a period on or back, keeps kSymmetryClearanceD clear of every height where the treated
-// `section` (one period from z0) has a mesh symmetric about it (a sphere's centre, a contact's
-// point between two spheres): a triangle centred on the seam would be taken by both parts or by
-// neither (a simple cubic array's spheres lie at such heights). InputError when none does.
-inline constexpr double kSymmetryClearanceD = 1e-4;
-double seam_depth_clear(const UnwrappedSection& section, const SurfaceParams& p, double d) {
+// The seam's depths below z0 (m) to try, best first: the least from seam_depth(p, d) up to H
+// less that whose height, a period on or back, keeps kSymmetryClearanceD clear of every height
+// where the treated `section` (one period from z0) has a mesh symmetric about it (a sphere's
+// centre, a contact's point between two spheres): a triangle centred on the seam would be taken
+// by both parts or by neither (a simple cubic array's spheres lie at such heights). Then, up to
+// kSeamTries in all, the next such depths at least kSeamSpacingEdges edges from those before: a
+// cap's regular rings can still take other diagonals in the two copies of a sphere that a seam
+// crosses (docs/findings.md, 2026-12-03 and 2026-12-05), and a seam elsewhere passes other
+// spheres. InputError when none is clear.
+inline constexpr double kSymmetryClearanceD = 1e-4, kSeamSpacingEdges = 2.0;
+inline constexpr int kSeamTries = 3;
+std::vector<double> seam_depths_clear(const UnwrappedSection& section, const SurfaceParams& p, double d) {
   const double H = section.planes.z1 - section.planes.z0, z0 = section.planes.z0, least = seam_depth(p, d);
-  const double inf = std::numeric_limits<double>::infinity();
   const Bed& b = section.bed;
   // The heights less z0 that the seam keeps clear of, a period on and back.
   std::vector<std::pair<double, double>> taken;
@@ -105,16 +114,23 @@ double seam_depth_clear(const UnwrappedSection& section, const SurfaceParams& p,
   auto clear = [&](double t) {
     return std::none_of(taken.begin(), taken.end(), [t](const auto& r) { return t > r.first && t < r.second; });
   };
-  double best = -inf;
-  if (clear(H - least)) best = H - least;
+  std::vector<double> free{};
+  if (clear(H - least)) free.push_back(H - least);
   for (const auto& [lo, hi] : taken)
-    if (lo <= H - least && lo >= least && lo > best && clear(lo)) best = lo;
-  if (best < least)
+    if (lo <= H - least && lo >= least && clear(lo)) free.push_back(lo);
+  std::sort(free.begin(), free.end(), std::greater<>());
+  if (free.empty())
     throw InputError(fmt::format(
         "contacts.at_periodic_planes = \"cut\": no height of the period {:.4g} d keeps clear of the spheres' centres "
         "and contacts, where its two parts would meet; allowed: \"open\"",
         H / d));
-  return H - best;
+  std::vector<double> depths;
+  for (const double t : free)
+    if (static_cast<int>(depths.size()) < kSeamTries &&
+        std::all_of(depths.begin(), depths.end(),
+                    [&](double m) { return std::abs(H - m - t) >= kSeamSpacingEdges * p.edge_length_d * d; }))
+      depths.push_back(H - t);
+  return depths;
 }
 
 }  // namespace
@@ -135,16 +151,14 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p) {
   return p.cut_at_periodic_planes && bed.container->axial_period() > 0.0 && joins;
 }
 
-FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
-  const double H = bed.container->axial_period(), d = reference_diameter(bed);
-  check_periodic_cut(*bed.container, p, d);
-  // 1. The planes: z0 the height widest apart from the contacts' rims and the spheres' ends
-  // that keeps clip_clearance_d from the ends, a height the STL keeps as it is; the seam m below
-  // each.
-  const UnwrappedSection section = unwrap_periodic_section(
-      bed, p, treated_heights(repeated(bed, -largest_diameter(bed), H + largest_diameter(bed)), p));
-  const double z0 = round_to_ascii_stl(section.planes.z0), z1 = z0 + H;
-  const double m = seam_depth_clear(section, p, d), s = z0 - m;
+namespace {
+
+// build_cut_periodic_surface's section of `bed` between z0 and z0 + H (`section` as unwrapped),
+// its two parts joined at the seam m below each plane; nullopt, with what did not match in
+// `unmatched`, when the layout's surface does not repeat itself at that seam.
+std::optional<FluidSurface> section_joined_at(const Bed& bed, const SurfaceParams& p, const UnwrappedSection& section,
+                                              double z0, double m, std::string& unmatched) {
+  const double H = bed.container->axial_period(), d = reference_diameter(bed), z1 = z0 + H, s = z0 - m;
 
   // 2. The bed repeated a period apart, whole spheres from piece_margin_d below the lower seam
   // to as far above the upper plane, in a window whose own planes cut nothing (window_for_cuts),
@@ -240,11 +254,11 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
   }
 
   // 5. The seam closed (its topology alone; the surface stage's own check follows).
-  if (const SurfaceCheck closed = check_surface(f, SelfIntersectionTest::skip); !closed.closed || !closed.manifold)
-    throw std::runtime_error(fmt::format(
-        "periodic section: the bed repeated a period on does not repeat its surface at the seam {:.4f} d below the "
-        "planes ({} edges unmatched, first at{}); please report it with the bed",
-        m / d, closed.defects.size(), describe_defects(closed)));
+  if (const SurfaceCheck closed = check_surface(f, SelfIntersectionTest::skip); !closed.closed || !closed.manifold) {
+    unmatched = fmt::format("at the seam {:.4f} d below the planes {} edges unmatched, first at{}", m / d,
+                            closed.defects.size(), describe_defects(closed));
+    return std::nullopt;
+  }
 
   // 6. What the surface stage reports of it.
   out.report = whole.report;
@@ -266,6 +280,29 @@ FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) 
                                      {"cut", to_json(cut)}};
   finish_cut_surface(out, d);
   return out;
+}
+
+}  // namespace
+
+FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p) {
+  const double H = bed.container->axial_period(), d = reference_diameter(bed);
+  check_periodic_cut(*bed.container, p, d);
+  // 1. The planes: z0 the height widest apart from the contacts' rims and the spheres' ends
+  // that keeps clip_clearance_d from the ends, a height the STL keeps as it is; the seam m below
+  // each, at the next depth clear when the first does not join.
+  const UnwrappedSection section = unwrap_periodic_section(
+      bed, p, treated_heights(repeated(bed, -largest_diameter(bed), H + largest_diameter(bed)), p));
+  const double z0 = round_to_ascii_stl(section.planes.z0);
+  std::vector<std::string> tried;
+  for (const double m : seam_depths_clear(section, p, d)) {
+    std::string unmatched;
+    if (std::optional<FluidSurface> out = section_joined_at(bed, p, section, z0, m, unmatched)) return std::move(*out);
+    tried.push_back(unmatched);
+  }
+  throw std::runtime_error(fmt::format(
+      "periodic section: the bed repeated a period on does not repeat its surface at any seam tried ({}); please "
+      "report it with the bed",
+      fmt::join(tried, "; ")));
 }
 
 }  // namespace bedforge::meshing
