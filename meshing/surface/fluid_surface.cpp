@@ -232,8 +232,9 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
         spacing = std::min(growth * spacing, step);
       }
     }
-  // Intervals beside the holes near the ring halved until no longer than the grading there,
-  // from both corners and in ascending order, so that either direction finds the same points.
+  // Intervals beside the holes near the ring halved until no longer than the grading there (to
+  // a fifth), from both corners and in ascending order, so that either direction finds the same
+  // points.
   if (!near.empty()) {
     const auto graded = [&](double x) {
       double spacing = step;

@@ -114,18 +114,18 @@ std::vector<double> seam_depths_clear(const UnwrappedSection& section, const Sur
   auto clear = [&](double t) {
     return std::none_of(taken.begin(), taken.end(), [t](const auto& r) { return t > r.first && t < r.second; });
   };
-  std::vector<double> free{};
-  if (clear(H - least)) free.push_back(H - least);
+  std::vector<double> clear_heights;
+  if (clear(H - least)) clear_heights.push_back(H - least);
   for (const auto& [lo, hi] : taken)
-    if (lo <= H - least && lo >= least && clear(lo)) free.push_back(lo);
-  std::sort(free.begin(), free.end(), std::greater<>());
-  if (free.empty())
+    if (lo <= H - least && lo >= least && clear(lo)) clear_heights.push_back(lo);
+  std::sort(clear_heights.begin(), clear_heights.end(), std::greater<>());
+  if (clear_heights.empty())
     throw InputError(fmt::format(
         "contacts.at_periodic_planes = \"cut\": no height of the period {:.4g} d keeps clear of the spheres' centres "
         "and contacts, where its two parts would meet; allowed: \"open\"",
         H / d));
   std::vector<double> depths;
-  for (const double t : free)
+  for (const double t : clear_heights)
     if (static_cast<int>(depths.size()) < kSeamTries &&
         std::all_of(depths.begin(), depths.end(),
                     [&](double m) { return std::abs(H - m - t) >= kSeamSpacingEdges * p.edge_length_d * d; }))

@@ -36,7 +36,9 @@ bool cuts_contacts_at_periodic_planes(const Bed& bed, const SurfaceParams& p);
 //          (contacts_treated, solid_volume_change_m3, ...) and "periodic_planes_m" with the cut's.
 // InputError naming the key when the period is shorter than twice the seam depth; the errors of
 // build_fluid_surface and cut_by_plane (CutConflict as InputError); std::runtime_error when the
-// layout's surface does not repeat itself at the seam (a defect of ours), saying where.
+// layout's surface does not repeat itself at the seam (a defect of ours), saying where, after up
+// to three seam depths were tried (a cap's regular rings across a seam can take other diagonals
+// in the two copies of its sphere).
 inline constexpr double kSeamDepthEdges = 4.0, kSeamDepthMinD = 0.5;
 FluidSurface build_cut_periodic_surface(const Bed& bed, const SurfaceParams& p);
 
