@@ -153,6 +153,12 @@ bool meets(const WallHole& h, double z) {
          std::count_if(h.loop.begin(), h.loop.end(), [z](const auto& q) { return q.z() == z; }) >= 2;
 }
 
+// The spacing a side's strip grades to at `distance` (m) from hole `h`'s loop: the loop's,
+// growing by `growth` per step away (spacing s then s g, ..., at distance about s + (g - 1) t).
+double spacing_beside(const WallHole& h, double distance, double growth) {
+  return h.spacing + (growth - 1.0) * distance;
+}
+
 // A box side's horizontal edge at a ring, from corner `from` to corner `to` (box_edge's points,
 // `to` left out), passing each hole of `meeting` (loops that meet the ring only at vertices,
 // snap_holes_to_rings) along its arc on the side `above` or below the ring (its edge along the
@@ -240,7 +246,7 @@ std::vector<Eigen::Vector3d> ring_path(const Eigen::Vector3d& from, const Eigen:
       double spacing = step;
       for (const WallHole* h : near)
         for (const Eigen::Vector3d& q : h->loop)
-          spacing = std::min(spacing, h->spacing + (growth - 1.0) * std::hypot(q[axis] - x, q.z() - z));
+          spacing = std::min(spacing, spacing_beside(*h, std::hypot(q[axis] - x, q.z() - z), growth));
       return spacing;
     };
     std::vector<double> ends = along;
@@ -584,7 +590,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
         }
         for (std::size_t j = 1; j + 1 < strips.size(); ++j)
           if (std::any_of(h.loop.begin(), h.loop.end(), [&](const Eigen::Vector3d& q) {
-                return h.spacing + (p.growth - 1.0) * std::abs(q.z() - strips[j]) < edge;
+                return spacing_beside(h, std::abs(q.z() - strips[j]), p.growth) < edge;
               }))
             near[j].push_back(&h);
         const auto [lowest, highest] =
