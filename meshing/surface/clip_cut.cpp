@@ -54,8 +54,7 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
   }();
 
   // 3. Cut at the lower plane, keeping what lies above, then at the upper, keeping what lies below.
-  PlaneCutParams cut_params = plane_cut_params(p, d);
-  cut_params.ends = whole.ends_near_planes;
+  const PlaneCutParams cut_params = plane_cut_params(p, window.bed, whole);
   nlohmann::json clip;
   TriangleMesh fluid = std::move(whole.fluid);
   for (const auto& [z, lower, asked] : {std::tuple{lo, true, p.clip_bottom_d}, std::tuple{hi, false, p.clip_top_d}}) {
@@ -77,8 +76,10 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
   FluidSurface out;
   out.fluid = std::move(fluid);
   // A slab of this window is cut again at its pieces' planes (its wall rings): that face must be
-  // graded about the same ends as the neighbouring slab's, whose window is no clip window.
+  // graded about the same ends, and sized from the same spheres, as the neighbouring slab's, whose
+  // window is no clip window.
   out.ends_near_planes = std::move(whole.ends_near_planes);
+  out.spheres_near_planes = std::move(whole.spheres_near_planes);
   out.report = whole.report;
   for (const char* key : {"clip", "domain_m", "opened_at_clip_planes"}) out.report.erase(key);
   out.report["parameters"] = to_json(p);

@@ -28,6 +28,20 @@ std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& c
   return out;
 }
 
+std::vector<SphereNearPlane> spheres_near_planes(const std::vector<Eigen::Vector3d>& centres,
+                                                 const std::vector<double>& radii,
+                                                 const std::vector<double>& planes_z, double reach) {
+  std::vector<SphereNearPlane> out;
+  for (std::size_t i = 0; i < centres.size(); ++i)
+    if (std::any_of(planes_z.begin(), planes_z.end(),
+                    [&](double z) { return std::abs(centres[i].z() - z) < radii[i] + reach; }))
+      out.push_back({centres[i], radii[i]});
+  std::sort(out.begin(), out.end(), [](const SphereNearPlane& a, const SphereNearPlane& b) {
+    return std::tuple(a.centre.x(), a.centre.y(), a.centre.z()) < std::tuple(b.centre.x(), b.centre.y(), b.centre.z());
+  });
+  return out;
+}
+
 std::vector<std::pair<double, double>> end_rings(const EndNearPlane& e, double coarse) {
   const double r = e.radius, gap = e.gap();
   // The gap between the plane and the sphere at distance rho from the end's axis; inside the loop

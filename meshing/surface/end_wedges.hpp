@@ -46,6 +46,22 @@ std::vector<EndNearPlane> ends_near_planes(const std::vector<Eigen::Vector3d>& c
                                            const std::vector<double>& radii, const std::vector<double>& planes_z,
                                            double coarse);
 
+// A treated sphere near a plane the surface is cut at (m). The cut's face, made from the plane's
+// loops alone, would not see the spheres just above and below it, which narrow the fluid there;
+// sized across the gaps they leave, its triangles match the cells gmsh grades between the
+// surfaces about it (PlaneCutParams::spheres).
+struct SphereNearPlane {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+// The spheres (`centres`, `radii`: N each, m) whose surface comes within `reach` (m) of one of
+// the planes z = `planes_z` (m), each once, every sphere given (both windows of a plane hold the
+// spheres near it, so both find the same), sorted by x, then y, then z.
+std::vector<SphereNearPlane> spheres_near_planes(const std::vector<Eigen::Vector3d>& centres,
+                                                 const std::vector<double>& radii,
+                                                 const std::vector<double>& planes_z, double reach);
+
 // The graded rings about an end: (distance from its axis, spacing) in m, the first (0, its own
 // spacing) the end itself; each next ring sqrt(3)/2 of a spacing further out, until the spacing
 // kWedgeEdgePerGap x the gap there (where the plane cuts the sphere, not less than the cut's

@@ -488,6 +488,10 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       if (e.gap() > 0.0) ends.push_back(e);
   std::vector<std::vector<const EndNearPlane*>> ends_of(bed.size());
   for (const EndNearPlane& e : ends) ends_of[e.sphere].push_back(&e);
+  std::vector<double> cut_planes = rings;
+  if (p.clip || laid.periodic()) cut_planes.insert(cut_planes.end(), {z0, z1});
+  std::vector<SphereNearPlane> near_cuts =
+      gaps ? spheres_near_planes(bed.centres, tb.radius, cut_planes, 2.0 * p.cells_per_gap * edge) : std::vector<SphereNearPlane>{};
   auto field = [&](int self) {
     SpacingField f = gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
                           : SpacingField{};
@@ -700,6 +704,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   out.report["domain_m"] = {{"inlet_z", z0}, {"outlet_z", z1}};
   out.exact_volume_m3 = domain - tb.solid_volume;
   out.ends_near_planes = ends;
+  out.spheres_near_planes = std::move(near_cuts);
   out.report["fluid_volume_exact_m3"] = out.exact_volume_m3;
   out.report["void_fraction_bed_section_change"] =
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);

@@ -147,6 +147,11 @@ struct FluidSurface {
   // ends at (a clip window's, a periodic section's; there only ends the plane does not cut), which
   // the spheres grade their vertices about and a cut's face must too (PlaneCutParams::ends).
   std::vector<EndNearPlane> ends_near_planes;
+  // The treated spheres whose surface comes within twice cells_per_gap x edge of those planes (the
+  // face measures gaps to the nearer, and their spacing from their own neighbours), which a cut's
+  // face sizes its edge across the fluid from (PlaneCutParams::spheres); none without
+  // [surface] cells_per_gap.
+  std::vector<SphereNearPlane> spheres_near_planes;
   nlohmann::json report;
 };
 

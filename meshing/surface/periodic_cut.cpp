@@ -171,9 +171,7 @@ std::optional<FluidSurface> section_joined_at(const Bed& bed, const SurfaceParam
   // 3. Cut at the lower plane: the fluid above it and below it, one face between them.
   PlaneCut cut = [&] {
     try {
-      PlaneCutParams cut_params = plane_cut_params(p, d);
-      cut_params.ends = whole.ends_near_planes;
-      return cut_by_plane(whole.fluid, z0, cut_params);
+      return cut_by_plane(whole.fluid, z0, plane_cut_params(p, window.bed, whole));
     } catch (const CutConflict& e) {
       throw InputError(fmt::format("the periodic section's lower plane: {}; allowed: a shorter "
                                    "surface.contact_edge_length_d or another treatment",

@@ -8,12 +8,14 @@
 #include <iterator>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 #include <unordered_map>
 
 #include "core/edge_key.hpp"
 #include "meshing/surface/delaunay_facets.hpp"
+#include "meshing/surface/gap_spacing.hpp"
 #include "meshing/surface/planar_cdt.hpp"
 #include "meshing/surface/primitives.hpp"
 #include "meshing/surface/spaced_points.hpp"
@@ -204,6 +206,14 @@ nlohmann::json to_json(const PlaneCut& c) {
 PlaneCutParams plane_cut_params(const SurfaceParams& s, double d) {
   return {.edge = s.edge_length_d * d, .growth = s.growth, .cells_per_gap = s.cells_per_gap,
           .finest = std::min(s.contact_edge_length_d, s.edge_length_d) * d};
+}
+
+PlaneCutParams plane_cut_params(const SurfaceParams& s, const Bed& bed, const FluidSurface& cut) {
+  PlaneCutParams out = plane_cut_params(s, reference_diameter(bed));
+  out.ends = cut.ends_near_planes;
+  out.spheres = cut.spheres_near_planes;
+  out.container = bed.container;
+  return out;
 }
 
 PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) {
@@ -486,37 +496,78 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
                                     z, where(h.points[0])));
     holes[holder].push_back({h.points, h.spacing, -1});
   }
-  // The face's spacing across narrow gaps, from its loops alone (both windows of a plane have the
-  // same loops): each loop point with its normal into the fluid, which lies on the right of every
-  // loop (outer loops run clockwise, holes anticlockwise).
+  // The face's spacing across narrow gaps, from its loops (both windows of a plane have the same
+  // loops) and the spheres near it (both windows hold them): each loop point with its normal into
+  // the fluid, which lies on the right of every loop (outer loops run clockwise, holes
+  // anticlockwise), and each sphere by its nearest point.
   const double reach = p.cells_per_gap * p.edge;
-  std::vector<Eigen::Vector2d> loop_point, fluid_side;
+  std::vector<Eigen::Vector3d> loop_point, fluid_side, centre;
+  std::vector<double> loop_spacing, radius;
   PointsByCell near_loop(reach > 0.0 ? reach : p.edge);
+  for (const SphereNearPlane& b : p.spheres)
+    if (std::abs(b.centre.z() - z) < b.radius + 2.0 * reach) centre.push_back(b.centre), radius.push_back(b.radius);
+  if (!centre.empty() && !p.container) throw std::invalid_argument("cut_by_plane: spheres given without their container");
+  const std::vector<char> kept(centre.size(), 1);
+  std::optional<GapSpacing> surface_spacing;
+  if (p.container) surface_spacing.emplace(centre, radius, kept, *p.container, p.cells_per_gap, p.finest, p.edge);
+  PointsByCell near_sphere(reach + (radius.empty() ? 0.0 : *std::max_element(radius.begin(), radius.end())));
+  // The surface's own spacing at a point of it (GapSpacing, as build_fluid_surface gave the
+  // spheres and walls): on the sphere it lies on (within twice the sagitta of an edge), else on
+  // a wall; without the spheres, the edge.
+  auto spacing_at = [&](const Eigen::Vector3d& q, int sphere) {
+    return surface_spacing ? surface_spacing->at(q, sphere) : p.edge;
+  };
   SpacingField field;
   if (reach > 0.0) {
+    for (std::size_t i = 0; i < centre.size(); ++i) near_sphere.add({centre[i].x(), centre[i].y(), z}, static_cast<int>(i));
     for (const auto& loop : loops)
       for (std::size_t k = 0; k < loop.size(); ++k) {
+        const Eigen::Vector3d& q = x[loop[k]];
         const Eigen::Vector3d t = x[loop[(k + 1) % loop.size()]] - x[loop[(k + loop.size() - 1) % loop.size()]];
-        near_loop.add({x[loop[k]].x(), x[loop[k]].y(), 0.0}, static_cast<int>(loop_point.size()));
-        loop_point.emplace_back(x[loop[k]].x(), x[loop[k]].y());
-        fluid_side.push_back(Eigen::Vector2d(t.y(), -t.x()).normalized());
+        int on = -1;
+        double off = std::numeric_limits<double>::infinity();
+        near_sphere.near(q, [&](int i) {
+          const double o = std::abs((q - centre[i]).norm() - radius[i]);
+          if (o < off && o < p.edge * p.edge / (4.0 * radius[i])) off = o, on = i;
+        });
+        near_loop.add(q, static_cast<int>(loop_point.size()));
+        loop_point.push_back(q);
+        loop_spacing.push_back(spacing_at(q, on));
+        fluid_side.push_back(Eigen::Vector3d(t.y(), -t.x(), 0.0).normalized());
       }
+    // At a point q of the face, the nearest solid point (d1 away, the surface's spacing there h1)
+    // and the nearest ahead of it, within 60 degrees of the direction from the first to q (d2,
+    // h2): the face's edge is the gap d1 + d2 over cells_per_gap, or the spacing the volume mesh
+    // grades to between the two surfaces, h1 + (h2 - h1) d1 / (d1 + d2), if finer.
     field = {[&](const Eigen::Vector3d& q3) {
-               const Eigen::Vector2d q(q3.x(), q3.y());
-               const Eigen::Vector3d at(q.x(), q.y(), 0.0);
-               int nearest = -1;
-               double d1 = reach, d2 = reach;
-               near_loop.near(at, [&](int i) {
-                 if (const double r = (loop_point[i] - q).norm(); r < d1) d1 = r, nearest = i;
+               const Eigen::Vector3d q(q3.x(), q3.y(), z);
+               double d1 = reach, d2 = reach, h1 = p.edge, h2 = p.edge;
+               Eigen::Vector3d away = Eigen::Vector3d::Zero();
+               near_loop.near(q, [&](int i) {
+                 if (const double r = (loop_point[i] - q).norm(); r < d1) {
+                   d1 = r, h1 = loop_spacing[i];
+                   away = r > 1e-9 * reach ? Eigen::Vector3d((q - loop_point[i]) / r) : fluid_side[i];
+                 }
                });
-               if (nearest < 0) return p.edge;
-               const Eigen::Vector2d away = d1 > 1e-9 * reach ? Eigen::Vector2d((q - loop_point[nearest]) / d1)
-                                                              : fluid_side[nearest];
-               near_loop.near(at, [&](int i) {
-                 const Eigen::Vector2d w = loop_point[i] - q;
-                 if (const double r = w.norm(); r < d2 && w.dot(away) > 0.5 * r) d2 = r;
+               near_sphere.near(q, [&](int i) {
+                 const Eigen::Vector3d w = q - centre[i];
+                 const double n = w.norm();
+                 if (const double r = std::max(0.0, n - radius[i]); r < d1 && n > 0.0)
+                   d1 = r, away = w / n, h1 = spacing_at(centre[i] + radius[i] * away, static_cast<int>(i));
                });
-               return std::clamp((d1 + d2) / p.cells_per_gap, p.finest, p.edge);
+               if (away.isZero()) return p.edge;
+               near_loop.near(q, [&](int i) {
+                 const Eigen::Vector3d w = loop_point[i] - q;
+                 if (const double r = w.norm(); r < d2 && w.dot(away) > 0.5 * r) d2 = r, h2 = loop_spacing[i];
+               });
+               near_sphere.near(q, [&](int i) {
+                 const Eigen::Vector3d w = centre[i] - q;
+                 const double n = w.norm();
+                 if (const double r = std::max(0.0, n - radius[i]); r < d2 && w.dot(away) > 0.5 * n)
+                   d2 = r, h2 = spacing_at(q + r * w / n, static_cast<int>(i));
+               });
+               const double graded = d1 + d2 > 0.0 ? h1 + (h2 - h1) * d1 / (d1 + d2) : h1;
+               return std::clamp(std::min((d1 + d2) / p.cells_per_gap, graded), p.finest, p.edge);
              },
              p.finest};
   }

@@ -1,4 +1,5 @@
 #pragma once
+#include <memory>
 #include <string>
 
 #include "meshing/surface/end_wedges.hpp"
@@ -27,6 +28,12 @@ struct PlaneCutParams {
   // Spheres' ends near the plane, passed by or cut just inside (FluidSurface::ends_near_planes, of
   // any plane: the cut takes those at its own height): the face gets plane_end_seeds about each.
   std::vector<EndNearPlane> ends{};
+  // Treated spheres near the plane (FluidSurface::spheres_near_planes, of any plane: the cut takes
+  // those near its own height) and their container (needed with them): with cells_per_gap, the
+  // gap at a point of the face is measured to their surfaces too, above and below it, not only to
+  // the loops in it, and the face takes the spacing the surfaces about it have (see cut_by_plane).
+  std::vector<SphereNearPlane> spheres{};
+  std::shared_ptr<const Container> container{};
 };
 
 struct PlaneCut {
@@ -63,10 +70,12 @@ struct PlaneCut {
 // the holes (the solid's sections) it is the nearest to hold; each is meshed by plane_mesh with
 // `p`'s edge and growth, graded about the ends of spheres near the plane (PlaneCutParams::ends),
 // shorter across narrow gaps (PlaneCutParams::cells_per_gap: the gap at
-// a point of the face is its distance to the nearest loop point plus that to the nearest loop
+// a point of the face is its distance to the nearest solid point plus that to the nearest solid
 // point ahead of it, within 60 degrees of the direction away from the first, so two sides of
-// one loop (spheres joined by a bridge the plane cuts) count as a gap too), normals +z on the
-// part below and -z above.
+// one loop (spheres joined by a bridge the plane cuts) count as a gap too; the solid points are
+// the loops' and the nearest points of PlaneCutParams::spheres, in 3D; and where finer, the
+// spacing the surfaces have at those two points (GapSpacing), interpolated between them as gmsh
+// grades its cells between surfaces), normals +z on the part below and -z above.
 // CutConflict (primitives.hpp) naming the height and place when the plane meets the surface at
 // a point where loops touch, or when plane_mesh cannot place a hole; std::runtime_error when
 // `surface` is not closed along the plane.
@@ -108,7 +117,10 @@ void finish_cut_surface(FluidSurface& out, double d);
 nlohmann::json to_json(const PlaneCut& c);
 
 // The cut's parameters from the surface stage's `s` (d: the reference diameter, m): the
-// surface's edge and its cells across gaps, down to the edge the gaps' spacing allows.
+// surface's edge and its cells across gaps, down to the edge the gaps' spacing allows; with the
+// surface `cut` of `bed` (the one to be cut), its spheres' ends, the spheres near its planes and
+// their container.
 PlaneCutParams plane_cut_params(const SurfaceParams& s, double d);
+PlaneCutParams plane_cut_params(const SurfaceParams& s, const Bed& bed, const FluidSurface& cut);
 
 }  // namespace bedforge::meshing

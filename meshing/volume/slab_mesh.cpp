@@ -385,9 +385,7 @@ VolumeMesh mesh_slab(const Bed& bed, const SurfaceParams& surface, const std::ve
     for (const auto& [j, keep_above] : {std::pair{k - 1, true}, std::pair{k, false}}) {
       if (j < 0 || j + 1 >= slabs) continue;
       try {
-        PlaneCutParams cut_params = plane_cut_params(surface, d);
-        cut_params.ends = fs.ends_near_planes;
-        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), cut_params);
+        PlaneCut c = cut_by_plane(fs.fluid, round_to_ascii_stl(planes[j] * d), plane_cut_params(surface, window_bed, fs));
         cut_report.push_back(cut_json(c, planes[j]));
         fs.fluid = std::move(keep_above ? c.above : c.below);
       } catch (const CutConflict& e) {
@@ -457,7 +455,14 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
       nlohmann::json cut_report = nlohmann::json::array();
       if (k + 1 < slabs) {
         try {
-          PlaneCut c = cut_by_plane(own, planes[k] * d, plane_cut_params(surface, d));
+          // The whole surface keeps no treated radii: the face is sized from the spheres' own.
+          PlaneCutParams cut_params = plane_cut_params(surface, d);
+          std::vector<double> radii(bed.size());
+          for (std::size_t i = 0; i < bed.size(); ++i) radii[i] = 0.5 * bed.diameters[i];
+          cut_params.spheres = spheres_near_planes(bed.centres, radii, {planes[k] * d},
+                                                   2.0 * surface.cells_per_gap * surface.edge_length_d * d);
+          cut_params.container = bed.container;
+          PlaneCut c = cut_by_plane(own, planes[k] * d, cut_params);
           cut_report.push_back(cut_json(c, planes[k]));
           own = std::move(c.below), above = std::move(c.above);
         } catch (const CutConflict& e) {

@@ -52,6 +52,25 @@ TEST(EndWedges, EndsWithinTheReachOfAPlaneAreFoundOnBothSidesAndInOneOrderWhatev
   for (std::size_t k = 0; k < ends.size(); ++k) EXPECT_EQ(again[k].centre, ends[k].centre);
 }
 
+TEST(EndWedges, SpheresWhoseSurfaceComesWithinReachOfAPlaneAreFoundOnceInOneOrderWhateverTheSpheresOrder) {
+  // Spheres of radius 0.5 about the planes z = 0 and z = 3, reach 0.2: surfaces within 0.2 count.
+  std::vector<Eigen::Vector3d> centres{{0.0, 0.0, 0.69},  {1.2, 0.0, -0.71},  // 0.19 above; 0.21 below
+                                       {0.0, 1.2, 0.0},   {2.0, 0.0, 3.69},   // cut through; 0.19 above the other
+                                       {3.0, 0.0, 1.5}};                      // between, near neither
+  std::vector<double> radii(centres.size(), 0.5);
+  const std::vector<SphereNearPlane> found = spheres_near_planes(centres, radii, {0.0, 3.0}, 0.2);
+  ASSERT_EQ(found.size(), 3u);
+  EXPECT_EQ(found[0].centre, centres[0]);
+  EXPECT_EQ(found[1].centre, centres[2]);
+  EXPECT_EQ(found[2].centre, centres[3]);
+  // Near both planes at once (a thin slab between them), still once.
+  EXPECT_EQ(spheres_near_planes({{0.0, 0.0, 0.5}}, {0.5}, {0.0, 1.0}, 0.2).size(), 1u);
+  std::reverse(centres.begin(), centres.end());
+  const std::vector<SphereNearPlane> again = spheres_near_planes(centres, radii, {0.0, 3.0}, 0.2);
+  ASSERT_EQ(again.size(), found.size());
+  for (std::size_t i = 0; i < found.size(); ++i) EXPECT_EQ(again[i].centre, found[i].centre);
+}
+
 TEST(EndWedges, RingsAreSpacedAtTwiceTheGapUnderThemUpToTheCoarseEdge) {
   // A gap below 0: the plane cuts the sphere that deep inside its end.
   for (double gap : {1e-4, 0.0023, 0.03, -0.0023, -0.03}) {

@@ -223,6 +223,41 @@ TEST(PlaneCut, TheFaceIsFinerAcrossANarrowGapBetweenSections) {
   EXPECT_GE(with, 4) << "asked for " << sp.cells_per_gap;
 }
 
+// Spheres just above and below the plane, neither cut by it, narrow the fluid there to a gap of
+// 0.1 d that the plane's section does not show: given them (PlaneCutParams::spheres), the face
+// takes the gap's spacing between them; without, the surface's edge (the session 82 finding in
+// docs/findings.md: the pieces' faces, sized from their loops alone, held 45 % fewer cells 0.1-0.2 d
+// from the spheres beside the planes than one piece).
+TEST(PlaneCut, TheFaceIsFinerBetweenSpheresJustAboveAndBelowIt) {
+  Bed b;
+  b.container = std::make_shared<Cylinder>(2.0);
+  b.centres = {{0.0, 0.0, 0.95}, {0.0, 0.0, 2.05}};
+  b.diameters = {1.0, 1.0};
+  SurfaceParams sp;
+  sp.edge_length_d = 0.3;
+  sp.cells_per_gap = 4.0;
+  const FluidSurface whole = build_fluid_surface(b, sp);
+  // Vertices of the face within 0.15 d of the axis, under both spheres.
+  auto under_the_gap = [&](bool given) {
+    PlaneCutParams p = plane_cut_params(sp, 1.0);
+    if (given) {
+      p.spheres = spheres_near_planes(b.centres, {0.5, 0.5}, {1.5}, 2.0 * sp.cells_per_gap * sp.edge_length_d);
+      p.container = b.container;
+    }
+    const PlaneCut c = cut_by_plane(whole.fluid, 1.5, p);
+    expect_valid(c.below, "below"), expect_valid(c.above, "above");
+    int n = 0;
+    for (const Eigen::Vector3d& q : c.below.points) n += q.z() == 1.5 && std::hypot(q.x(), q.y()) < 0.15;
+    return n;
+  };
+  const int without = under_the_gap(false), with = under_the_gap(true);
+  // The gap 0.1 over 4 cells asks for the finest edge (the contact edge, 0.033 d) under the
+  // spheres: a triangular lattice of that spacing puts 75 vertices in a disc of radius 0.15 (at
+  // least half asked); the surface's edge of 0.3 puts 1 or none.
+  EXPECT_LE(without, 2) << "the control: sized from the loops alone; given the spheres: " << with;
+  EXPECT_GE(with, 38);
+}
+
 // A plane a hair (a thousandth of an edge) above or below each vertex near the bridged contact
 // of A and B, where the bridge's rims are saddles of the height that the snaps must leave off
 // the plane: no vertex of either part beside a point on the plane is left within a hundredth of
