@@ -55,6 +55,11 @@ struct SphereNearPlane {
   double radius = 0.0;
 };
 
+// A cut's face measures gaps out to cells_per_gap x edge from a point of it, and the surfaces'
+// spacing at the points it finds from their own neighbours as far again: the spheres it needs
+// come within this many times cells_per_gap x edge of its plane.
+inline constexpr double kSpheresNearPlaneReach = 2.0;
+
 // The spheres (`centres`, `radii`: N each, m) whose surface comes within `reach` (m) of one of
 // the planes z = `planes_z` (m), each once, every sphere given (both windows of a plane hold the
 // spheres near it, so both find the same), sorted by x, then y, then z.

@@ -491,7 +491,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   std::vector<double> cut_planes = rings;
   if (p.clip || laid.periodic()) cut_planes.insert(cut_planes.end(), {z0, z1});
   std::vector<SphereNearPlane> near_cuts =
-      gaps ? spheres_near_planes(bed.centres, tb.radius, cut_planes, 2.0 * p.cells_per_gap * edge) : std::vector<SphereNearPlane>{};
+      gaps ? spheres_near_planes(bed.centres, tb.radius, cut_planes, kSpheresNearPlaneReach * p.cells_per_gap * edge) : std::vector<SphereNearPlane>{};
   auto field = [&](int self) {
     SpacingField f = gaps ? SpacingField{[&gaps, self](const Eigen::Vector3d& q) { return gaps->at(q, self); }, gaps->finest()}
                           : SpacingField{};

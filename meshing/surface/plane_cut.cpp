@@ -505,7 +505,7 @@ PlaneCut cut_by_plane(const TriangleMesh& m, double z, const PlaneCutParams& p) 
   std::vector<double> loop_spacing, radius;
   PointsByCell near_loop(reach > 0.0 ? reach : p.edge);
   for (const SphereNearPlane& b : p.spheres)
-    if (std::abs(b.centre.z() - z) < b.radius + 2.0 * reach) centre.push_back(b.centre), radius.push_back(b.radius);
+    if (std::abs(b.centre.z() - z) < b.radius + kSpheresNearPlaneReach * reach) centre.push_back(b.centre), radius.push_back(b.radius);
   if (!centre.empty() && !p.container) throw std::invalid_argument("cut_by_plane: spheres given without their container");
   const std::vector<char> kept(centre.size(), 1);
   std::optional<GapSpacing> surface_spacing;

@@ -440,6 +440,9 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
   const double d = reference_diameter(bed);
   TriangleMesh above;  // slabs from the whole surface: the part above the planes cut so far
   if (from_whole) above = *whole;
+  // The whole surface keeps no treated radii: its cuts' faces are sized from the spheres' own.
+  std::vector<double> radii(bed.size());
+  for (std::size_t i = 0; i < bed.size(); ++i) radii[i] = 0.5 * bed.diameters[i];
   Joined joined;
   nlohmann::json reports = nlohmann::json::array();
   for (int k = 0; k < slabs; ++k) {
@@ -455,12 +458,9 @@ VolumeMesh mesh_and_join_slabs(const Bed& bed, const SurfaceParams& surface, con
       nlohmann::json cut_report = nlohmann::json::array();
       if (k + 1 < slabs) {
         try {
-          // The whole surface keeps no treated radii: the face is sized from the spheres' own.
           PlaneCutParams cut_params = plane_cut_params(surface, d);
-          std::vector<double> radii(bed.size());
-          for (std::size_t i = 0; i < bed.size(); ++i) radii[i] = 0.5 * bed.diameters[i];
           cut_params.spheres = spheres_near_planes(bed.centres, radii, {planes[k] * d},
-                                                   2.0 * surface.cells_per_gap * surface.edge_length_d * d);
+                                                   kSpheresNearPlaneReach * surface.cells_per_gap * surface.edge_length_d * d);
           cut_params.container = bed.container;
           PlaneCut c = cut_by_plane(own, planes[k] * d, cut_params);
           cut_report.push_back(cut_json(c, planes[k]));

@@ -241,7 +241,7 @@ TEST(PlaneCut, TheFaceIsFinerBetweenSpheresJustAboveAndBelowIt) {
   auto under_the_gap = [&](bool given) {
     PlaneCutParams p = plane_cut_params(sp, 1.0);
     if (given) {
-      p.spheres = spheres_near_planes(b.centres, {0.5, 0.5}, {1.5}, 2.0 * sp.cells_per_gap * sp.edge_length_d);
+      p.spheres = spheres_near_planes(b.centres, {0.5, 0.5}, {1.5}, kSpheresNearPlaneReach * sp.cells_per_gap * sp.edge_length_d);
       p.container = b.container;
     }
     const PlaneCut c = cut_by_plane(whole.fluid, 1.5, p);
