@@ -103,6 +103,8 @@ pieces_1e4: issue 58's own bed (a = 14, N = 1e4, bridges, 0.1 d, tetrahedra, not
         ranks the pieces joined by reconstructParMesh and checked whole; the issue's targets for it.
 pieces_1e4_solved: the same bed at 0.15 d on polyhedra, solved: one piece (simpleFoam on 2 processes) against 2 and 4
         pieces on their ranks: dp/L, scene to dp/L, the largest processes, checkMesh (at 4 ranks reconstructed too).
+pieces_1e4_tetrahedra: the same at 0.25 d, contact edge a third, on gmsh's tetrahedra (the cells of
+        scenes/default.toml), solved likewise.
 weak_scaling_1e4: --weak-1e4-spheres spheres per rank at a = 14 (bridges, 0.1 d, tetrahedra), on 1, 2 and 4 ranks.
 projection_1e4: the projection from pieces_1e4's ranks.
 Times and peak memory are the stages' own (report.json); a run's peak is the largest of its
@@ -132,7 +134,7 @@ RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_500", "study_reynolds", "study_treatments",
             "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
-            "pieces_1e4_solved", "weak_scaling_1e4",
+            "pieces_1e4_solved", "pieces_1e4_tetrahedra", "weak_scaling_1e4",
             "projection_1e4"]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
@@ -863,6 +865,18 @@ def bed_1e4_solved_scene(count, solve, spheres=10000):
                    ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')], "bed_1e4_solved_scene")
 
 
+def bed_1e4_tetrahedra_scene(count, solve, spheres=10000):
+    """Issue 58's bed at 0.25 d, contact edge a third (0.0833 d), on gmsh's tetrahedra (the cells of
+    scenes/default.toml), solved, in `count` pieces (0: one piece); unsolved when not `solve`. So coarse because
+    simpleFoam takes 3.4 kB per tetrahedron (docs/findings.md, 2026-12-05) and the cells around the 32,866 contacts
+    hardly fall with the surface edge: bedforge's estimate refused 0.2 d with the default contact edge (9.3 M
+    cells, 30.7 GB) and puts this one at 5.5 M cells, 18.2 GB, of the 24.7 GB here (docs/findings.md, 2026-12-05)."""
+    return edited(scene(14, spheres, "bridge", 0.25, solve, cells="tetrahedra"),
+                  [('algorithm = "hxt"', f'algorithm = "hxt"\npieces = {count}'),
+                   ('files = ["positions", "stl", "mesh", "case"]', 'files = ["positions", "case"]')],
+                  "bed_1e4_tetrahedra_scene")
+
+
 def timed_run(path, text, env):
     """`bedforge run` of the scene `text` (written to path.toml) into `path`: its wall time (s)."""
     open(path + ".toml", "w").write(text)
@@ -909,6 +923,9 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
     # The mesh the section describes, as the scene sets it.
     mesh = {"cells_kind": scene_value(text, "cells"), "edge_d": float(scene_value(text, "edge_length_d")),
             "cells_per_gap": float(scene_value(text, "cells_per_gap"))}
+    contact_edge = re.search(r"^contact_edge_length_d = ([\d.]+)", text, re.M)
+    if contact_edge:  # else the default, 0.05 d
+        mesh["contact_edge_d"] = float(contact_edge.group(1))
     rows = []
     one_run = bool(solved) if one_piece is None else one_piece
     for p in ([0] if one_run else []) + ranks:
@@ -1215,16 +1232,26 @@ def pieces_1e4_solved_lines(rows):
     """Issue 58's bed solved in one piece and in pieces: dp/L, scene to dp/L, memory and checkMesh, and the issue's
     targets that need the solve."""
     one = next(r for r in rows if r["pieces"] == 0)
-    lines = ["## Issue 58's bed solved in pieces: a = 14, N = 1e4, bridges, 0.15 d, one piece against 2 and 4 ranks", "",
-             f"Made at {rows[0]['commit']} on {rows[0]['date']}. The bed: {BED_1E4_SOLVED}; at 0.15 d, not the 0.1 d "
-             "of the section above, because simpleFoam on the 0.1 d mesh would need some 37 GB here. *One piece*: the run "
-             "as before pieces (its mesh stage, the case stage's dual, decomposePar, simpleFoam on 2 processes). *P "
-             "pieces*: `[mesh] pieces = P`, each rank cutting, meshing and writing its slab's polyhedra as "
-             "`processorK`, then simpleFoam on the P pieces as written (no decomposePar); 4 ranks run oversubscribed "
-             "on the 2 cores. Scene to dp/L: the whole `bedforge run`, packing included, one run after the other. "
-             "checkMesh: Allrun's, `-parallel` on the pieces; where marked, the pieces joined by "
+    # Rows made before the mesh was recorded: polyhedra at 0.15 d (BED_1E4_SOLVED).
+    kind, edge = rows[0].get("cells_kind", "polyhedra"), rows[0].get("edge_d", 0.15)
+    tets = kind == "tetrahedra"
+    bed = (BED_1E4_SOLVED if not tets else
+           f"a = 14, seed 1, bridges, surface edge {edge:g} d ("
+           + (f"{rows[0]['contact_edge_d']:g} d" if "contact_edge_d" in rows[0] else "the default 0.05 d")
+           + " where contacts meet), no refinement "
+           "across gaps, gmsh's tetrahedra as the case's cells (those of scenes/default.toml), Re_p = 1, solved")
+    lines = [f"## Issue 58's bed solved in pieces: a = 14, N = 1e4, bridges, {edge:g} d"
+             + (", tetrahedra" if tets else "") + ", one piece against 2 and 4 ranks", "",
+             f"Made at {rows[0]['commit']} on {rows[0]['date']}. The bed: {bed}; at {edge:g} d, not the 0.1 d "
+             "of the section above, because simpleFoam on the 0.1 d mesh would need some 37 GB here"
+             + (" (3.4 kB per tetrahedron; docs/findings.md, 2026-12-05)" if tets else "") + ". *One piece*: the run "
+             "as before pieces (its mesh stage, the case stage" + ("" if tets else "'s dual") + ", decomposePar, "
+             "simpleFoam on 2 processes). *P pieces*: `[mesh] pieces = P`, each rank cutting, meshing and writing its "
+             f"slab's {kind} as `processorK`, then simpleFoam on the P pieces as written (no decomposePar); 4 ranks run "
+             "oversubscribed on the 2 cores. Scene to dp/L: the whole `bedforge run`, packing included, one run after "
+             "the other. checkMesh: Allrun's, `-parallel` on the pieces; where marked, the pieces joined by "
              "`reconstructParMesh -constant` and checked whole.", "",
-             "| route | polyhedra | largest mesh process (MB) | simpleFoam, largest process (MB) | simpleFoam (s) | "
+             f"| route | {kind} | largest mesh process (MB) | simpleFoam, largest process (MB) | simpleFoam (s) | "
              "scene to dp/L (s) | checkMesh | dp/L (Pa/m) |",
              "|---|---|---|---|---|---|---|---|"]
     lines.append(f"| one piece, 2 processes | {one['cells']} | {one_piece_peaks(one)} | {one['solver_peak_mb']:.0f} | "
@@ -1237,16 +1264,17 @@ def pieces_1e4_solved_lines(rows):
                      f"{r['solver_peak_mb']:.0f} | {r['solve_s']:.0f} | {r['wall_s']:.0f} | {check} | "
                      f"{r['dp_pa_m']:.6g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.3f} %) |")
     verdict = lambda ok: "**met**" if ok else "**not met**"
-    lines += ["", "Issue 58's targets that need the solve, on this bed at 0.15 d:", ""]
+    lines += ["", f"Issue 58's targets that need the solve, on this bed at {edge:g} d:", ""]
     for p in (4, 2):
         r = next((r for r in rows if r["pieces"] == p), None)
         if r is None:
             continue
         change = 100 * (r["dp_pa_m"] / one["dp_pa_m"] - 1)
         lines.append(f"- dp/L on {p} ranks within 0.5 % of the one-piece route's: {change:+.3f} %, "
-                     f"{verdict(abs(change) <= 0.5)}; the polyhedra differ by {r['cells'] - one['cells']:+d} "
-                     f"({100 * (r['cells'] / one['cells'] - 1):+.2f} %: the planes' cut faces and whole dual cells across "
-                     "them, and gmsh's threads make other tetrahedra on each run).")
+                     f"{verdict(abs(change) <= 0.5)}; the {kind} differ by {r['cells'] - one['cells']:+d} "
+                     f"({100 * (r['cells'] / one['cells'] - 1):+.2f} %: the planes' cut faces"
+                     + ("" if tets else " and whole dual cells across them")
+                     + ", and gmsh's threads make other tetrahedra on each run).")
     four = next((r for r in rows if r["pieces"] == 4 and "reconstructed" in r), None)
     if four:
         lines.append(f"- 4 ranks: the case runs in parallel without decomposePar (checkMesh -parallel: "
@@ -1813,6 +1841,7 @@ def write(results):
                                ("pieces_bridge", pieces_lines), ("pieces_large", pieces_lines),
                                ("weak_scaling", weak_scaling_lines), ("projection", projection_lines),
                                ("pieces_1e4", pieces_1e4_lines), ("pieces_1e4_solved", pieces_1e4_solved_lines),
+                               ("pieces_1e4_tetrahedra", pieces_1e4_solved_lines),
                                ("weak_scaling_1e4", weak_scaling_lines),
                                ("projection_1e4", projection_lines)):
         if key in results:
@@ -2042,6 +2071,10 @@ def main():
         if "pieces_1e4_solved" in args.only:
             results["pieces_1e4_solved"] = pieces(tmp, [2, 4], 10000, solved=(0, 2, 4), make_scene=bed_1e4_solved_scene,
                                                   reconstruct=(4,))
+            write(results)
+        if "pieces_1e4_tetrahedra" in args.only:
+            results["pieces_1e4_tetrahedra"] = pieces(tmp, [2, 4], 10000, solved=(0, 2, 4),
+                                                      make_scene=bed_1e4_tetrahedra_scene, reconstruct=(4,))
             write(results)
         if "weak_scaling_1e4" in args.only:
             results["weak_scaling_1e4"] = weak_scaling(tmp, [1, 2, 4], args.weak_1e4_spheres, bed_1e4_scene, BED_1E4)
