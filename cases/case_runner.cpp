@@ -12,7 +12,9 @@
 #include <future>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "analysis/pressure_drop.hpp"
 #include "core/error.hpp"
@@ -147,6 +149,20 @@ std::vector<Iteration> read_iterations(std::istream& log, bool* converged = null
   return its;
 }
 
+// Controls a running solve through its controlDict (OpenFOAM reads it again when it changes, the
+// case being written with runTimeModifiable): stopAt writeNow ends the run after the current
+// iteration with its fields written. Written beside and renamed, so that the solver never
+// reads half a file.
+void stop_at_write_now(const fs::path& case_dir) {
+  const fs::path dict = case_dir / "system" / "controlDict", written = case_dir / "system" / "controlDict.stopping";
+  std::ifstream in(dict);
+  std::ofstream out(written);
+  for (std::string line; std::getline(in, line);)
+    out << (line.rfind("stopAt", 0) == 0 ? "stopAt          writeNow;" : line) << '\n';
+  out.close();
+  fs::rename(written, dict);
+}
+
 // The last finished iteration of a log being written (step 0 before there is one). Only the
 // log's tail is read, so polling a long run stays cheap.
 Iteration last_iteration(const fs::path& log_path) {
@@ -256,6 +272,23 @@ std::string last_line(const fs::path& path) {
 
 }  // namespace
 
+std::optional<Divergence> find_divergence(std::istream& log, double target_u, double target_p) {
+  struct Least {
+    long step = 0;
+    double residual = std::numeric_limits<double>::infinity();
+  } least_u, least_p;
+  for (const Iteration& it : read_iterations(log)) {
+    for (auto [field, r, least, target] : {std::tuple{"U", it.res_u, &least_u, target_u},
+                                           std::tuple{"p", it.res_p, &least_p, target_p}}) {
+      if (!(r > 0.0)) continue;  // not solved for in this iteration (yet)
+      if (least->step > 0 && r > kDivergenceRise * std::max(least->residual, target))
+        return Divergence{field, least->step, least->residual, it.step, r};
+      if (r < least->residual) *least = {it.step, r};
+    }
+  }
+  return std::nullopt;
+}
+
 std::string missing_openfoam_program(int processors) {
   std::vector<std::string> programs = {"simpleFoam", "checkMesh"};
   if (processors > 1) programs.insert(programs.end(), {"decomposePar", "reconstructPar", "mpirun"});
@@ -283,11 +316,18 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
   const double target_p = c.params.residual_p, target_u = c.params.residual_u.value();
   double start_p = 0.0, start_u = 0.0;
+  long watched = 0;  // the last iteration find_divergence has seen
+  std::optional<Divergence> diverging;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");
     if (now.step == 0 || now.res_p <= 0.0 || now.res_u <= 0.0) {
       progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
       continue;
+    }
+    if (!diverging && now.step > watched) {
+      watched = now.step;
+      std::ifstream log(case_dir / "log.simpleFoam");
+      if ((diverging = find_divergence(log, target_u, target_p))) stop_at_write_now(case_dir);
     }
     if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
     const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),
@@ -297,6 +337,17 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
                     std::clamp(done, 0.0, 1.0));
   }
   progress.finish();
+  if (diverging) {
+    const Divergence& d = *diverging;
+    const Iteration last = last_iteration(case_dir / "log.simpleFoam");
+    throw ConvergenceError(fmt::format(
+        "simpleFoam diverging: the initial residual of {} rose from {:.2e} at iteration {} to {:.2e} at iteration {}, "
+        "more than {:g} times the least it had reached; stopped at iteration {} with its fields written there (in "
+        "{}/{} or, on more than one process, its processor*/{}) to show where; see {}/log.simpleFoam. The case and its "
+        "mesh are kept; allowed: a mesh that passes a stricter gate ([mesh.gate]), or a lower case.reynolds",
+        d.field, d.least, d.least_step, d.residual, d.step, kDivergenceRise, last.step, case_dir.string(), last.step,
+        last.step, case_dir.string()));
+  }
   const CheckMeshLog check = read_check_mesh_log(case_dir / "log.checkMesh");
   if (run.get() != 0) {
     if (snappy) refuse_lost_ends(check, c);

@@ -1,5 +1,6 @@
 #pragma once
 #include <nlohmann/json.hpp>
+#include <istream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,10 +79,35 @@ std::string missing_openfoam_program(int processors);
 // inlet that carried only the fluid's share took off 60 %.
 inline constexpr double kFlowRateTolerance = 0.1;
 
+// A solve turning back: the initial residual of U (the largest of its components) or of p (its
+// first solve in an iteration) past kDivergenceRise times the least it had reached, or times its
+// target where the least is below the target (noise there is no divergence).
+struct Divergence {
+  std::string field;       // "U" or "p"
+  long least_step = 0;     // the iteration of the least residual before the rise
+  double least = 0.0;
+  long step = 0;           // the first iteration past the rise
+  double residual = 0.0;
+};
+// 10: on 56 solves that converged (tetrahedra and polyhedra; Re_p 0.01 to 100; beds in one piece
+// and in 2 to 16, periodic sections, a random array; docs/findings.md 2026-12-06) neither residual
+// ever rose past 1.3 times its least; the one that diverged slowly (a = 14, N = 1e4, 4 pieces)
+// rose 156 (p) and 235 (U) times with no floating-point exception in 70 iterations, and would
+// have run on to case.iterations (some 10 hours there).
+inline constexpr double kDivergenceRise = 10.0;
+
+// The first divergence in a simpleFoam log `log` with the targets SIMPLE stops at (residual_u,
+// residual_p); std::nullopt when there is none.
+std::optional<Divergence> find_divergence(std::istream& log, double target_u, double target_p);
+
 // Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
 // reads back the solver's convergence and the pressure drop, compared with Eisfeld &
 // Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
-// while it runs. ConvergenceError when snappyHexMesh's cells lost the inlet or the outlet (the
+// while it runs, and watches it for a divergence (find_divergence): the run is then stopped at
+// that iteration with its fields written (controlDict's stopAt set to writeNow, which OpenFOAM
+// reads while it runs) and ConvergenceError says where, rather than the solve running on to
+// case.iterations. ConvergenceError also when the solver stopped on a floating-point exception,
+// and when snappyHexMesh's cells lost the inlet or the outlet (the
 // fluid they kept does not reach it), naming the settings that make finer cells;
 // std::runtime_error naming the log and Allrun's last words when another step fails.
 FlowResult run_case(const CaseInfo& c, Progress& progress);

@@ -402,13 +402,14 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
       (particles ? forces("forceParticles", "particles", p.density_kg_m3) : std::string()) +
       (periodic ? std::string()
                 : forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3));
+  // runTimeModifiable: run_case stops a diverging solve by setting stopAt to writeNow as it runs.
   write_text(tmp / "system/controlDict",
              dict("dictionary", "system", "controlDict", note,
                   fmt::format("application     simpleFoam;\nstartFrom       startTime;\nstartTime       0;\n"
                               "stopAt          endTime;\nendTime         {};\ndeltaT          1;\n"
                               "writeControl    timeStep;\nwriteInterval   {};\npurgeWrite      1;\n"
                               "writeFormat     {};\nwritePrecision  10;\nwriteCompression off;\n"
-                              "timeFormat      general;\ntimePrecision   8;\nrunTimeModifiable false;\n\n"
+                              "timeFormat      general;\ntimePrecision   8;\nrunTimeModifiable true;\n\n"
                               "// Pressure (kinematic, p/rho) averaged over the inlet, the outlet and the bed section's\n"
                               "// planes z = {:.6g} and {:.6g} m; flow rate through the outlet (m3/s); forces (N) on the\n"
                               "// walls, the particles, the inlet and the outlet.\n"
