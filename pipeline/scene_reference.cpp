@@ -259,7 +259,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "1"}},
       {"case.density_kg_m3", {"the fluid's density"}},
       {"case.viscosity_pa_s", {"the fluid's dynamic viscosity"}},
-      {"case.iterations", {"simpleFoam's iteration cap"}},
+      {"case.iterations",
+       {"simpleFoam's iteration cap; a solve whose residual of U or p climbs past 10 times the least it reached (or its "
+        "target) is stopped sooner, its fields written there, and the run exits 3 (cases/case_runner.hpp)"}},
       {"case.residual_p", {"simpleFoam's convergence target for p", "1", kWhyResiduals}},
       {"case.residual_u",
        {"the same for U; its own default on cells with prism layers, where U's residual stalls near 3e-3 while dp/L "
