@@ -93,7 +93,7 @@ struct Divergence {
 // and in 2 to 16, periodic sections, a random array; docs/findings.md 2026-12-06) neither residual
 // ever rose past 1.3 times its least; the one that diverged slowly (a = 14, N = 1e4, 4 pieces)
 // rose 156 (p) and 235 (U) times with no floating-point exception in 70 iterations, and would
-// have run on to case.iterations (some 10 hours there).
+// have run on to case.iterations (some 11 hours there).
 inline constexpr double kDivergenceRise = 10.0;
 
 // The first divergence in a simpleFoam log `log` with the targets SIMPLE stops at (residual_u,
