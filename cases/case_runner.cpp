@@ -272,21 +272,35 @@ std::string last_line(const fs::path& path) {
 
 }  // namespace
 
-std::optional<Divergence> find_divergence(std::istream& log, double target_u, double target_p) {
-  struct Least {
-    long step = 0;
-    double residual = std::numeric_limits<double>::infinity();
-  } least_u, least_p;
+std::optional<Divergence> DivergenceWatch::feed(std::istream& log) {
   for (const Iteration& it : read_iterations(log)) {
-    for (auto [field, r, least, target] : {std::tuple{"U", it.res_u, &least_u, target_u},
-                                           std::tuple{"p", it.res_p, &least_p, target_p}}) {
+    if (found_) break;
+    for (auto [field, r, least, target] : {std::tuple{"U", it.res_u, &least_u_, target_u_},
+                                           std::tuple{"p", it.res_p, &least_p_, target_p_}}) {
       if (!(r > 0.0)) continue;  // not solved for in this iteration (yet)
-      if (least->step > 0 && r > kDivergenceRise * std::max(least->residual, target))
-        return Divergence{field, least->step, least->residual, it.step, r};
+      if (least->step > 0 && r > kDivergenceRise * std::max(least->residual, target)) {
+        found_ = Divergence{field, least->step, least->residual, it.step, r};
+        break;
+      }
       if (r < least->residual) *least = {it.step, r};
     }
   }
-  return std::nullopt;
+  return found_;
+}
+
+std::optional<Divergence> DivergenceWatch::follow(const fs::path& path) {
+  std::ifstream log(path, std::ios::binary);
+  if (found_ || !log.seekg(read_)) return found_;
+  const std::string added{std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>()};
+  const std::size_t next = added.rfind("\nTime = ");
+  if (next == std::string::npos) return found_;
+  std::istringstream finished(added.substr(0, next + 1));
+  read_ += static_cast<std::streamoff>(next + 1);
+  return feed(finished);
+}
+
+std::optional<Divergence> find_divergence(std::istream& log, double target_u, double target_p) {
+  return DivergenceWatch(target_u, target_p).feed(log);
 }
 
 std::string missing_openfoam_program(int processors) {
@@ -316,7 +330,8 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
   const double target_p = c.params.residual_p, target_u = c.params.residual_u.value();
   double start_p = 0.0, start_u = 0.0;
-  long watched = 0;  // the last iteration find_divergence has seen
+  DivergenceWatch watch(target_u, target_p);
+  long watched = 0;  // the last iteration the watch was given
   std::optional<Divergence> diverging;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");
@@ -326,8 +341,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
     }
     if (!diverging && now.step > watched) {
       watched = now.step;
-      std::ifstream log(case_dir / "log.simpleFoam");
-      if ((diverging = find_divergence(log, target_u, target_p))) stop_at_write_now(case_dir);
+      if ((diverging = watch.follow(case_dir / "log.simpleFoam"))) stop_at_write_now(case_dir);
     }
     if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
     const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),

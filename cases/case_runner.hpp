@@ -1,6 +1,8 @@
 #pragma once
 #include <nlohmann/json.hpp>
+#include <filesystem>
 #include <istream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,14 +98,37 @@ struct Divergence {
 // have run on to case.iterations (some 11 hours there).
 inline constexpr double kDivergenceRise = 10.0;
 
-// The first divergence in a simpleFoam log `log` with the targets SIMPLE stops at (residual_u,
-// residual_p); std::nullopt when there is none.
+// Watches a simpleFoam log for a divergence, with the targets SIMPLE stops at (residual_u,
+// residual_p): each iteration is read once, so that watching a run of many iterations stays linear
+// in its log.
+class DivergenceWatch {
+ public:
+  DivergenceWatch(double target_u, double target_p) : target_u_(target_u), target_p_(target_p) {}
+  // The first divergence among the iterations of `log` (text continuing what was fed before,
+  // whole iterations); std::nullopt while there is none.
+  std::optional<Divergence> feed(std::istream& log);
+  // The same for the log file `path` being written: reads what was added since the last call, up
+  // to its last "Time = " line (the iterations before it are finished).
+  std::optional<Divergence> follow(const std::filesystem::path& path);
+
+ private:
+  struct Least {
+    long step = 0;
+    double residual = std::numeric_limits<double>::infinity();
+  };
+  double target_u_, target_p_;
+  Least least_u_, least_p_;
+  std::optional<Divergence> found_;
+  std::streamoff read_ = 0;  // of the file follow() reads: the bytes fed
+};
+
+// The first divergence in the whole simpleFoam log `log` (DivergenceWatch::feed).
 std::optional<Divergence> find_divergence(std::istream& log, double target_u, double target_p);
 
 // Runs `case.directory/Allrun` (OpenFOAM on PATH, WM_PROJECT_DIR defaulting to Debian's) and
 // reads back the solver's convergence and the pressure drop, compared with Eisfeld &
 // Schnitzlein at the section's own void fraction. Shows the solver's iteration on `progress`
-// while it runs, and watches it for a divergence (find_divergence): the run is then stopped at
+// while it runs, and watches it for a divergence (DivergenceWatch): the run is then stopped at
 // that iteration with its fields written (controlDict's stopAt set to writeNow, which OpenFOAM
 // reads while it runs) and ConvergenceError says where, rather than the solve running on to
 // case.iterations. ConvergenceError also when the solver stopped on a floating-point exception,

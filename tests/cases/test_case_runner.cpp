@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -21,6 +23,37 @@ using namespace bedforge;
 
 namespace {
 
+// One iteration of a simpleFoam log, `step`, with these initial residuals (U's three components
+// alike; p solved twice, the second time a tenth of the first, as with a non-orthogonal corrector).
+std::string iteration_text(std::size_t step, double u, double p) {
+  auto number = [](double x) {
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  };
+  std::string text = "Time = " + std::to_string(step) + "\n\n";
+  for (const char* c : {"x", "y", "z"})
+    text += std::string("smoothSolver:  Solving for U") + c + ", Initial residual = " + number(u) +
+            ", Final residual = 1e-06, No Iterations 2\n";
+  text += "GAMG:  Solving for p, Initial residual = " + number(p) + ", Final residual = 1e-07, No Iterations 3\n";
+  text += "GAMG:  Solving for p, Initial residual = " + number(p / 10) + ", Final residual = 1e-08, No Iterations 2\n";
+  return text + "ExecutionTime = " + std::to_string(step) + " s  ClockTime = " + std::to_string(step) + " s\n\n";
+}
+
+// A simpleFoam log whose iterations 1, 2, ... have these initial residuals of U and p.
+std::string solver_log(const std::vector<std::pair<double, double>>& u_and_p) {
+  std::string log = "Starting time loop\n\n";
+  for (std::size_t k = 0; k < u_and_p.size(); ++k) log += iteration_text(k + 1, u_and_p[k].first, u_and_p[k].second);
+  return log;
+}
+
+std::optional<cases::Divergence> divergence_in(const std::vector<std::pair<double, double>>& u_and_p) {
+  std::istringstream log(solver_log(u_and_p));
+  return cases::find_divergence(log, 1e-4, 1e-4);
+}
+
+const std::string kIterations = solver_log({{1, 1}, {0.5, 0.4}});
+
 // A case directory whose Allrun writes `solver_log` to log.simpleFoam and fails as
 // OpenFOAM's Allrun does when a step fails.
 cases::CaseInfo failing_case(const std::string& name, const std::string& solver_log) {
@@ -35,12 +68,6 @@ cases::CaseInfo failing_case(const std::string& name, const std::string& solver_
   c.params.residual_u = 1e-4;
   return c;
 }
-
-const std::string kIterations =
-    "Time = 1\n\nsmoothSolver:  Solving for Ux, Initial residual = 1, Final residual = 0.01, No Iterations 2\n"
-    "GAMG:  Solving for p, Initial residual = 1, Final residual = 0.01, No Iterations 3\nExecutionTime = 1 s\n\n"
-    "Time = 2\n\nsmoothSolver:  Solving for Ux, Initial residual = 0.5, Final residual = 0.01, No Iterations 2\n"
-    "GAMG:  Solving for p, Initial residual = 0.4, Final residual = 0.01, No Iterations 3\nExecutionTime = 2 s\n\n";
 
 }  // namespace
 
@@ -71,37 +98,6 @@ TEST(CaseRunner, AnotherFailedStepIsNamedWithAllrunsLastWords) {
   }
 }
 
-namespace {
-
-// A simpleFoam log whose iterations have these initial residuals (U's three components alike;
-// p solved twice an iteration, the second time a tenth of the first, as with a non-orthogonal
-// corrector).
-std::string solver_log(const std::vector<std::pair<double, double>>& u_and_p) {
-  auto number = [](double x) {
-    std::ostringstream s;
-    s << x;
-    return s.str();
-  };
-  std::string log = "Starting time loop\n\n";
-  for (std::size_t k = 0; k < u_and_p.size(); ++k) {
-    const auto [u, p] = u_and_p[k];
-    log += "Time = " + std::to_string(k + 1) + "\n\n";
-    for (const char* c : {"x", "y", "z"})
-      log += std::string("smoothSolver:  Solving for U") + c + ", Initial residual = " + number(u) +
-             ", Final residual = 1e-06, No Iterations 2\n";
-    log += "GAMG:  Solving for p, Initial residual = " + number(p) + ", Final residual = 1e-07, No Iterations 3\n";
-    log += "GAMG:  Solving for p, Initial residual = " + number(p / 10) + ", Final residual = 1e-08, No Iterations 2\n";
-    log += "ExecutionTime = " + std::to_string(k + 1) + " s  ClockTime = " + std::to_string(k + 1) + " s\n\n";
-  }
-  return log;
-}
-
-std::optional<cases::Divergence> divergence_in(const std::vector<std::pair<double, double>>& u_and_p) {
-  std::istringstream log(solver_log(u_and_p));
-  return cases::find_divergence(log, 1e-4, 1e-4);
-}
-
-}  // namespace
 
 // The bound kDivergenceRise is 10; a converging solve's residuals rose at most 1.3 times their
 // least (56 solves, cases/case_runner.hpp), so such bumps must pass and a rise past 10 must not.
@@ -141,19 +137,49 @@ TEST(FindDivergence, ARiseThatStaysBelowTenTimesTheTargetIsNoise) {
   EXPECT_EQ(d->step, 6);
 }
 
-// The runner's part: a stand-in Allrun writes a diverging log iteration by iteration (0.1 s each)
-// and, like simpleFoam, ends after writing its fields once the controlDict says stopAt writeNow;
-// it gives up after 100 iterations, so a runner that never stops it fails here instead of hanging.
+// A log read while it is written: an iteration cut off at the end of the file is left for the
+// next look, and each is read once, so that reading the log in parts finds what reading it whole
+// does (ASolveThatTurnsBack...'s log, divergent at iteration 7).
+TEST(DivergenceWatch, FollowingALogAsItGrowsFindsWhatTheWholeLogShows) {
+  const std::string whole = solver_log({{1, 1}, {0.1, 0.01}, {0.01, 0.003}, {0.0025, 0.001}, {0.005, 0.002},
+                                        {0.02, 0.004}, {0.03, 0.006}, {0.1, 0.02}});
+  const fs::path dir = test_support::fresh_dir("following"), path = dir / "log.simpleFoam";
+  fs::create_directories(dir);
+  cases::DivergenceWatch watch(1e-4, 1e-4);
+  EXPECT_FALSE(watch.follow(path));  // no log yet
+  // Up to the middle of iteration 7's U line: its residual 0.03 is not read yet.
+  const std::size_t cut = whole.find("Initial residual = 0.03");
+  std::ofstream(path) << whole.substr(0, cut);
+  EXPECT_FALSE(watch.follow(path));
+  EXPECT_FALSE(watch.follow(path));  // nothing added: nothing new
+  // The rest of iteration 7: finished only when iteration 8 begins.
+  const std::size_t eighth = whole.find("Time = 8");
+  std::ofstream(path, std::ios::app) << whole.substr(cut, eighth - cut);
+  EXPECT_FALSE(watch.follow(path));
+  std::ofstream(path, std::ios::app) << whole.substr(eighth);
+  const auto d = watch.follow(path);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->least_step, 4);
+  EXPECT_EQ(d->step, 7);
+  EXPECT_DOUBLE_EQ(d->residual, 0.03);
+}
+
+// The runner's part: a stand-in Allrun appends a diverging log iteration by iteration (0.1 s each;
+// U and p at 1e-3 to iteration 5, then 1.5 times more each) and, like simpleFoam, ends after
+// writing its fields once the controlDict says stopAt writeNow; it gives up after 100 iterations,
+// so a runner that never stops it fails here instead of hanging.
 TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
   const fs::path dir = test_support::fresh_dir("diverging");
   fs::create_directories(dir / "system");
+  fs::create_directories(dir / "iterations");
+  for (int i = 1; i <= 100; ++i) {
+    const double r = 1e-3 * std::pow(1.5, std::max(0, i - 5));
+    std::ofstream(dir / "iterations" / std::to_string(i)) << iteration_text(i, r, r);
+  }
   std::ofstream(dir / "system/controlDict") << "application     simpleFoam;\nstopAt          endTime;\nendTime         3000;\n";
   std::ofstream(dir / "Allrun")
-      << "#!/bin/sh\ncd \"$(dirname \"$0\")\"\nr=0.001\nfor i in $(seq 1 100); do\n"
-         "  if [ $i -gt 5 ]; then r=$(awk \"BEGIN{print $r*1.5}\"); fi\n"
-         "  printf 'Time = %d\\n\\nsmoothSolver:  Solving for Ux, Initial residual = %s, Final residual = 1e-06, No "
-         "Iterations 2\\nGAMG:  Solving for p, Initial residual = %s, Final residual = 1e-07, No Iterations 3\\n"
-         "ExecutionTime = %d s\\n\\n' $i $r $r $i >> log.simpleFoam\n"
+      << "#!/bin/sh\ncd \"$(dirname \"$0\")\"\nfor i in $(seq 1 100); do\n"
+         "  cat iterations/$i >> log.simpleFoam\n"
          "  if grep -q '^stopAt *writeNow;' system/controlDict; then mkdir $i; echo End >> log.simpleFoam; exit 0; fi\n"
          "  sleep 0.1\ndone\nexit 0\n";
   fs::permissions(dir / "Allrun", fs::perms::owner_all);
@@ -178,7 +204,7 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
     // not at the script's hundredth, and said at which, where its fields are.
     long stopped = 0;
     for (const auto& entry : fs::directory_iterator(dir))
-      if (entry.is_directory() && entry.path().filename() != "system") stopped = std::stol(entry.path().filename());
+      if (entry.is_directory() && entry.path().filename() != "system" && entry.path().filename() != "iterations") stopped = std::stol(entry.path().filename());
     EXPECT_GT(stopped, 10);
     EXPECT_LT(stopped, 40);
     EXPECT_NE(what.find("stopped at iteration " + std::to_string(stopped)), std::string::npos) << what;
