@@ -877,12 +877,23 @@ def bed_1e4_tetrahedra_scene(count, solve, spheres=10000):
                   "bed_1e4_tetrahedra_scene")
 
 
+class Diverged(RuntimeError):
+    """A run bedforge stopped because its solve diverged (exit 3, "simpleFoam diverging"): a result, not a failure
+    of the tool; `message` is bedforge's, `wall_s` the run's time until it stopped."""
+    def __init__(self, message, wall_s):
+        super().__init__(message)
+        self.message, self.wall_s = message, wall_s
+
+
 def timed_run(path, text, env):
-    """`bedforge run` of the scene `text` (written to path.toml) into `path`: its wall time (s)."""
+    """`bedforge run` of the scene `text` (written to path.toml) into `path`: its wall time (s). Diverged when
+    bedforge stopped a diverging solve, RuntimeError when it failed otherwise."""
     open(path + ".toml", "w").write(text)
     t0 = time.time()
     out = subprocess.run([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"], capture_output=True,
                          text=True, env=env)
+    if out.returncode == 3 and "simpleFoam diverging" in out.stderr:
+        raise Diverged(out.stderr.strip(), time.time() - t0)
     if out.returncode != 0:
         raise RuntimeError(f"bedforge run {path}.toml failed:\n{out.stdout}\n{out.stderr}")
     return time.time() - t0
@@ -931,11 +942,20 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
     for p in ([0] if one_run else []) + ranks:
         # P = 1 takes the one-piece run's case when there is one, not a second run of it.
         path = os.path.join(tmp, f"pieces_{treatment}_{spheres}_{0 if p == 1 and one_run else p}")
-        wall = 0.0 if p == 1 and one_run else timed_run(path, make_scene(p if p > 1 else 0, p in solved, spheres), env)
-        rep = json.load(open(os.path.join(path, "report.json")))
-        case = rep["stages"]["case"]
-        row = {"pieces": p, "spheres": spheres, "treatment": treatment, **mesh, "wall_s": wall, "cells": case["cells"], "stages_s": stage_times(rep),
-               "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
+        try:
+            wall = 0.0 if p == 1 and one_run else timed_run(path, make_scene(p if p > 1 else 0, p in solved, spheres), env)
+            rep = json.load(open(os.path.join(path, "report.json")))
+            case = rep["stages"]["case"]
+            row = {"pieces": p, "spheres": spheres, "treatment": treatment, **mesh, "wall_s": wall, "cells": case["cells"],
+                   "stages_s": stage_times(rep),
+                   "stage_peak_mb": {k: v["peak_memory_mb"] for k, v in rep["stages"].items() if "peak_memory_mb" in v}}
+        except Diverged as e:
+            if p == 0:  # the row the others are held against
+                raise
+            # The run wrote no report; the ranks' pieces and Allrun's checkMesh are there.
+            case = {}
+            row = {"pieces": p, "spheres": spheres, "treatment": treatment, **mesh, "wall_s": e.wall_s,
+                   "diverged": e.message}
         if "flow" in case and not (p == 1 and one_run):  # P = 1 shares the one-piece run's case and solve
             row["dp_pa_m"] = case["flow"]["pressure_gradient_bed_pa_m"]
             row["solve_s"] = case["flow"]["time_s"]
@@ -951,7 +971,8 @@ def pieces(tmp, ranks, spheres=500, solved=(0, 2), make_scene=pieces_scene, one_
             row["cells"] = sum(r["cells"] for r in row["ranks"])
             if p > 1:  # Allrun's checkMesh when solved, else one run here
                 case_dir = os.path.join(path, "case")
-                log = open(os.path.join(case_dir, "log.checkMesh")).read() if "flow" in case else subprocess.run(
+                allrun_check = os.path.join(case_dir, "log.checkMesh")
+                log = open(allrun_check).read() if os.path.exists(allrun_check) else subprocess.run(
                     ["mpirun", "-np", str(p), "checkMesh", "-parallel", "-case", case_dir], capture_output=True, text=True,
                     env=dict(env, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")).stdout
                 row["check_mesh_ok"] = "Mesh OK." in log
@@ -1148,7 +1169,8 @@ def pieces_lines(rows):
             continue
         peak, scaled, times, check = rank_columns(r, fewest)
         solved_here = "dp_pa_m" in r and r["pieces"] > 1  # rows of P = 1 made before it was left out held the one piece's
-        dp = f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if solved_here else ""
+        dp = (f"{r['dp_pa_m']:.4g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.2f} %)" if solved_here else
+              f"diverged: {diverged_where(r)}" if "diverged" in r else "")
         lines.append(f"| {r['pieces']} piece{'s' if r['pieces'] > 1 else ''} | {r['cells']} | {peak} | {scaled} | "
                      f"{times} | {r['wall_s']:.0f} | {check} | {dp} |")
     lines += ["", "Issue 58's targets as far as this bed goes (its own bed, a = 14, N = 1e4 with bridges, has its "
@@ -1260,6 +1282,10 @@ def pieces_1e4_solved_lines(rows):
         if r["pieces"] < 2:
             continue
         _, _, _, check = rank_columns(r, None)
+        if "diverged" in r:
+            lines.append(f"| {r['pieces']} pieces on {r['pieces']} ranks | {r['cells']} | {largest_peak(r):.0f} (a rank) | "
+                         f"| diverged: {diverged_where(r)} | {r['wall_s']:.0f} (stopped) | {check} | |")
+            continue
         lines.append(f"| {r['pieces']} pieces on {r['pieces']} ranks | {r['cells']} | {largest_peak(r):.0f} (a rank) | "
                      f"{r['solver_peak_mb']:.0f} | {r['solve_s']:.0f} | {r['wall_s']:.0f} | {check} | "
                      f"{r['dp_pa_m']:.6g} ({100 * (r['dp_pa_m'] / one['dp_pa_m'] - 1):+.3f} %) |")
@@ -1268,6 +1294,12 @@ def pieces_1e4_solved_lines(rows):
     for p in (4, 2):
         r = next((r for r in rows if r["pieces"] == p), None)
         if r is None:
+            continue
+        if "diverged" in r:
+            lines.append(f"- dp/L on {p} ranks within 0.5 % of the one-piece route's: **not met**, the solve diverged "
+                         f"and bedforge stopped it ({diverged_where(r)}; its fields are written there); the {kind} "
+                         f"differ from one piece's by {r['cells'] - one['cells']:+d} "
+                         f"({100 * (r['cells'] / one['cells'] - 1):+.2f} %).")
             continue
         change = 100 * (r["dp_pa_m"] / one["dp_pa_m"] - 1)
         lines.append(f"- dp/L on {p} ranks within 0.5 % of the one-piece route's: {change:+.3f} %, "
@@ -1280,7 +1312,7 @@ def pieces_1e4_solved_lines(rows):
         lines.append(f"- 4 ranks: the case runs in parallel without decomposePar (checkMesh -parallel: "
                      f"{'OK' if four['check_mesh_ok'] else 'failed'}); checkMesh on the reconstructed mesh: "
                      f"{verdict(four['reconstructed']['mesh_ok'])}.")
-    two = next((r for r in rows if r["pieces"] == 2), None)
+    two = next((r for r in rows if r["pieces"] == 2 and "diverged" not in r), None)
     if two:
         lines.append(f"- Scene to dp/L on 2 ranks no slower than today's one-piece route: {two['wall_s']:.0f} s against "
                      f"{one['wall_s']:.0f} s, {two['wall_s'] / one['wall_s']:.2f} times, "
@@ -1289,6 +1321,16 @@ def pieces_1e4_solved_lines(rows):
                      "piece, decomposePar).")
     lines.append("")
     return lines
+
+
+def diverged_where(row):
+    """Where a diverged row's solve turned back and stopped, from bedforge's message."""
+    m = re.search(r"initial residual of (\w+) rose from ([\d.e+-]+) at iteration (\d+) to ([\d.e+-]+) at iteration (\d+)"
+                  r".*?stopped at iteration (\d+)", row["diverged"], re.S)
+    if not m:
+        return row["diverged"].splitlines()[0]
+    return (f"{m.group(1)}'s residual from {m.group(2)} (iteration {m.group(3)}) to {m.group(4)} (iteration "
+            f"{m.group(5)}), stopped at iteration {m.group(6)}")
 
 
 def largest_peak(row):
