@@ -25,9 +25,9 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
   const double d = reference_diameter(bed), nan = std::numeric_limits<double>::quiet_NaN();
   // 1. The planes: each at the widest gap between the spheres' ends and the contacts' rims near
   // where it was asked, a height an ASCII STL keeps.
-  const std::vector<double> clear = plane_clear_heights_d(bed, p, true);
-  const double lo = round_to_ascii_stl(widest_interval_middle(clear, p.clip_bottom_d, p.clip_shift_d, nan) * d);
-  const double hi = round_to_ascii_stl(widest_interval_middle(clear, p.clip_top_d, p.clip_shift_d, nan) * d);
+  const ClearHeights clear = plane_clear_heights_d(bed, p, true);
+  const double lo = round_to_ascii_stl(widest_interval_middle(clear, p.clip_bottom_d, p.clip_shift_d, nan, p.clip_clearance_d) * d);
+  const double hi = round_to_ascii_stl(widest_interval_middle(clear, p.clip_top_d, p.clip_shift_d, nan, p.clip_clearance_d) * d);
   if (!(hi > lo))
     throw InputError(fmt::format("surface.clip_window_d = [{}, {}]: its planes, moved clear of the spheres' ends and "
                                  "contacts, leave no window ({:.4g} to {:.4g} d); allowed: a taller window",

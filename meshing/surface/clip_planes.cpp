@@ -166,24 +166,41 @@ CutWindow spheres_between(const Bed& bed, const SurfaceParams& p, double lo, dou
   return out;
 }
 
-std::vector<double> plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts) {
+ClearHeights plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts) {
   const double d = reference_diameter(bed);
-  std::vector<double> ends;
-  for (std::size_t i = 0; i < bed.size(); ++i)
-    for (double r : {0.5 * bed.diameters[i], 0.5 * p.shrink_factor * bed.diameters[i]})
-      ends.push_back((bed.centres[i].z() - r) / d), ends.push_back((bed.centres[i].z() + r) / d);
+  // The spheres' surface is at the shrunk radius where shrink treats them all.
+  const bool shrunk_all = p.treatment == SurfaceParams::Treatment::shrink;
+  ClearHeights h;
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const double z = bed.centres[i].z(), r = 0.5 * bed.diameters[i], shrunk = p.shrink_factor * r;
+    const double surface = shrunk_all ? shrunk : r;
+    h.sphere_ends.insert(h.sphere_ends.end(), {(z - surface) / d, (z + surface) / d});
+    h.all.insert(h.all.end(), {(z - r) / d, (z + r) / d, (z - shrunk) / d, (z + shrunk) / d});
+  }
   if (through_contacts)
-    for (double z : treated_heights(bed, p)) ends.push_back(z / d);
-  std::sort(ends.begin(), ends.end());
-  return ends;
+    for (double z : treated_heights(bed, p)) h.all.push_back(z / d);
+  std::sort(h.all.begin(), h.all.end());
+  std::sort(h.sphere_ends.begin(), h.sphere_ends.end());
+  return h;
 }
 
-double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid) {
+double widest_interval_middle(const ClearHeights& heights, double asked, double shift, double avoid, double clearance) {
+  const std::vector<double>& all = heights.all;
+  // The distance from z to the nearest sphere end.
+  const auto to_ends = [&](double z) {
+    const auto above = std::lower_bound(heights.sphere_ends.begin(), heights.sphere_ends.end(), z);
+    double nearest = std::numeric_limits<double>::infinity();
+    if (above != heights.sphere_ends.end()) nearest = *above - z;
+    if (above != heights.sphere_ends.begin()) nearest = std::min(nearest, z - *std::prev(above));
+    return nearest;
+  };
   double best = asked, widest = -1.0;
-  for (std::size_t j = 0; j + 1 < ends.size(); ++j) {
-    const double mid = 0.5 * (ends[j] + ends[j + 1]);
-    if (ends[j] <= avoid && avoid <= ends[j + 1]) continue;
-    if (std::abs(mid - asked) <= shift && ends[j + 1] - ends[j] > widest) best = mid, widest = ends[j + 1] - ends[j];
+  bool best_clear = false;
+  for (std::size_t j = 0; j + 1 < all.size(); ++j) {
+    const double mid = 0.5 * (all[j] + all[j + 1]), width = all[j + 1] - all[j];
+    if ((all[j] <= avoid && avoid <= all[j + 1]) || std::abs(mid - asked) > shift) continue;
+    const bool clear = to_ends(mid) >= clearance;
+    if ((clear && !best_clear) || (clear == best_clear && width > widest)) best = mid, widest = width, best_clear = clear;
   }
   return best;
 }

@@ -89,15 +89,24 @@ std::vector<double> survey_stretches(const Bed& bed, std::size_t spheres);
 std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p,
                                     std::size_t spheres_per_window = kSpheresPerSurveyWindow);
 
-// The heights (d above the floor) a plane between slabs or a clip plane keeps clear of: the
-// spheres' tops and bottoms at their own and their shrunk radius, and, for a plane cut through
-// the treated contacts (`through_contacts`), treated_heights too; sorted.
-std::vector<double> plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts);
-// The middle of the widest interval between successive `ends` (sorted, d) whose middle lies
-// within `shift` of `asked`, leaving out the interval that holds `avoid` (NaN: none); `asked`
-// itself when there is no such interval: where a plane meets the surface at its widest angles,
-// away from the near-tangent cuts that leave slivers.
-double widest_interval_middle(const std::vector<double>& ends, double asked, double shift, double avoid);
+// The heights (d above the floor, sorted) a plane between slabs or a clip plane keeps clear of.
+// `all`: the spheres' tops and bottoms at their own and their shrunk radius, and, for a plane cut
+// through the treated contacts (`through_contacts`), treated_heights too. `sphere_ends`: the
+// tops and bottoms of their surface (at the shrunk radius under shrink, else their own), of which
+// a plane keeps surface.clip_clearance_d where it can, as a periodic section's planes do: a plane nearer a sphere's end leaves a film of fluid between them that the mesh must fill
+// (a = 14, N = 1e4 in 4 pieces: a plane 0.0017 d below a sphere at the wall, over a gap of
+// 0.07 d to the sphere below it, is where that bed's solve turned back, twice; docs/findings.md,
+// 2026-12-06).
+struct ClearHeights {
+  std::vector<double> all, sphere_ends;
+};
+ClearHeights plane_clear_heights_d(const Bed& bed, const SurfaceParams& p, bool through_contacts);
+// The middle of the widest interval between successive `heights.all` whose middle lies within
+// `shift` of `asked` and at least `clearance` from every one of `heights.sphere_ends`, leaving
+// out the interval that holds `avoid` (NaN: none); of all intervals within `shift` where none is
+// that clear of the ends; `asked` itself when there is no interval: where a plane meets the
+// surface at its widest angles, away from the near-tangent cuts that leave slivers.
+double widest_interval_middle(const ClearHeights& heights, double asked, double shift, double avoid, double clearance);
 
 // A window of `bed` whose surface is cut at planes inside it through its treated contacts (a
 // slab's or a piece's, a periodic section's). Its own clip planes must cut no contact, which a

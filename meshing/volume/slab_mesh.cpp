@@ -296,7 +296,7 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
   std::vector<double> below(bins + 1, 0.0);  // cells below each bin's bottom
   std::partial_sum(profile.cells.begin(), profile.cells.end(), below.begin() + 1);
   const double height = (profile.z1 - profile.z0) / bins;
-  const std::vector<double> ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
+  const ClearHeights ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
   for (int k = 1; k < slabs; ++k) {
     // Where the cells below reach k / slabs of them, within its bin by linear interpolation.
     const double target = below.back() * k / slabs;
@@ -304,19 +304,19 @@ std::vector<double> slab_planes_d(const Bed& bed, const SurfaceParams& s, const 
                              0, bins - 1);
     const double share = profile.cells[b] > 0.0 ? (target - below[b]) / profile.cells[b] : 0.0;
     const double asked = (profile.z0 + (b + std::clamp(share, 0.0, 1.0)) * height) / d;
-    planes.push_back(widest_interval_middle(ends, asked, s.clip_shift_d, std::nan("")));
+    planes.push_back(widest_interval_middle(ends, asked, s.clip_shift_d, std::nan(""), s.clip_clearance_d));
   }
   return planes;
 }
 
 std::vector<double> moved_slab_planes_d(const Bed& bed, const SurfaceParams& s, const std::vector<double>& planes,
                                         const std::vector<int>& failed) {
-  const std::vector<double> ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
+  const ClearHeights ends = plane_clear_heights_d(bed, s, !slabs_from_clip_windows(s));
   const auto named = [&](int slab) { return std::find(failed.begin(), failed.end(), slab) != failed.end(); };
   std::vector<double> moved = planes;
   for (int j = 0; j < static_cast<int>(planes.size()); ++j)  // plane j lies between slabs j and j + 1
     if (failed.empty() || named(j) || named(j + 1))
-      moved[j] = widest_interval_middle(ends, planes[j], s.clip_shift_d, planes[j]);
+      moved[j] = widest_interval_middle(ends, planes[j], s.clip_shift_d, planes[j], s.clip_clearance_d);
   return moved;
 }
 
