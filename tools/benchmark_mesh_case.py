@@ -1317,8 +1317,8 @@ def pieces_1e4_solved_lines(rows):
         lines.append(f"- Scene to dp/L on 2 ranks no slower than today's one-piece route: {two['wall_s']:.0f} s against "
                      f"{one['wall_s']:.0f} s, {two['wall_s'] / one['wall_s']:.2f} times, "
                      f"{verdict(two['wall_s'] <= one['wall_s'])} (one run each; simpleFoam "
-                     f"{two['solve_s']:.0f} s against {one['solve_s']:.0f} s, the rest meshing, the dual and, for the one "
-                     "piece, decomposePar).")
+                     f"{two['solve_s']:.0f} s against {one['solve_s']:.0f} s, the rest meshing"
+                     + ("" if tets else ", the dual") + " and, for the one piece, decomposePar).")
     lines.append("")
     return lines
 
