@@ -160,7 +160,7 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"clip window (surface.clip_window_d), bridges, caps and unions: what its planes do to the treated contacts "
         "they cross: `cut` them through as treated (the window's spheres laid out whole and their surface cut at "
         "each plane, as the slabs between pieces are; the planes go to the widest gap between the spheres' ends and "
-        "the contacts' rims within clip_shift_d) or `open` them where they find no height clear of them (their "
+        "the contacts' rims within clip_shift_d that keeps clip_clearance_d from the spheres' ends) or `open` them where they find no height clear of them (their "
         "spheres shrunk by shrink_factor, the contact left a gap; not enlarge). `cut` passed the surface and mesh "
         "gates on 7 windows of the default scene's bed where `open` failed 4 (docs/findings.md, 2026-12-04)",
         "", kWhyContacts}},
@@ -202,7 +202,11 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
         "bridge, cap or union; where no such height exists, the contacts the plane cuts are opened instead (their "
         "spheres shrink by `contacts.shrink_factor`; not with enlarge); the planes used and the contacts opened are "
         "in the report"}},
-      {"surface.clip_clearance_d", {"the clearance a clip plane keeps"}},
+      {"surface.clip_clearance_d",
+       {"the clearance a clip plane keeps; the planes between slabs and pieces, and a clip window's cut through "
+        "contacts, keep it from every sphere's top and bottom (at its treated radius) where a height within "
+        "clip_shift_d does: a = 14, N = 1e4 in 4 pieces diverged twice beside a plane 0.0017 d below a sphere's end "
+        "and converged with its planes 0.005 d or more from them (docs/findings.md, 2026-12-06)"}},
       {"surface.min_angle_deg",
        {"quality gate: a surface with a smaller triangle angle fails, naming the particles nearby and writing the "
         "triangles to `bad_triangles.vtp` (0 turns it off)"}},
