@@ -331,7 +331,6 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const double target_p = c.params.residual_p, target_u = c.params.residual_u.value();
   double start_p = 0.0, start_u = 0.0;
   DivergenceWatch watch(target_u, target_p);
-  long watched = 0;  // the last iteration the watch was given
   std::optional<Divergence> diverging;
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");
@@ -339,10 +338,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
       progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
       continue;
     }
-    if (!diverging && now.step > watched) {
-      watched = now.step;
-      if ((diverging = watch.follow(case_dir / "log.simpleFoam"))) stop_at_write_now(case_dir);
-    }
+    if (!diverging && (diverging = watch.follow(case_dir / "log.simpleFoam"))) stop_at_write_now(case_dir);
     if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
     const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),
                                  std::log(start_u / now.res_u) / std::log(start_u / target_u));

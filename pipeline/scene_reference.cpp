@@ -160,9 +160,10 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"clip window (surface.clip_window_d), bridges, caps and unions: what its planes do to the treated contacts "
         "they cross: `cut` them through as treated (the window's spheres laid out whole and their surface cut at "
         "each plane, as the slabs between pieces are; the planes go to the widest gap between the spheres' ends and "
-        "the contacts' rims within clip_shift_d that keeps clip_clearance_d from the spheres' ends) or `open` them where they find no height clear of them (their "
-        "spheres shrunk by shrink_factor, the contact left a gap; not enlarge). `cut` passed the surface and mesh "
-        "gates on 7 windows of the default scene's bed where `open` failed 4 (docs/findings.md, 2026-12-04)",
+        "the contacts' rims within clip_shift_d that keeps clip_clearance_d from the spheres' ends) or `open` them "
+        "where they find no height clear of them (their spheres shrunk by shrink_factor, the contact left a gap; not "
+        "enlarge). `cut` passed the surface and mesh gates on 7 windows of the default scene's bed where `open` "
+        "failed 4 (docs/findings.md, 2026-12-04)",
         "", kWhyContacts}},
       {"contacts.shrink_factor", {"shrink: sphere scale", "1"}},
       {"contacts.enlarge_factor", {"enlarge: sphere scale", "1"}},

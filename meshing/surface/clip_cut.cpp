@@ -26,8 +26,10 @@ FluidSurface build_cut_clip_surface(const Bed& bed, const SurfaceParams& p) {
   // 1. The planes: each at the widest gap between the spheres' ends and the contacts' rims near
   // where it was asked, a height an ASCII STL keeps.
   const ClearHeights clear = plane_clear_heights_d(bed, p, true);
-  const double lo = round_to_ascii_stl(widest_interval_middle(clear, p.clip_bottom_d, p.clip_shift_d, nan, p.clip_clearance_d) * d);
-  const double hi = round_to_ascii_stl(widest_interval_middle(clear, p.clip_top_d, p.clip_shift_d, nan, p.clip_clearance_d) * d);
+  auto placed = [&](double asked_d) {
+    return round_to_ascii_stl(widest_interval_middle(clear, asked_d, p.clip_shift_d, nan, p.clip_clearance_d) * d);
+  };
+  const double lo = placed(p.clip_bottom_d), hi = placed(p.clip_top_d);
   if (!(hi > lo))
     throw InputError(fmt::format("surface.clip_window_d = [{}, {}]: its planes, moved clear of the spheres' ends and "
                                  "contacts, leave no window ({:.4g} to {:.4g} d); allowed: a taller window",

@@ -93,10 +93,10 @@ std::vector<double> treated_heights(const Bed& bed, const SurfaceParams& p,
 // `all`: the spheres' tops and bottoms at their own and their shrunk radius, and, for a plane cut
 // through the treated contacts (`through_contacts`), treated_heights too. `sphere_ends`: the
 // tops and bottoms of their surface (at the shrunk radius under shrink, else their own), of which
-// a plane keeps surface.clip_clearance_d where it can, as a periodic section's planes do: a plane nearer a sphere's end leaves a film of fluid between them that the mesh must fill
-// (a = 14, N = 1e4 in 4 pieces: a plane 0.0017 d below a sphere at the wall, over a gap of
-// 0.07 d to the sphere below it, is where that bed's solve turned back, twice; docs/findings.md,
-// 2026-12-06).
+// a plane keeps surface.clip_clearance_d where it can, as a periodic section's planes do: a plane
+// nearer a sphere's end leaves a film of fluid between them that the mesh must fill (a = 14,
+// N = 1e4 in 4 pieces: a plane 0.0017 d below a sphere at the wall, over a gap of 0.07 d to the
+// sphere below it, is where that bed's solve turned back, twice; docs/findings.md, 2026-12-06).
 struct ClearHeights {
   std::vector<double> all, sphere_ends;
 };

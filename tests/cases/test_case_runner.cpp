@@ -98,7 +98,6 @@ TEST(CaseRunner, AnotherFailedStepIsNamedWithAllrunsLastWords) {
   }
 }
 
-
 // The bound kDivergenceRise is 10; a converging solve's residuals rose at most 1.3 times their
 // least (56 solves, cases/case_runner.hpp), so such bumps must pass and a rise past 10 must not.
 TEST(FindDivergence, AConvergingSolveWithBumpsOfOnePointThreeTimesItsLeastIsNoDivergence) {
@@ -204,7 +203,8 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
     // not at the script's hundredth, and said at which, where its fields are.
     long stopped = 0;
     for (const auto& entry : fs::directory_iterator(dir))
-      if (entry.is_directory() && entry.path().filename() != "system" && entry.path().filename() != "iterations") stopped = std::stol(entry.path().filename());
+      if (entry.is_directory() && entry.path().filename() != "system" && entry.path().filename() != "iterations")
+        stopped = std::stol(entry.path().filename());
     EXPECT_GT(stopped, 10);
     EXPECT_LT(stopped, 40);
     EXPECT_NE(what.find("stopped at iteration " + std::to_string(stopped)), std::string::npos) << what;

@@ -11,8 +11,8 @@ namespace {
 
 // Spheres' ends at 0, 0.0034 and 0.03 d, treated contacts' rims between them: the widest interval
 // (0.0034-0.012, middle 0.0077) lies 0.0043 d from an end; the intervals between the rims from
-// 0.012 to 0.0243 are narrower (0.0015 to 0.0025) but keep more than 0.005 d from every end, as the plane
-// that replaced issue 58's 0.0017 d from a sphere's end did (docs/findings.md, 2026-12-06).
+// 0.012 to 0.0243 are narrower (0.0015 to 0.0025) but keep more than 0.005 d from every end, as
+// the plane that replaced issue 58's 0.0017 d from a sphere's end did (docs/findings.md, 2026-12-06).
 ClearHeights heights() {
   ClearHeights h;
   h.sphere_ends = {0.0, 0.0034, 0.03};
