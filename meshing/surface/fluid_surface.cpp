@@ -69,6 +69,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
+  p.sphere_volume = s.choice("sphere_facets", "inscribed", {"inscribed", "volume"}) == "volume";
   p.cells_per_gap = s.number("cells_per_gap", kSceneCellsPerGap, Range::closed(0.0, 20.0));
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
@@ -109,6 +110,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"edge_length_d", p.edge_length_d},
           {"contact_edge_length_d", p.contact_edge_length_d},
           {"growth", p.growth},
+          {"sphere_facets", p.sphere_volume ? "volume" : "inscribed"},
           {"cells_per_gap", p.cells_per_gap},
           {"inlet_length_d", p.inlet_length_d},
           {"outlet_length_d", p.outlet_length_d},
@@ -505,7 +507,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // while this one meshes the container, whose wall is one large piece.
   const std::size_t n = bed.size();
   std::vector<TriangleMesh> spheres(n);
-  std::vector<double> chordal(n, 0.0);
+  std::vector<double> chordal(n, 0.0), pushed(n, 0.0);
   std::vector<std::string> failure(n);
   std::future<void> spheres_meshed = std::async(std::launch::async, [&] {
 #pragma omp parallel for schedule(dynamic, 16)
@@ -515,6 +517,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
         spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
                                  field(static_cast<int>(i)));
         chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
+        if (p.sphere_volume) pushed[i] = match_sphere_volume(spheres[i], bed.centres[i], tb.radius[i], tb.cuts[i]);
       } catch (const CutConflict& e) {
         failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
                                  "another treatment",
@@ -684,7 +687,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       cut_planes.emplace_back(cut.axis, h);
     }
     add_solid(spheres[i]);
-    piece(Shape::sphere, bed.centres[i], tb.radius[i], std::move(cut_planes));
+    piece(Shape::sphere, bed.centres[i], tb.radius[i] + pushed[i], std::move(cut_planes));
   }
   for (auto& m : tb.parts) {  // cap disks (ring_mesh) or bridges, which the test finds not flat and takes whole
     add_solid(m);
@@ -710,6 +713,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
       -out.report["solid_volume_change_m3"].get<double>() / (c.cross_section_area() * section);
   out.report["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
   out.report["wall_sagitta_d"] = wall_sag / d;
+  out.report["sphere_vertices_moved_out_d"] = (n > 0 ? *std::max_element(pushed.begin(), pushed.end()) : 0.0) / d;
   out.report["wall_edge_d"] = wall_edge / d;
   out.report["wall_delaunay"] = {{"missing_before", splits.missing_before},
                                  {"missing_after", splits.missing_after},

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <numbers>
 #include <numeric>
+#include <set>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -366,6 +367,31 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   m.patches = {patch};
   orient_by(m, [&](const Eigen::Vector3d& q) { return outward ? Eigen::Vector3d(q - c) : Eigen::Vector3d(c - q); });
   return m;
+}
+
+double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts) {
+  std::set<std::array<double, 3>> on_loops;
+  for (const SphereCut& cut : cuts)
+    for (const Eigen::Vector3d& q : cut.loop) on_loops.insert({q.x(), q.y(), q.z()});
+  // Per vertex: the area of its triangles, and their area times their mean depth inside the sphere.
+  std::vector<double> area(m.points.size(), 0.0), deficit(m.points.size(), 0.0);
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d &a = m.points[t[0]], &b = m.points[t[1]], &q = m.points[t[2]];
+    const double A = 0.5 * (b - a).cross(q - a).norm();
+    const double depth = ((b - a).squaredNorm() + (q - b).squaredNorm() + (a - q).squaredNorm()) / (24.0 * r);
+    for (int v : t) area[v] += A, deficit[v] += A * depth;
+  }
+  double largest = 0.0;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    Eigen::Vector3d& x = m.points[v];
+    if (!(area[v] > 0.0) || on_loops.count({x.x(), x.y(), x.z()})) continue;
+    const double push = deficit[v] / area[v];
+    const Eigen::Vector3d moved = c + (x - c) * ((r + push) / (x - c).norm());
+    if (std::any_of(cuts.begin(), cuts.end(), [&](const SphereCut& cut) { return cut.removed(moved); })) continue;
+    x = moved;
+    largest = std::max(largest, push);
+  }
+  return largest;
 }
 
 double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double r) {

@@ -83,6 +83,15 @@ struct CutConflict : std::runtime_error {
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
                          double growth, bool outward, const std::string& patch, const SpacingField& field = {});
 
+// Moves the vertices of a sphere's mesh `m` (centre c, radius r, cut along `cuts`' loops; m)
+// outward along their radius so that its facets hold the sphere's volume, not the inscribed
+// polyhedron's: a flat triangle with edges a, b, c on a sphere of radius r lies on average
+// (a^2 + b^2 + c^2) / (24 r) inside it, and each vertex moves by the area-weighted mean of that
+// over its triangles, which puts back what they cut off to second order. The loops' vertices stay
+// where they are (other shapes share them), and so does a vertex the move would take into a cut's
+// removed part. Returns the largest move (m), for the ball that holds the mesh.
+double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts);
+
 // Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper
 // bound of the chordal deviation of an inscribed mesh.
 double chordal_deviation(const TriangleMesh& m, const Eigen::Vector3d& c, double r);

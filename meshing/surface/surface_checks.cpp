@@ -90,7 +90,7 @@ Region region_of(const TriangleMesh& m, const SurfacePiece& p) {
   bool kept = true;
   if (p.shape == Shape::sphere) {
     r.radius = p.radius * (1.0 + 1e-9) + rounding;
-    each_vertex([&](const Eigen::Vector3d& v) { kept = kept && std::abs((v - p.centre).norm() - p.radius) <= r.radius - p.radius; });
+    each_vertex([&](const Eigen::Vector3d& v) { kept = kept && (v - p.centre).norm() <= r.radius; });
     for (const auto& [normal, h] : p.cut_planes) {
       r.cut_planes.emplace_back(normal, h + (r.radius - p.radius) + 1e-12 * (p.centre.norm() + far));
       each_vertex([&](const Eigen::Vector3d& v) { kept = kept && normal.dot(v - p.centre) <= r.cut_planes.back().second; });

@@ -17,12 +17,13 @@ inline double from_axis(const Eigen::Vector3d& p, const Eigen::Vector3d& centre,
 
 // A part of a surface meshed on its own: triangles [first, last) of the mesh, and what is known
 // of them by how they were made (lengths in m). The test by pieces checks each shape's premise
-// on the vertices (every vertex on the sphere, the plane or the cylinder, up to 1e-9 of its size
+// on the vertices (every vertex in the sphere's ball, on the plane or the cylinder, up to 1e-9 of its size
 // and the rounding of fluid.stl) and takes a piece that fails it as Shape::other.
 struct SurfacePiece {
   enum class Shape {
     other,     // nothing: tested pair by pair with every face near it, its own included
-    sphere,    // facets of the convex hull of points on the sphere (centre, radius), as sphere_mesh makes them
+    sphere,    // facets of the convex hull of points on the sphere, as sphere_mesh makes them, or those points
+               // moved out along their radius (match_sphere_volume); radius: of the ball that holds them all
     plane,     // a triangulation of a planar region (the plane is fitted to its vertices), as ring_mesh and plane_mesh make
     cylinder,  // a triangulation of the unrolled wall laid on the cylinder (axis through centre along axis, radius), as wall_mesh makes
   };

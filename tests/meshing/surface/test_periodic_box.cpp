@@ -86,9 +86,10 @@ TEST(PeriodicBox, OppositeSidesAreOneTriangulationAndTheSurfaceIsClosed) {
       const auto lower = side(s.fluid, pairs[a][0], a, true), up = side(s.fluid, pairs[a][1], a, false);
       EXPECT_FALSE(lower.empty());
       EXPECT_EQ(lower, up) << "seed " << seed << ", axis " << a;
-      for (std::size_t k = 0; k < s.fluid.triangles.size(); ++k)
-        if (s.fluid.patches[s.fluid.patch[k]] == pairs[a][1])
-          for (int v : s.fluid.triangles[k]) EXPECT_EQ(s.fluid.points[v][a], upper[a]);
+      for (std::size_t k = 0; k < s.fluid.triangles.size(); ++k) {
+        if (s.fluid.patches[s.fluid.patch[k]] != pairs[a][1]) continue;
+        for (int v : s.fluid.triangles[k]) EXPECT_EQ(s.fluid.points[v][a], upper[a]);
+      }
     }
     const double area = 25 * std::numbers::pi, chordal = s.report["chordal_deviation_d"].get<double>();
     EXPECT_GE(check.volume, s.exact_volume_m3 * (1.0 - 1e-12)) << "seed " << seed;

@@ -53,6 +53,57 @@ TEST(Primitives, SphereIsClosedInscribedAndConverges) {
   EXPECT_LT(enclosed_volume(sphere_mesh(c, 1.0, {}, 0.3, 1.3, false, "p")), 0.0);
 }
 
+// Inscribed facets lose O(edge^2) of the volume; moved out by their mean depth the loss is of
+// higher order: it falls faster than the inscribed one as the edge halves, and is far smaller.
+TEST(Primitives, SphereMovedToHoldItsVolumeConvergesFasterThanInscribed) {
+  const Eigen::Vector3d c(0.3, -0.2, 1.0);
+  const double exact = 4.0 / 3.0 * kPi;
+  std::vector<double> inscribed, matched;
+  for (double edge : {0.4, 0.2, 0.1}) {
+    TriangleMesh m = sphere_mesh(c, 1.0, {}, edge, 1.3, true, "particles");
+    inscribed.push_back((exact - enclosed_volume(m)) / exact);
+    const double moved = match_sphere_volume(m, c, 1.0, {});
+    matched.push_back(std::abs(exact - enclosed_volume(m)) / exact);
+    // Star-shaped about the centre still (each triangle faces out): the by-pieces test's premise.
+    for (const auto& t : m.triangles)
+      EXPECT_GT((m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]).dot(m.points[t[0]] - c), 0.0);
+    for (const auto& p : m.points) EXPECT_LE((p - c).norm(), 1.0 + moved + 1e-12);
+    EXPECT_GT(moved, 0.0);
+  }
+  for (std::size_t k = 0; k < matched.size(); ++k) EXPECT_LT(matched[k], 0.1 * inscribed[k]) << k;
+  // Second order: the inscribed loss falls about 4 times per halving; the matched one faster.
+  for (std::size_t k = 1; k < matched.size(); ++k) {
+    EXPECT_GT(inscribed[k - 1] / inscribed[k], 3.0);
+    EXPECT_GT(matched[k - 1] / matched[k], 1.5 * inscribed[k - 1] / inscribed[k]) << k;
+  }
+}
+
+// A cut's loop is shared with the shape beyond it: its vertices stay, bit for bit, and no vertex
+// is moved into the part the cut removes.
+TEST(Primitives, SphereMovedToHoldItsVolumeKeepsItsLoops) {
+  const Eigen::Vector3d c(1.0, 2.0, 3.0);
+  const double r = 0.5;
+  const std::vector<SphereCut> cuts{plane(c, r, Eigen::Vector3d::UnitZ(), 0.49, 0.0125),
+                                    plane(c, r, Eigen::Vector3d(1, 0, 0), 0.2, 0.0125)};
+  TriangleMesh m = sphere_mesh(c, r, cuts, 0.05, 1.3, true, "particles");
+  const TriangleMesh before = m;
+  EXPECT_GT(match_sphere_volume(m, c, r, cuts), 0.0);
+  long loop_vertices = 0, moved = 0;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    bool on_loop = false;
+    for (const SphereCut& cut : cuts)
+      for (const auto& q : cut.loop) on_loop = on_loop || q == before.points[v];
+    if (on_loop) {
+      EXPECT_EQ(m.points[v], before.points[v]);
+      ++loop_vertices;
+    }
+    for (const SphereCut& cut : cuts) EXPECT_TRUE(on_loop || !cut.removed(m.points[v]));
+    moved += m.points[v] != before.points[v];
+  }
+  EXPECT_GT(loop_vertices, 100);
+  EXPECT_GT(moved, static_cast<long>(m.points.size()) / 2);
+}
+
 TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {
   // A sphere cut flat by three planes (a large cap, two small ones 60 degrees apart, as where
   // three spheres touch), each closed by a disk sharing the cut's loop.
