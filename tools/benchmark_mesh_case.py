@@ -61,11 +61,13 @@ verification: the empty tube of scenes/examples/empty_tube_verification.toml (D 
         ratio --verify-ratio); each level's error against the exact value, the order of those
         errors, and the GCI the study would quote without the exact value.
 cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1): one study each with
-        case.cells = "polyhedra" and "tetrahedra" (--cost-levels meshes from --cost-edge d, contact edge a third,
-        --cost-gap-cells per gap): each level's cells and seconds per sphere, its error against the extrapolation
-        with the narrower band, and the issue's targets.
-cost_500: the same on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh and study),
-        with case.cells "polyhedra" and "tetrahedra".
+        case.cells = "polyhedra", "tetrahedra", and tetrahedra with surface.sphere_facets = "volume" (--cost-levels
+        meshes from --cost-edge d, contact edge a third, --cost-gap-cells per gap): each level's cells and seconds
+        per sphere, its error against the extrapolation with the narrowest band, and the issue's targets.
+cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge d (contact edge half of it,
+        some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed.
+cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
+        and study).
 verification_spheres: a column of a simple cubic array of spheres in Stokes flow (Re_p = 0.01) in a square
         box whose slip walls are the array's mirror planes, as scenes/examples/simple_cubic_verification.toml
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
@@ -131,17 +133,19 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_500", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "study_reynolds", "study_treatments",
             "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
             "pieces_1e4_solved", "pieces_1e4_tetrahedra", "weak_scaling_1e4",
             "projection_1e4"]
+# The cost sections' routes: case.cells, surface.sphere_facets.
+COST_ROUTES = [("polyhedra", "inscribed"), ("tetrahedra", "inscribed"), ("tetrahedra", "volume")]
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
 def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000,
-          levels=0, ratio=1.3, cells="polyhedra"):
+          levels=0, ratio=1.3, cells="polyhedra", contact_edge=None, sphere_facets="inscribed"):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -154,8 +158,9 @@ seed = 1
 treatment = "{treatment}"
 [surface]
 edge_length_d = {edge}
-contact_edge_length_d = {edge / 3:.4g}
+contact_edge_length_d = {edge / 3 if contact_edge is None else contact_edge:.4g}
 cells_per_gap = {cells_per_gap}
+sphere_facets = "{sphere_facets}"
 [mesh]
 algorithm = "hxt"
 [mesh.layers]
@@ -339,27 +344,38 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
     yield row
 
 
-def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra"):
-    """One run of the scene with a mesh-convergence study; its levels and verdict."""
-    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}")
-    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells)
+def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra",
+          contact_edge=None, sphere_facets="inscribed"):
+    """One run of the scene with a mesh-convergence study; its levels and verdict. contact_edge:
+    the contact edge (d), else a third of `edge`."""
+    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}_{ratio}_{sphere_facets}")
+    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells,
+                 contact_edge=contact_edge, sphere_facets=sphere_facets)
     open(path + ".toml", "w").write(text)
     return study_record(path, {"a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
-                               "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap})
+                               "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap,
+                               "contact_edge_d": edge / 3 if contact_edge is None else contact_edge,
+                               "sphere_facets": sphere_facets})
 
 
-def default_study(tmp, cells):
-    """scenes/default.toml as it is, its study included, on `cells` ("polyhedra" or "tetrahedra")."""
+def default_study(tmp, cells, sphere_facets):
+    """scenes/default.toml as it is, its study included, on `cells` ("polyhedra" or "tetrahedra")
+    with `sphere_facets` ("inscribed" or "volume")."""
     text, n = re.subn(r'^cells = "\w+"', f'cells = "{cells}"', open(DEFAULT_SCENE).read(), count=1, flags=re.M)
     if n != 1:
         raise SystemExit("scenes/default.toml: no line sets cells; update default_study")
-    path = os.path.join(tmp, f"default_study_{cells}")
+    text = re.sub(r'^sphere_facets = .*\n', "", text, flags=re.M)
+    text, n = re.subn(r'^\[surface\]\n', f'[surface]\nsphere_facets = "{sphere_facets}"\n', text, count=1, flags=re.M)
+    if n != 1:
+        raise SystemExit("scenes/default.toml: no [surface] section; update default_study")
+    path = os.path.join(tmp, f"default_study_{cells}_{sphere_facets}")
     open(path + ".toml", "w").write(text)
     sc = lambda key: float(scene_value(text, key))
     return study_record(path, {"a": sc("diameter_d"), "n": int(sc("count")), "treatment": scene_value(text, "treatment"),
                                "reynolds": sc("reynolds"), "cells": cells, "edge_d": sc("edge_length_d"),
                                "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"),
-                               "contact_edge_d": sc("contact_edge_length_d"), "default_scene": True})
+                               "contact_edge_d": sc("contact_edge_length_d"), "sphere_facets": sphere_facets,
+                               "default_scene": True})
 
 
 def study_record(path, fields):
@@ -1400,6 +1416,11 @@ def study_lines(r):
     return lines
 
 
+def route(r):
+    """A cost run's cells and, where set, its spheres' facets (runs before 2026-12-06 were inscribed)."""
+    return r["cells"] + (", facets holding the spheres' volume" if r.get("sphere_facets") == "volume" else "")
+
+
 def cost_lines(runs):
     """Issue 57's cost curve on one bed: each route's levels as error against the best
     extrapolation, against cells and seconds per sphere; the route whose band is narrowest gives
@@ -1412,8 +1433,9 @@ def cost_lines(runs):
     best = min(usable, key=lambda r: fits(r)[0]["gci_fine"]) if usable else None
     r0 = runs[0]
     n = r0["n"]
-    lines = [f"## Cost per sphere: polyhedra against tetrahedra (a = {r0['a']:g}, N = {n}, {r0['treatment']}, "
-             f"Re_p = {r0['reynolds']:g})", "",
+    routes = [route(r) for r in runs]
+    lines = [f"## Cost per sphere: {', '.join(routes[:-1])} against {routes[-1]} (a = {r0['a']:g}, N = {n}, "
+             f"{r0['treatment']}, Re_p = {r0['reynolds']:g}, from {r0['edge_d']:g} d, ratio {r0['ratio']:g})", "",
              f"Made at commit {r0['commit']} on {r0['date']}: "
              + ("issue 57's bed" if n == 40 else "the README's scene, scenes/default.toml as it is"
                 if r0.get("default_scene") else "the README's bed at the mesh settings scenes/default.toml had until "
@@ -1424,10 +1446,13 @@ def cost_lines(runs):
              # scene() sets a third of the edge; the default scene its own (rows before 2026-12-05: a third).
              + (f"{r0['contact_edge_d']:g} d" if "contact_edge_d" in r0 else "a third")
              + f", {r0['cells_per_gap']:g} cells per gap, on 2 processes; "
-             "`case.cells` the only difference. Seconds per sphere are a level's wall time (surface, mesh, case and "
+             + ("`case.cells` and `surface.sphere_facets` (inscribed: vertices on the spheres; volume: moved out so "
+                "that the facets hold each sphere's volume) the only differences"
+                if any(r.get("sphere_facets") for r in runs) else "`case.cells` the only difference")
+             + ". Seconds per sphere are a level's wall time (surface, mesh, case and "
              "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
-             "with the narrower GCI band"
-             + (f": that of the {best['cells']}, {fits(best)[0]['extrapolated']:.4g} Pa/m (GCI "
+             "with the narrowest GCI band"
+             + (f": that of the {route(best)}, {fits(best)[0]['extrapolated']:.4g} Pa/m (GCI "
                 f"{100 * fits(best)[0]['gci_fine']:.1f} %)." if best else "; no route gave one."), "",
              "| cells | level | cells per sphere | dp/L (Pa/m) | against the reference | s per sphere (2 cores) |",
              "|---|---|---|---|---|---|"]
@@ -1435,28 +1460,30 @@ def cost_lines(runs):
     for r in runs:
         for lv in r["study"]["levels"]:
             if "failure" in lv:
-                lines.append(f"| {r['cells']} | {lv['level']} | failed: {lv['failure']} | | | {lv['time_s'] / n:.1f} |")
+                lines.append(f"| {route(r)} | {lv['level']} | failed: {lv['failure']} | | | {lv['time_s'] / n:.1f} |")
                 continue
             dp = lv["pressure_gradient_bed_pa_m"]
-            lines.append(f"| {r['cells']} | {lv['level']} | {lv['cells'] / n:,.0f} | {dp:.4g} | "
+            lines.append(f"| {route(r)} | {lv['level']} | {lv['cells'] / n:,.0f} | {dp:.4g} | "
                          + (f"{100 * (dp / ref - 1):+.1f} %" if ref else "") + f" | {lv['time_s'] / n:.1f} |")
     lines += ["", "| cells | finest level's GCI | order, finest three | least squares over all: order, extrapolation "
-                  "| extrapolation (Pa/m) | issue 57's targets (GCI <= 5 %, <= 20 k cells per sphere, order 1.5-2.5, "
-                  "the two orders within 0.3) |", "|---|---|---|---|---|---|"]
+                  "| extrapolation (Pa/m) | issue 57's targets (GCI <= 5 %, <= 20 k cells per sphere, order 1.5-2.5 "
+                  "by the finest three and by least squares over all, the two within 0.3) |", "|---|---|---|---|---|---|"]
     for r in runs:
         g, ls = fits(r)
         finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
         if g.get("gci_fine") is None or finest is None:
-            lines.append(f"| {r['cells']} | none: {r['study']['conclusion']} | | | | not met |")
+            lines.append(f"| {route(r)} | none: {r['study']['conclusion']} | | | | not met |")
             continue
         per_sphere = finest["cells"] / n
         gap = abs(ls["order"] - g["apparent_order"]) if ls.get("order") is not None else None
         missed = ([f"GCI {100 * g['gci_fine']:.1f} %"] if g["gci_fine"] > 0.05 else []) + \
                  ([f"{per_sphere / 1000:.1f} k cells per sphere"] if per_sphere > 20000 else []) + \
                  ([f"order {g['apparent_order']:.2f}"] if not 1.5 <= g["apparent_order"] <= 2.5 else []) + \
+                 ([f"least-squares order {ls['order']:.2f}"] if ls.get("order") is not None and
+                  not 1.5 <= ls["order"] <= 2.5 else []) + \
                  ([f"orders {gap:.2f} apart" if gap is not None else "no least-squares fit"]
                   if gap is None or gap > 0.3 else [])
-        lines.append(f"| {r['cells']} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | "
+        lines.append(f"| {route(r)} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | "
                      + (f"{ls['order']:.2f}, {ls['extrapolated']:.4g}" if ls.get("order") is not None else "none")
                      + f" | {g['extrapolated']:.4g} | " + ("met" if not missed else "not met: " + ", ".join(missed)) + " |")
     if not r0.get("default_scene"):
@@ -1472,7 +1499,7 @@ def cost_lines(runs):
         missed = ([f"GCI {100 * gci:.1f} %" if gci is not None else "no GCI"] if gci is None or gci > 0.15 else []) + \
                  ([f"{r['wall_s'] / 60:.1f} min"] if r["wall_s"] > 15 * 60 else []) + \
                  ([f"at most {whole_gb:.1f} GB"] if whole_gb > 12 else [])
-        lines.append(f"- {r['cells']}: GCI " + (f"{100 * gci:.1f} %" if gci is not None else "none")
+        lines.append(f"- {route(r)}: GCI " + (f"{100 * gci:.1f} %" if gci is not None else "none")
                      + f", {r['wall_s'] / 60:.1f} min, at most {whole_gb:.1f} GB (largest process {r['peak_mb']:.0f} MB): "
                      + ("**met**" if not missed else "**not met** (" + ", ".join(missed) + ")") + ".")
     return lines + [""]
@@ -1837,7 +1864,7 @@ def write(results):
         lines.append("")
         for r in results["study_treatments"]:
             lines += study_lines(r)
-    for key in ("cost", "cost_500"):
+    for key in ("cost", "cost_20k", "cost_500"):
         if key in results:
             lines += cost_lines(results[key])
     if "verification" in results:
@@ -1977,6 +2004,9 @@ def main():
     ap.add_argument("--cost-edge", type=float, default=0.07, help="cost: finest surface edge (d)")
     ap.add_argument("--cost-levels", type=int, default=4, help="cost: meshes in all")
     ap.add_argument("--cost-gap-cells", type=float, default=4, help="cost: surface.cells_per_gap on the finest")
+    ap.add_argument("--target-edge", type=float, default=0.0868,
+                    help="cost_20k: finest surface edge (d), contact edge half of it: some 20 k tetrahedra per sphere")
+    ap.add_argument("--target-ratio", type=float, default=1.2, help="cost_20k: cell size ratio between levels")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
     ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
     ap.add_argument("--default-reference-levels", type=int, default=4,
@@ -2049,10 +2079,15 @@ def main():
             write(results)
         if "cost" in args.only:
             results["cost"] = [study(tmp, args.cost_edge, args.cost_levels, args.ratio, args.cost_gap_cells, a=4, n=40,
-                                     cells=cells) for cells in ("polyhedra", "tetrahedra")]
+                                     cells=cells, sphere_facets=facets) for cells, facets in COST_ROUTES]
+            write(results)
+        if "cost_20k" in args.only:
+            results["cost_20k"] = [study(tmp, args.target_edge, args.cost_levels, args.target_ratio, args.cost_gap_cells,
+                                         a=4, n=40, cells="tetrahedra", contact_edge=args.target_edge / 2,
+                                         sphere_facets=facets) for facets in ("inscribed", "volume")]
             write(results)
         if "cost_500" in args.only:
-            results["cost_500"] = [default_study(tmp, cells) for cells in ("polyhedra", "tetrahedra")]
+            results["cost_500"] = [default_study(tmp, cells, facets) for cells, facets in COST_ROUTES]
             write(results)
         # Runs at other Re_p or treatments are kept, so one can be redone alone.
         for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
