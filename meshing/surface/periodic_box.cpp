@@ -558,12 +558,14 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
         }
         TriangleMesh part = sphere_mesh(s.c, s.r, cuts, edge, p.growth, true, "particles", field);
         chordal[i] = std::max(chordal[i], chordal_deviation(part, s.c, s.r));
+        if (p.sphere_volume) match_sphere_volume(part, s.c, s.r, cuts);
         for (auto& x : part.points) x += move;
         parts[i].push_back(std::move(part));
       }
       if (crossed.empty()) {
         parts[i].push_back(sphere_mesh(s.c, s.r, {}, edge, p.growth, true, "particles", field));
         chordal[i] = chordal_deviation(parts[i].back(), s.c, s.r);
+        if (p.sphere_volume) match_sphere_volume(parts[i].back(), s.c, s.r, {});
       }
     } catch (const CutConflict& e) {
       std::string where;

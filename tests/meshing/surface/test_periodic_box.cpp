@@ -97,6 +97,28 @@ TEST(PeriodicBox, OppositeSidesAreOneTriangulationAndTheSurfaceIsClosed) {
   }
 }
 
+// With the spheres' facets holding their volume, the box stays closed and free of
+// self-intersection, its sides one triangulation each (their vertices stay: they are the loops),
+// and its fluid volume is far nearer the exact one than inscribed.
+TEST(PeriodicBox, SpheresHoldingTheirVolumeKeepTheSidesAndTheVolume) {
+  const Bed bed = random_array(25, 3.5, 1);
+  SurfaceParams p = plain();
+  std::array<double, 2> error{};
+  for (bool volume : {false, true}) {
+    p.sphere_volume = volume;
+    const FluidSurface s = build_periodic_box_surface(bed, p);
+    const SurfaceCheck check = check_surface(s.fluid, SelfIntersectionTest::all_pairs);
+    EXPECT_TRUE(check.closed && check.manifold && !check.self_intersecting) << volume;
+    const std::array<std::array<const char*, 2>, 3> pairs{{{"x_min", "x_max"}, {"y_min", "y_max"}, {"inlet", "outlet"}}};
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(side(s.fluid, pairs[a][0], a, true), side(s.fluid, pairs[a][1], a, false)) << a;
+    error[volume] = check.volume / s.exact_volume_m3 - 1.0;
+  }
+  EXPECT_GT(error[0], 0.0);  // inscribed: the spheres' facets inside them, the fluid larger
+  // Measured 2026-12-06: +1.34 % inscribed, +0.059 % holding their volume (0.044 of it): what stays
+  // is beside the loops where the sides cut the spheres, whose vertices stay on them.
+  EXPECT_LT(std::abs(error[1]), 0.1 * error[0]) << error[0] << " -> " << error[1];
+}
+
 // Spheres that touch across a side have no room for the fluid between them: refused with the
 // treatment that parts them; a treatment that would join contacts across a side, and a box
 // periodic on one side only, are refused by key.
