@@ -68,8 +68,9 @@ cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge
         some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed.
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
         and study).
-verification_spheres: a column of a simple cubic array of spheres in Stokes flow (Re_p = 0.01) in a square
-        box whose slip walls are the array's mirror planes, as scenes/examples/simple_cubic_verification.toml
+verification_spheres: on each of the cost sections' routes, a column of a simple cubic array of spheres in
+        Stokes flow (Re_p = 0.01) in a square box whose slip walls are the array's mirror planes, as
+        scenes/examples/simple_cubic_verification.toml
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
         (1982) tabulate: one `bedforge run` each with [case.convergence] (--sphere-levels meshes from
         --sphere-edge d, ratio 1.3); each level's error, the order of the errors, the study's own verdict.
@@ -536,11 +537,11 @@ def study_run(path):
     return {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
 
 
-def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case=""):
+def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case="", surface=""):
     """One column of a simple cubic array at solid fraction phi, `count` spheres of 3 mm at the
     centres of L-long cells in a square box of side L with slip sides, Stokes flow: one
     `bedforge run` with a convergence study (`levels` meshes from `edge` d, ratio 1.3).
-    `container` and `case` add keys to those sections."""
+    `container`, `case` and `surface` add keys to those sections."""
     side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
     path = os.path.join(tmp, name)
     with open(path + ".txt", "w") as f:
@@ -559,7 +560,7 @@ treatment = "none"
 edge_length_d = {edge}
 contact_edge_length_d = {edge / 2}
 cells_per_gap = 4
-[case]
+{surface}[case]
 walls = "slip"
 reynolds = 0.01
 {case}processors = 2
@@ -572,15 +573,18 @@ files = ["case"]
 
 
 def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
-    """Simple cubic columns at each solid fraction: count spheres, the pressure drop over the middle
-    cells_measured, whose planes lie a whole number of cells apart at the same phase."""
+    """Simple cubic columns at each solid fraction, on each of the cost sections' routes: count
+    spheres, the pressure drop over the middle cells_measured, whose planes lie a whole number of
+    cells apart at the same phase."""
     out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
     for phi in fractions:
         side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
         # From the box's bottom and the top sphere's top, both planes at the same phase:
         exclude = ((count - 0.5 - cells_measured) * side + 0.5) / 2.0
-        out["runs"][str(phi)] = cubic_column_run(tmp, f"simple_cubic_{phi}", phi, count, edge, levels,
-                                                 case=f"section_exclude_d = {exclude:.12f}\n")
+        for cells, facets in COST_ROUTES:
+            out["runs"][f"{phi}, {cells}, {facets}"] = cubic_column_run(
+                tmp, f"simple_cubic_{phi}_{cells}_{facets}", phi, count, edge, levels,
+                case=f'section_exclude_d = {exclude:.12f}\ncells = "{cells}"\n', surface=f'sphere_facets = "{facets}"\n')
     return out
 
 
@@ -1885,8 +1889,12 @@ def write(results):
                   f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}. Exact: Zick & "
                   "Homsy (1982, Table 2), drag 6 pi mu a K U per sphere to about 0.1 %: K = 7.442 at solid fraction "
                   "0.216, 28.1 at 0.45 (gaps of 0.05 d between neighbours). Error = dp/L / exact - 1; the order is a "
-                  "least-squares fit of ln |error| against ln h over all levels.", ""]
-        lines += verification_lines(v, "solid fraction", "verification_spheres.png")
+                  "least-squares fit of ln |error| against ln h over all levels."
+                  + (" Each fraction on the cost sections' routes: `case.cells` and `surface.sphere_facets` "
+                     "(inscribed: vertices on the spheres; volume: moved out so that the facets hold each sphere's "
+                     "volume)." if any(", " in k for k in v["runs"]) else ""), ""]
+        lines += verification_lines(v, "solid fraction" + (", cells, facets" if any(", " in k for k in v["runs"]) else ""),
+                                    "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")
     if "verification_periodic" in results:
