@@ -89,7 +89,9 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
 // (a^2 + b^2 + c^2) / (24 r) inside it, and each vertex moves by the area-weighted mean of that
 // over its triangles, which puts back what they cut off to second order. The loops' vertices stay
 // where they are (other shapes share them), and so does a vertex the move would take into a cut's
-// removed part. Returns the largest move (m), for the ball that holds the mesh.
+// removed part. Each vertex stays on its ray from the centre, so the mesh stays a radial graph
+// over the same spherical triangles and cannot cross itself. Returns the largest move (m), for
+// the ball that holds the mesh.
 double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts);
 
 // Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper
