@@ -1882,6 +1882,7 @@ def write(results):
         plot_verification(v)
     if "verification_spheres" in results:
         v = results["verification_spheres"]
+        on_routes = any(", " in k for k in v["runs"])  # runs named "fraction, cells, facets"
         lines += ["## Verification around spheres: a simple cubic array against Zick & Homsy", "",
                   f"Made at commit {v['commit']} on {v['date']}: one column of a simple cubic array of spheres in a "
                   "square box whose sides the flow slips along (the array's mirror planes), six cells, the pressure "
@@ -1892,8 +1893,8 @@ def write(results):
                   "least-squares fit of ln |error| against ln h over all levels."
                   + (" Each fraction on the cost sections' routes: `case.cells` and `surface.sphere_facets` "
                      "(inscribed: vertices on the spheres; volume: moved out so that the facets hold each sphere's "
-                     "volume)." if any(", " in k for k in v["runs"]) else ""), ""]
-        lines += verification_lines(v, "solid fraction" + (", cells, facets" if any(", " in k for k in v["runs"]) else ""),
+                     "volume)." if on_routes else ""), ""]
+        lines += verification_lines(v, "solid fraction" + (", cells, facets" if on_routes else ""),
                                     "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")

@@ -69,7 +69,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
-  p.sphere_volume = s.choice("sphere_facets", "inscribed", {"inscribed", "volume"}) == "volume";
+  p.facets_hold_sphere_volume = s.choice("sphere_facets", "inscribed", {"inscribed", "volume"}) == "volume";
   p.cells_per_gap = s.number("cells_per_gap", kSceneCellsPerGap, Range::closed(0.0, 20.0));
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
@@ -110,7 +110,7 @@ nlohmann::json to_json(const SurfaceParams& p) {
           {"edge_length_d", p.edge_length_d},
           {"contact_edge_length_d", p.contact_edge_length_d},
           {"growth", p.growth},
-          {"sphere_facets", p.sphere_volume ? "volume" : "inscribed"},
+          {"sphere_facets", p.facets_hold_sphere_volume ? "volume" : "inscribed"},
           {"cells_per_gap", p.cells_per_gap},
           {"inlet_length_d", p.inlet_length_d},
           {"outlet_length_d", p.outlet_length_d},
@@ -517,7 +517,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
         spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
                                  field(static_cast<int>(i)));
         chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
-        if (p.sphere_volume) pushed[i] = match_sphere_volume(spheres[i], bed.centres[i], tb.radius[i], tb.cuts[i]);
+        if (p.facets_hold_sphere_volume) pushed[i] = match_sphere_volume(spheres[i], bed.centres[i], tb.radius[i], tb.cuts[i]);
       } catch (const CutConflict& e) {
         failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
                                  "another treatment",

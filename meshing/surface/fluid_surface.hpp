@@ -40,7 +40,7 @@ struct SurfaceParams {
   double growth = 1.5;                  // edge growth per ring away from those loops
   // The spheres' vertices moved out so that their facets hold each sphere's volume
   // (match_sphere_volume), instead of lying on the sphere, inscribed, with less solid than it.
-  bool sphere_volume = false;
+  bool facets_hold_sphere_volume = false;
   // Cells across narrow gaps: where a sphere or wall faces another surface closer than
   // cells_per_gap x edge_length_d, its edge shrinks to gap / cells_per_gap (not below
   // contact_edge_length_d), and the volume mesh follows. 0: edge_length_d everywhere.

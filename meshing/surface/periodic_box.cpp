@@ -479,7 +479,7 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
   // it lies beyond.
   std::vector<std::vector<TriangleMesh>> parts(n);
   std::vector<std::string> failure(n);
-  std::vector<double> chordal(n, 0.0);
+  std::vector<double> chordal(n, 0.0), pushed(n, 0.0);
   long spheres_cut = 0;
   for (const Placed& s : spheres) spheres_cut += (s.cross[0] != 0 || s.cross[1] != 0 || s.cross[2] != 0) ? 1 : 0;
 #pragma omp parallel for schedule(dynamic, 4)
@@ -558,14 +558,14 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
         }
         TriangleMesh part = sphere_mesh(s.c, s.r, cuts, edge, p.growth, true, "particles", field);
         chordal[i] = std::max(chordal[i], chordal_deviation(part, s.c, s.r));
-        if (p.sphere_volume) match_sphere_volume(part, s.c, s.r, cuts);
+        if (p.facets_hold_sphere_volume) pushed[i] = std::max(pushed[i], match_sphere_volume(part, s.c, s.r, cuts));
         for (auto& x : part.points) x += move;
         parts[i].push_back(std::move(part));
       }
       if (crossed.empty()) {
         parts[i].push_back(sphere_mesh(s.c, s.r, {}, edge, p.growth, true, "particles", field));
         chordal[i] = chordal_deviation(parts[i].back(), s.c, s.r);
-        if (p.sphere_volume) match_sphere_volume(parts[i].back(), s.c, s.r, {});
+        if (p.facets_hold_sphere_volume) pushed[i] = match_sphere_volume(parts[i].back(), s.c, s.r, {});
       }
     } catch (const CutConflict& e) {
       std::string where;
@@ -609,6 +609,7 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
   j["fluid_volume_exact_m3"] = out.exact_volume_m3;
   j["void_fraction_bed_section_change"] = -change / domain;
   j["chordal_deviation_d"] = (n > 0 ? *std::max_element(chordal.begin(), chordal.end()) : 0.0) / d;
+  j["sphere_vertices_moved_out_d"] = (n > 0 ? *std::max_element(pushed.begin(), pushed.end()) : 0.0) / d;
   j["domain_m"] = {{"inlet_z", cell.lo.z()}, {"outlet_z", cell.hi.z()}};
   j["periodic_box"] = {{"shift_m", {shift.x(), shift.y(), shift.z()}},
                        {"clearance_d", best / d},

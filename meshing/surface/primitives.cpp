@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <numbers>
 #include <numeric>
-#include <set>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -370,9 +369,8 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
 }
 
 double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts) {
-  std::set<std::array<double, 3>> on_loops;
-  for (const SphereCut& cut : cuts)
-    for (const Eigen::Vector3d& q : cut.loop) on_loops.insert({q.x(), q.y(), q.z()});
+  std::size_t on_loops = 0;  // sphere_mesh's first points
+  for (const SphereCut& cut : cuts) on_loops += cut.loop.size();
   // Per vertex: the area of its triangles, and their area times their mean depth inside the sphere.
   std::vector<double> area(m.points.size(), 0.0), deficit(m.points.size(), 0.0);
   for (const auto& t : m.triangles) {
@@ -382,9 +380,9 @@ double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, 
     for (int v : t) area[v] += A, deficit[v] += A * depth;
   }
   double largest = 0.0;
-  for (std::size_t v = 0; v < m.points.size(); ++v) {
+  for (std::size_t v = on_loops; v < m.points.size(); ++v) {
     Eigen::Vector3d& x = m.points[v];
-    if (!(area[v] > 0.0) || on_loops.count({x.x(), x.y(), x.z()})) continue;
+    if (!(area[v] > 0.0)) continue;
     const double push = deficit[v] / area[v];
     const Eigen::Vector3d moved = c + (x - c) * ((r + push) / (x - c).norm());
     if (std::any_of(cuts.begin(), cuts.end(), [&](const SphereCut& cut) { return cut.removed(moved); })) continue;

@@ -77,21 +77,22 @@ struct CutConflict : std::runtime_error {
 // thinned so no two lie closer than 0.8 x their mean spacing; the triangles are their convex hull
 // (the Delaunay triangulation on the sphere) less the faces spanning a loop; a loop vertex off the
 // sphere (moved onto a wall ring, snap_holes_to_rings) is taken into the hull moved radially onto
-// it and kept where it is in the mesh. At least 48 vertices. With a `field`, no vertex is spaced
-// wider than it asks: where it asks for less than `edge`, candidates come from a lattice of
-// spacing field.finest, those asking for the least first.
+// it and kept where it is in the mesh. The mesh's first points are the loops' vertices, loop by
+// loop in the cuts' order, as given (match_sphere_volume relies on it). At least 48 vertices.
+// With a `field`, no vertex is spaced wider than it asks: where it asks for less than `edge`,
+// candidates come from a lattice of spacing field.finest, those asking for the least first.
 TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts, double edge,
                          double growth, bool outward, const std::string& patch, const SpacingField& field = {});
 
-// Moves the vertices of a sphere's mesh `m` (centre c, radius r, cut along `cuts`' loops; m)
-// outward along their radius so that its facets hold the sphere's volume, not the inscribed
-// polyhedron's: a flat triangle with edges a, b, c on a sphere of radius r lies on average
-// (a^2 + b^2 + c^2) / (24 r) inside it, and each vertex moves by the area-weighted mean of that
-// over its triangles, which puts back what they cut off to second order. The loops' vertices stay
-// where they are (other shapes share them), and so does a vertex the move would take into a cut's
-// removed part. Each vertex stays on its ray from the centre, so the mesh stays a radial graph
-// over the same spherical triangles and cannot cross itself. Returns the largest move (m), for
-// the ball that holds the mesh.
+// Moves the vertices of a sphere's mesh `m` (centre c, radius r, cut along `cuts`' loops; m, as
+// sphere_mesh made it, its loops' vertices first) outward along their radius so that its facets
+// hold the sphere's volume, not the inscribed polyhedron's: a flat triangle with edges a, b, c on
+// a sphere of radius r lies on average (a^2 + b^2 + c^2) / (24 r) inside it, and each vertex moves
+// by the area-weighted mean of that over its triangles, which puts back what they cut off to
+// second order. The loops' vertices stay where they are (other shapes share them), and so does a
+// vertex the move would take into a cut's removed part. Each vertex stays on its ray from the
+// centre, so the mesh stays a radial graph over the same spherical triangles and cannot cross
+// itself. Returns the largest move (m), for the ball that holds the mesh.
 double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts);
 
 // Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper

@@ -22,8 +22,9 @@ inline double from_axis(const Eigen::Vector3d& p, const Eigen::Vector3d& centre,
 struct SurfacePiece {
   enum class Shape {
     other,     // nothing: tested pair by pair with every face near it, its own included
-    sphere,    // facets of the convex hull of points on the sphere, as sphere_mesh makes them, or those points
-               // moved out along their radius (match_sphere_volume); radius: of the ball that holds them all
+    sphere,    // facets of the convex hull of points on the sphere, as sphere_mesh makes them, or
+               // those points moved out along their radius (match_sphere_volume); radius: of the
+               // ball that holds them all
     plane,     // a triangulation of a planar region (the plane is fitted to its vertices), as ring_mesh and plane_mesh make
     cylinder,  // a triangulation of the unrolled wall laid on the cylinder (axis through centre along axis, radius), as wall_mesh makes
   };

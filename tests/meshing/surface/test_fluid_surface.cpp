@@ -200,7 +200,7 @@ TEST(FluidSurface, SpheresHoldingTheirVolumeKeepTheSurfaceValidAndTheSolidsVolum
     p.treatment = p.wall_treatment = t;
     std::array<double, 2> error{};
     for (bool volume : {false, true}) {
-      p.sphere_volume = volume;
+      p.facets_hold_sphere_volume = volume;
       const FluidSurface fs = valid_surface(b, p, name + (volume ? ", volume" : ", inscribed"));
       const double height = fs.report["domain_m"]["outlet_z"].get<double>() - fs.report["domain_m"]["inlet_z"].get<double>();
       const double solid = b.container->cross_section_area() * height - fs.report["fluid_volume_exact_m3"].get<double>();
