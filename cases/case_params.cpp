@@ -1,6 +1,10 @@
 #include "cases/case_params.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <functional>
 
 #include "core/error.hpp"
 
@@ -26,6 +30,16 @@ CaseParams read_case_params(SceneSection& s) {
   p.slip_walls = s.choice("walls", "no_slip", {"no_slip", "slip"}) == "slip";
   p.section_exclude_d = s.number("section_exclude_d", p.section_exclude_d, Range::non_negative());
   p.run = s.boolean("run", p.run);
+  p.drag_by_gap_d = s.numbers("drag_by_gap_d", Range::positive());
+  if (p.drag_by_gap_d.size() > kMostGapBands - 1 ||
+      std::adjacent_find(p.drag_by_gap_d.begin(), p.drag_by_gap_d.end(), std::greater_equal<>()) !=
+          p.drag_by_gap_d.end())
+    throw InputError(fmt::format("case.drag_by_gap_d = [{}]: allowed: up to {} band edges, ascending (reference "
+                                 "diameters)",
+                                 fmt::join(p.drag_by_gap_d, ", "), kMostGapBands - 1));
+  if (!p.drag_by_gap_d.empty() && p.snappy_cells)
+    throw InputError("case.drag_by_gap_d with case.mesher = \"snappy\": the particles' patch is split on gmsh's "
+                     "cells; allowed: case.mesher = \"gmsh\", or no case.drag_by_gap_d");
   SceneSection convergence = s.sub("convergence");
   // A solved case is studied by default: a pressure drop without its discretisation error is
   // half an answer (docs/defaults.md).
@@ -54,6 +68,7 @@ nlohmann::json to_json(const CaseParams& p) {
           {"snappy_level", p.snappy_level}, {"section_exclude_d", p.section_exclude_d},
           {"walls", p.slip_walls ? "slip" : "no_slip"},
           {"run", p.run},                   {"mesher", p.snappy_cells ? "snappy" : "gmsh"},
+          {"drag_by_gap_d", p.drag_by_gap_d},
           {"convergence", {{"levels", p.convergence.levels}, {"ratio", p.convergence.ratio}}}};
 }
 

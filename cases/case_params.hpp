@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/scene_section.hpp"
 
@@ -10,6 +11,8 @@ namespace bedforge::cases {
 // SIMPLE's target for U's initial residual when [case] residual_u is unset.
 inline constexpr double kResidualU = 1.0e-4;
 inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism layers
+// Bands of case.drag_by_gap_d at most (one forces object each).
+inline constexpr std::size_t kMostGapBands = 8;
 // The meshes of a convergence study when the case is run and the scene names none.
 inline constexpr int kStudyLevels = 3;
 // The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
@@ -46,6 +49,9 @@ struct CaseParams {
   bool slip_walls = false;
   double section_exclude_d = 0.5;       // bed section for the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this
   bool run = false;                     // run Allrun after writing and read the pressure drop back
+  // The particles' drag split by the gap at each face (cases/drag_regions.hpp): the bands' edges,
+  // ascending, in reference diameters; empty: one particles patch.
+  std::vector<double> drag_by_gap_d;
   // [case.convergence]: the flow solved again on coarser meshes of the same bed, for the pressure
   // drop's discretisation error (Richardson extrapolation and the grid convergence index).
   struct Convergence {

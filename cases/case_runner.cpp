@@ -53,6 +53,10 @@ nlohmann::json FlowResult::to_json() const {
             {"push_inlet_outlet_n", push_inlet_outlet_n},
             {"wall_share", wall_share_of_drag},
             {"force_balance_relative_error", force_balance_relative_error}}}};
+  if (!drag_particles_by_gap.empty()) {
+    j["drag"]["particles_by_gap"] = nlohmann::json::array();
+    for (const GapBand& b : drag_particles_by_gap) j["drag"]["particles_by_gap"].push_back(b.to_json());
+  }
   if (van_der_hoef_pa_m) {
     j["van_der_hoef_pa_m"] = *van_der_hoef_pa_m;
     j["ratio_to_van_der_hoef"] = *ratio_to_van_der_hoef;
@@ -443,6 +447,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   const ForceZ particles = c.particles ? last_force_z(case_dir, "forceParticles") : ForceZ{};
   r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
   r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
+  r.drag_particles_by_gap = c.gap_bands;
+  for (GapBand& b : r.drag_particles_by_gap) {
+    if (b.faces == 0) continue;  // no forces object
+    const ForceZ f = last_force_z(case_dir, b.force_object());
+    b.drag_n = f.total, b.viscous_n = f.viscous;
+  }
   // What pushes the fluid: the pressure on the inlet and outlet, or in a periodic section the
   // driving gradient over the fluid's volume (the cells solved on).
   if (periodic)

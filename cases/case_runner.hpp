@@ -46,6 +46,7 @@ struct FlowResult {
   // error, falling as the mesh refines).
   double drag_walls_n = 0.0, drag_particles_n = 0.0, push_inlet_outlet_n = 0.0;
   double drag_walls_viscous_n = 0.0, drag_particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
+  std::vector<GapBand> drag_particles_by_gap;  // with case.drag_by_gap_d: the particles' drag by the gap
   double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
   double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
   // A case with a known answer (no correlation is compared): the exact gradient and the relative

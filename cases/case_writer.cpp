@@ -13,6 +13,7 @@
 #include "analysis/pressure_drop.hpp"
 #include "analysis/stokes_arrays.hpp"
 #include "analysis/void_fraction.hpp"
+#include "cases/drag_regions.hpp"
 #include "cases/poly_mesh_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -147,13 +148,14 @@ std::string dict(const std::string& cls, const std::string& location, const std:
 }
 
 // Walls and particles take the same conditions unless `particles` gives the particles their own
-// (walls that slip); `.*wall` matches wall and inner_wall. The constraint types cover processor
+// (walls that slip); `.*wall` matches wall and inner_wall, `particles.*` the particles' patches
+// split by gap (drag_regions.hpp). The constraint types cover processor
 // patches, so the fields serve snappyHexMesh's cells as they come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
                            const std::string& particles = {}) {
-  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles)\"\n    {{\n{}    }}\n", walls)
+  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles.*)\"\n    {{\n{}    }}\n", walls)
                                                : fmt::format("    \".*wall\"\n    {{\n{}    }}\n"
-                                                             "    particles\n    {{\n{}    }}\n",
+                                                             "    \"particles.*\"\n    {{\n{}    }}\n",
                                                              walls, particles);
   return fmt::format("boundaryField\n{{\n    #includeEtc \"caseDicts/setConstraintTypes\"\n"
                      "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n{}}}\n",
@@ -386,10 +388,13 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
 // controlDict: the iteration cap and, as function objects, the pressure averaged over the inlet,
 // the outlet and the section's planes, the flow rate and the forces on every solid patch.
 void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSection& section, bool particles,
-                        bool walls, bool periodic, const std::string& note) {
+                        bool walls, bool periodic, const std::vector<GapBand>& gap_bands, const std::string& note) {
   const std::string fmt_word = p.binary ? "binary" : "ascii";
   // A periodic section's pressure is periodic: the gradient is meanVelocityForce's, and the
   // cyclic patches carry no force.
+  std::string gap_forces;
+  for (const GapBand& b : gap_bands)
+    if (b.faces > 0) gap_forces += forces(b.force_object(), b.patch(), p.density_kg_m3);
   const std::string functions =
       (periodic ? std::string()
                 : surface_value("pInlet", patch_region("inlet"), "areaAverage", "p") +
@@ -399,7 +404,8 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
       surface_value("flowRate", patch_region("outlet"), "sum", "phi") +
       // Without walls no patch matches, and OpenFOAM's forces then takes the particles again.
       (walls ? forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) : std::string()) +
-      (particles ? forces("forceParticles", "particles", p.density_kg_m3) : std::string()) +
+      (particles ? forces("forceParticles", "\"particles.*\"", p.density_kg_m3) : std::string()) +
+      gap_forces +
       (periodic ? std::string()
                 : forces("forceInlet", "inlet", p.density_kg_m3) + forces("forceOutlet", "outlet", p.density_kg_m3));
   // runTimeModifiable: run_case stops a diverging solve by setting stopAt to writeNow as it runs.
@@ -661,6 +667,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   const bool walls = bed.container->wall_perimeter() > 0.0;  // a box periodic on every side has none
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
+  std::vector<GapBand> gap_bands;
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
@@ -671,17 +678,19 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                                       fmt::format("bad_polyhedra_{}.vtk", case_dir.filename().string()));
       polyhedra_quality->ears_cut = static_cast<long>(ears.size());
       if (g.periodic) meshing::match_every_cyclic_pair(dual);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(dual, bed, g.d_ref, p.drag_by_gap_d);
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
-    } else if (mesh && g.periodic) {
-      meshing::PolyMesh cyclic = *mesh;
-      meshing::match_every_cyclic_pair(cyclic);
-      write_poly_mesh(tmp / "constant/polyMesh", cyclic, p.binary, note);
+    } else if (mesh && (g.periodic || !p.drag_by_gap_d.empty())) {  // a copy, changed
+      meshing::PolyMesh changed = *mesh;
+      if (g.periodic) meshing::match_every_cyclic_pair(changed);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(changed, bed, g.d_ref, p.drag_by_gap_d);
+      write_poly_mesh(tmp / "constant/polyMesh", changed, p.binary, note);
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
     write_fields(tmp, p, u, nu, g.d_ref, ubar, inlet_flow, note);
-    write_control_dict(tmp, p, section, bed.size() > 0, walls, g.periodic, note);
+    write_control_dict(tmp, p, section, bed.size() > 0, walls, g.periodic, gap_bands, note);
     write_solver_settings(tmp, p, g.periodic, note);
     write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
     write_text(tmp / "Allclean", kAllclean, true);
@@ -696,6 +705,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   info.walls = walls;
   info.mean_velocity_m_s = ubar;
   info.polyhedra_quality = polyhedra_quality;
+  info.gap_bands = std::move(gap_bands);
   set_known_answers(info, bed, sphere_scale);
   return info;
 }

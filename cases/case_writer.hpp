@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cases/case_params.hpp"
+#include "cases/drag_regions.hpp"
 #include "core/bed.hpp"
 #include "meshing/volume/cell_quality.hpp"
 #include "meshing/volume/dual_mesh.hpp"
@@ -95,6 +96,8 @@ struct CaseInfo {
   std::optional<double> mean_velocity_m_s = std::nullopt;
   // On polyhedra written here: their worst figures, as checked (check_polyhedra).
   std::optional<meshing::JudgedQuality> polyhedra_quality = std::nullopt;
+  // With case.drag_by_gap_d: the particles' patches by gap, their faces and areas (no forces yet).
+  std::vector<GapBand> gap_bands{};
   nlohmann::json to_json() const;        // its report.json entry
 };
 

@@ -39,7 +39,16 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"cells_failing_check_mesh", l.cells_failing_check_mesh},
                 {"wall_share_of_drag", l.wall_share_of_drag},
                 {"force_balance_relative_error", l.force_balance_relative_error},
-                {"own_time_s", l.own_time_s}});
+                {"own_time_s", l.own_time_s},
+                {"drag",
+                 {{"walls_n", l.drag_walls_n},
+                  {"walls_viscous_n", l.drag_walls_viscous_n},
+                  {"particles_n", l.drag_particles_n},
+                  {"particles_viscous_n", l.drag_particles_viscous_n}}}});
+      if (!l.drag_particles_by_gap.empty()) {
+        j["drag"]["particles_by_gap"] = nlohmann::json::array();
+        for (const cases::GapBand& b : l.drag_particles_by_gap) j["drag"]["particles_by_gap"].push_back(b.to_json());
+      }
       if (exact_pa_m) j["relative_error_to_exact"] = l.pressure_gradient_pa_m / *exact_pa_m - 1.0;
     } else {
       j["failure"] = l.failure;
@@ -78,6 +87,15 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   l.wall_share_of_drag = j.at("wall_share_of_drag").get<double>();
   l.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
   l.own_time_s = j.at("own_time_s").get<double>();
+  if (j.contains("drag")) {  // reports before 2026-12-06 lack it
+    const nlohmann::json& drag = j["drag"];
+    l.drag_walls_n = drag.at("walls_n").get<double>();
+    l.drag_walls_viscous_n = drag.at("walls_viscous_n").get<double>();
+    l.drag_particles_n = drag.at("particles_n").get<double>();
+    l.drag_particles_viscous_n = drag.at("particles_viscous_n").get<double>();
+    for (const auto& b : drag.value("particles_by_gap", nlohmann::json::array()))
+      l.drag_particles_by_gap.push_back(cases::GapBand::from_json(b));
+  }
   l.exact_pa_m = exact_pa_m;
   return l;
 }
@@ -102,6 +120,10 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.converged = solved.flow->converged;
   if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
   l.wall_share_of_drag = solved.flow->wall_share_of_drag;
+  l.drag_walls_n = solved.flow->drag_walls_n, l.drag_walls_viscous_n = solved.flow->drag_walls_viscous_n;
+  l.drag_particles_n = solved.flow->drag_particles_n;
+  l.drag_particles_viscous_n = solved.flow->drag_particles_viscous_n;
+  l.drag_particles_by_gap = solved.flow->drag_particles_by_gap;
   l.force_balance_relative_error = solved.flow->force_balance_relative_error;
   l.exact_pa_m = solved.flow->exact_pa_m;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";

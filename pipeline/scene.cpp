@@ -146,6 +146,10 @@ void check_pieces(const Scene& sc) {
     throw InputError(fmt::format("mesh.pieces = {} with case.mesher = \"snappy\" (or case.snappy): the pieces are "
                                  "gmsh's cells; allowed: case.mesher = \"gmsh\"",
                                  n));
+  if (!sc.case_params.drag_by_gap_d.empty())
+    throw InputError(fmt::format("mesh.pieces = {} with case.drag_by_gap_d: the pieces' particles are not split by "
+                                 "gap; allowed: mesh.pieces = 0 or 1, or no case.drag_by_gap_d",
+                                 n));
 }
 
 // What a periodic section's surface, mesh and cyclic case can be given today: spheres cut by the

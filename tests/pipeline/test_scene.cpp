@@ -207,6 +207,25 @@ TEST(Scene, SlabsAndPiecesAreRefusedWhereTheirPlanesWouldChangeTheBed) {
 }
 #endif
 
+// The particles' drag by gap: ascending band edges, read; out of order, too many, with
+// snappyHexMesh's cells or in pieces, refused naming the key and what is allowed.
+TEST(Scene, DragByGapTakesAscendingEdgesOnOnePieceOfGmshCells) {
+  const std::string bed = "[container]\ndiameter_d = 5\n[particles]\ncount = 10\n";
+  const std::vector<double> edges = {0.01, 0.1};
+  EXPECT_EQ(read(bed + "[case]\ndrag_by_gap_d = [0.01, 0.1]\n").case_params.drag_by_gap_d, edges);
+  for (const auto& [extra, key] : std::vector<std::pair<std::string, std::string>>{
+           {"[case]\ndrag_by_gap_d = [0.1, 0.01]\n", "case.drag_by_gap_d = [0.1, 0.01]"},
+           {"[case]\ndrag_by_gap_d = [0.1, 0.1]\n", "case.drag_by_gap_d = [0.1, 0.1]"},
+           {"[case]\ndrag_by_gap_d = [1, 2, 3, 4, 5, 6, 7, 8]\n", "up to 7 band edges"},
+           {"[case]\ndrag_by_gap_d = [0, 0.1]\n", "drag_by_gap_d"},
+           {"[case]\nmesher = \"snappy\"\ndrag_by_gap_d = [0.1]\n", "case.drag_by_gap_d with case.mesher"},
+           {"[mesh]\npieces = 2\n[case]\ndrag_by_gap_d = [0.1]\n", "mesh.pieces = 2 with case.drag_by_gap_d"}}) {
+    const std::string m = message(bed + extra);
+    EXPECT_NE(m.find(key), std::string::npos) << m;
+    EXPECT_NE(m.find("allowed"), std::string::npos) << m;
+  }
+}
+
 TEST(Scene, PeriodicSectionsRefuseWhatTheyCannotBeGiven) {
   const std::string section = "[container]\ndiameter_d = 5\nperiod_z_d = 5\n[particles]\ncount = 105\n";
   EXPECT_EQ(read(section).container->axial_period(), 0.005);

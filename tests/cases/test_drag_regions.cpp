@@ -1,0 +1,128 @@
+#include "cases/drag_regions.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <set>
+
+using namespace bedforge;
+using namespace bedforge::cases;
+
+namespace {
+
+// Two unit spheres 1.2 apart along x in a cylinder of radius 2: a gap of 0.2 between them, and
+// sphere A's far side 0.4 from the wall (its centre at x = -0.6).
+Bed two_spheres() {
+  Bed bed;
+  bed.centres = {{-0.6, 0.0, 1.0}, {0.6, 0.0, 1.0}};
+  bed.diameters = {1.0, 1.0};
+  bed.container = std::make_shared<Cylinder>(2.0);
+  return bed;
+}
+
+}  // namespace
+
+// The gap at a point on a sphere is the distance to the other sphere or to the wall, whichever is
+// nearer, exactly (points on the sphere), and capped at the reach.
+TEST(DragRegions, GapIsTheDistanceToTheNearestOtherSurface) {
+  const Bed bed = two_spheres();
+  const std::vector<Eigen::Vector3d> points = {
+      {-0.1, 0.0, 1.0},  // A's point facing B: 0.2 to B's nearest point
+      {-1.1, 0.0, 1.0},  // A's far side: 2 - 1.1 = 0.9 to the wall
+      {-0.6, 0.0, 1.5},  // A's top: farther than the reach from B and the wall
+      {0.1, 0.0, 1.0},   // B's point facing A
+  };
+  const std::vector<double> gaps = gaps_at_particle_points(points, bed, 0.5);
+  EXPECT_NEAR(gaps[0], 0.2, 1e-12);
+  EXPECT_NEAR(gaps[1], 0.5, 1e-12);  // 0.9 capped at the reach
+  EXPECT_NEAR(gaps[3], 0.2, 1e-12);
+  const double to_b = (Eigen::Vector3d(-0.6, 0.0, 1.5) - bed.centres[1]).norm() - 0.5;  // 0.8: beyond the reach
+  EXPECT_GT(to_b, 0.5);
+  EXPECT_NEAR(gaps[2], 0.5, 1e-12);
+  const std::vector<double> wide = gaps_at_particle_points(points, bed, 2.0);
+  EXPECT_NEAR(wide[1], 0.9, 1e-12);
+  EXPECT_NEAR(wide[2], std::min(to_b, 2.0 - 0.6), 1e-12);  // B, nearer than the wall at radius 0.6
+}
+
+// Across a periodic side the nearest sphere is an image: two spheres 0.3 apart through x = +-L/2.
+TEST(DragRegions, GapTakesPeriodicImages) {
+  Bed bed;
+  const double L = 4.0;
+  bed.centres = {{-L / 2 + 0.6, 0.0, 1.0}, {L / 2 - 0.6, 0.0, 1.0}};  // 1.2 apart through the side
+  bed.diameters = {1.0, 1.0};
+  bed.container = std::make_shared<Box>(L, L, true, true);
+  const std::vector<double> gaps = gaps_at_particle_points({{-L / 2 + 0.1, 0.0, 1.0}}, bed, 1.0);
+  EXPECT_NEAR(gaps[0], 0.2, 1e-12);
+}
+
+// Splitting keeps every face with its owner, puts each particle face in its gap's band (faces
+// of one band in the order they had) and leaves the other patches' faces where they were.
+TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
+  const Bed bed = two_spheres();
+  meshing::PolyMesh m;
+  m.cells = 4;
+  // Particle faces: small triangles around points of A at known gaps (0.2 facing B, 0.9 from the
+  // wall on the far side, 0.8 from B on top), interleaved; one inlet face before, one outlet after.
+  const std::vector<std::pair<Eigen::Vector3d, double>> at = {
+      {{-0.1, 0.0, 1.0}, 0.2}, {{-1.1, 0.0, 1.0}, 0.9}, {{-0.6, 0.0, 1.5}, 0.8}, {{-0.1, 0.0, 1.0}, 0.2}};
+  auto triangle = [&](const Eigen::Vector3d& c) {
+    const int first = static_cast<int>(m.points.size());
+    for (const Eigen::Vector3d& e : {Eigen::Vector3d(0, 1e-3, 0), Eigen::Vector3d(0, -1e-3, 1e-3),
+                                     Eigen::Vector3d(0, -1e-3, -1e-3)})
+      m.points.push_back(c + e);
+    m.faces.push_back(meshing::Face{first, first + 1, first + 2});
+  };
+  triangle({0.0, 0.0, 0.0});
+  m.owner.push_back(0);
+  for (std::size_t k = 0; k < at.size(); ++k) triangle(at[k].first), m.owner.push_back(static_cast<int>(k));
+  triangle({0.0, 0.0, 3.0});
+  m.owner.push_back(3);
+  m.patches = {{"inlet", "patch", 0, 1}, {"particles", "wall", 1, 4}, {"outlet", "patch", 5, 1}};
+  const meshing::PolyMesh before = m;
+
+  const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {0.5, 0.85});
+  ASSERT_EQ(bands.size(), 3u);
+  EXPECT_EQ(bands[0].faces, 2);  // the two at 0.2
+  EXPECT_EQ(bands[1].faces, 1);  // 0.8
+  EXPECT_EQ(bands[2].faces, 1);  // 0.9
+  EXPECT_NEAR(bands[0].area_m2, 2.0 * 2e-6, 1e-15);  // each triangle: base 2e-3, height 2e-3
+  ASSERT_EQ(m.patches.size(), 5u);
+  const std::vector<std::string> names = {"inlet", "particles_gap0", "particles_gap1", "particles_gap2", "outlet"};
+  const std::vector<int> starts = {0, 1, 3, 4, 5};
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    EXPECT_EQ(m.patches[k].name, names[k]);
+    EXPECT_EQ(m.patches[k].start, starts[k]);
+  }
+  EXPECT_EQ(m.patches[1].type, "wall");
+  // Band by band, in the order they had: faces 1 and 4 (owners 0, 3), then 3 (owner 2), then 2 (owner 1).
+  const std::vector<int> from = {0, 1, 4, 3, 2, 5};
+  ASSERT_EQ(m.faces.size(), from.size());
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    EXPECT_EQ(std::vector<int>(m.faces[k].begin(), m.faces[k].end()),
+              std::vector<int>(before.faces[from[k]].begin(), before.faces[from[k]].end()));
+    EXPECT_EQ(m.owner[k], before.owner[from[k]]);
+  }
+
+  // The polyhedral mesh's faces are split alike.
+  meshing::PolyhedralMesh p;
+  p.points = before.points;
+  for (const auto& f : before.faces) p.faces.push_back(std::vector<int>(f.begin(), f.end()));
+  p.owner = before.owner;
+  p.patches = before.patches;
+  p.cells = before.cells;
+  const std::vector<GapBand> same = split_particles_by_gap(p, bed, 1.0, {0.5, 0.85});
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    const auto face = p.faces[k];
+    EXPECT_EQ(std::vector<int>(face.begin(), face.end()),
+              std::vector<int>(before.faces[from[k]].begin(), before.faces[from[k]].end()));
+  }
+  EXPECT_EQ(same[2].faces, 1);
+
+  // Without a particles patch nothing changes.
+  meshing::PolyMesh empty = before;
+  empty.patches = {{"inlet", "patch", 0, 6}};
+  EXPECT_TRUE(split_particles_by_gap(empty, bed, 1.0, {0.5}).empty());
+  EXPECT_EQ(empty.patches.size(), 1u);
+}
