@@ -134,6 +134,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line  # noqa: E402
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
+# cost_20k's particles split by the gap at their faces (case.drag_by_gap_d, d): the bridges' rims
+# and narrowest gaps, gaps of one to a few contact edges, of a few surface edges, and open pores.
+GAP_BANDS_D = [0.01, 0.03, 0.1, 0.3]
 SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "study_reynolds", "study_treatments",
             "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
@@ -146,7 +149,7 @@ ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/sha
 
 
 def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000,
-          levels=0, ratio=1.3, cells="polyhedra", contact_edge=None, sphere_facets="inscribed"):
+          levels=0, ratio=1.3, cells="polyhedra", contact_edge=None, sphere_facets="inscribed", drag_by_gap=()):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -173,7 +176,7 @@ reynolds = {reynolds}
 iterations = {iterations}
 processors = 2
 run = {"true" if run else "false"}
-[case.convergence]
+{f"drag_by_gap_d = [{', '.join(f'{g:g}' for g in drag_by_gap)}]" + chr(10) if drag_by_gap else ""}[case.convergence]
 levels = {levels}
 ratio = {ratio}
 [outputs]
@@ -346,12 +349,12 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
 
 
 def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra",
-          contact_edge=None, sphere_facets="inscribed"):
+          contact_edge=None, sphere_facets="inscribed", drag_by_gap=()):
     """One run of the scene with a mesh-convergence study; its levels and verdict. contact_edge:
-    the contact edge (d), else a third of `edge`."""
+    the contact edge (d), else a third of `edge`; drag_by_gap: case.drag_by_gap_d."""
     path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}_{ratio}_{sphere_facets}")
     text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells,
-                 contact_edge=contact_edge, sphere_facets=sphere_facets)
+                 contact_edge=contact_edge, sphere_facets=sphere_facets, drag_by_gap=drag_by_gap)
     open(path + ".toml", "w").write(text)
     return study_record(path, {"a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
                                "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap,
@@ -1509,6 +1512,59 @@ def cost_lines(runs):
     return lines + [""]
 
 
+def error_seat_lines(r):
+    """Issue 57's item 1 on one study: the drag by kind (walls, particles; pressure and viscous) and
+    the particles' by the gap at their faces, level by level: each part's changes between levels
+    and its share of the finest level's error. Nothing for a study without the split."""
+    levels = [lv for lv in r["study"]["levels"] if "failure" not in lv and "drag" in lv]
+    if len(levels) < 3 or "particles_by_gap" not in levels[0]["drag"]:
+        return []
+    g = r["study"].get("grid_convergence", {})
+    ratio = r["ratio"]
+    parts = [("walls, pressure", lambda d: d["walls_n"] - d["walls_viscous_n"], None),
+             ("walls, viscous", lambda d: d["walls_viscous_n"], None)]
+    for k, band in enumerate(levels[0]["drag"]["particles_by_gap"]):
+        span = (f"gap {band['gap_from_d']:g}-{band['gap_to_d']:g} d" if band["gap_to_d"] is not None
+                else f"gap beyond {band['gap_from_d']:g} d")
+        parts += [(f"particles, {span}, pressure", lambda d, k=k: d["particles_by_gap"][k]["drag_n"]
+                   - d["particles_by_gap"][k]["viscous_n"], k),
+                  (f"particles, {span}, viscous", lambda d, k=k: d["particles_by_gap"][k]["viscous_n"], k)]
+    total = lambda d: d["walls_n"] + d["particles_n"]
+    f1 = total(levels[0]["drag"])
+    area1 = sum(b["area_m2"] for b in levels[0]["drag"]["particles_by_gap"])
+    p = g.get("apparent_order")
+    # The finest level's error of each part by Richardson with the pressure drop's own order.
+    factor = ratio ** p - 1.0 if p else None
+    err_total = -(f1 - total(levels[1]["drag"])) / factor if factor else None
+    names = ", ".join(f"{lv['level'] + 1} to {lv['level']}" for lv in reversed(levels[:-1]))
+    lines = [f"### Where the error sits: {route(r)} (issue 57, item 1)", "",
+             f"Made at commit {r['commit']} on {r['date']}, the same run as the cost table above: the drag along "
+             "the flow on each level (OpenFOAM's forces, over the whole domain) split by kind and, with "
+             f"`case.drag_by_gap_d = {GAP_BANDS_D}`, the particles' faces by the gap at their centres (to the nearest "
+             "other sphere or wall; the cells are the same with and without the split). Changes are between "
+             "successive levels, coarser to finer, over the finest level's total drag; the order of a part is "
+             f"ln(change / next finer change) / ln {ratio} over the finest three; its error on the finest (finest "
+             f"less extrapolated) is minus its last change / (ratio^p - 1) with p = {p:.2f}, the pressure drop's "
+             "order, and its share is of the whole drag's error." if p else "no order: the study gave none.", "",
+             f"| part | area (of the particles') | share of the finest drag | changes, levels {names} | order "
+             "| error on the finest | share of the error |",
+             "|---|---|---|---|---|---|---|"]
+    for name, part, k in parts + [("all", total, None)]:
+        values = [part(lv["drag"]) for lv in levels]
+        changes = [(values[i] - values[i + 1]) / f1 for i in range(len(values) - 1)]  # finer minus coarser
+        order = (math.log(changes[1] / changes[0]) / math.log(ratio)
+                 if changes[0] != 0 and changes[1] / changes[0] > 0 else None)
+        err = -changes[0] * f1 / factor if factor else None  # finest - extrapolated
+        area = (f"{100 * levels[0]['drag']['particles_by_gap'][k]['area_m2'] / area1:.1f} %" if k is not None
+                else "")
+        lines.append(f"| {name} | {area} | {100 * values[0] / f1:.1f} % | "
+                     + ", ".join(f"{100 * c:+.2f} %" for c in reversed(changes)) + " | "
+                     + (f"{order:.2f}" if order is not None else "-") + " | "
+                     + (f"{100 * err / f1:+.2f} %" if err is not None else "") + " | "
+                     + (f"{100 * err / err_total:.0f} %" if err is not None and err_total else "") + " |")
+    return lines + [""]
+
+
 def drag_share(level):
     """The walls' share of a level's drag; runs before 2026-11-26 did not record it."""
     return f"{100 * level['wall_share_of_drag']:.1f} %" if "wall_share_of_drag" in level else "not recorded"
@@ -1871,6 +1927,8 @@ def write(results):
     for key in ("cost", "cost_20k", "cost_500"):
         if key in results:
             lines += cost_lines(results[key])
+            for r in results[key]:
+                lines += error_seat_lines(r)
     if "verification" in results:
         v = results["verification"]
         lines += ["## Verification: the empty tube against Hagen-Poiseuille, tetrahedra and their polyhedral dual", "",
@@ -2093,7 +2151,8 @@ def main():
         if "cost_20k" in args.only:
             results["cost_20k"] = [study(tmp, args.target_edge, args.cost_levels, args.target_ratio, args.cost_gap_cells,
                                          a=4, n=40, cells="tetrahedra", contact_edge=args.target_edge / 2,
-                                         sphere_facets=facets) for facets in ("inscribed", "volume")]
+                                         sphere_facets=facets, drag_by_gap=GAP_BANDS_D)
+                                   for facets in ("inscribed", "volume")]
             write(results)
         if "cost_500" in args.only:
             results["cost_500"] = [default_study(tmp, cells, facets) for cells, facets in COST_ROUTES]
