@@ -448,10 +448,13 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
   r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
   r.drag_particles_by_gap = c.gap_bands;
+  // The section's mean pressure (Pa), linear between its planes: p_low - gradient (z - z_low).
+  const double p_low = periodic ? 0.0 : rho * bottom[n - 1], mean_gradient = periodic ? 0.0 : gradient;
   for (GapBand& b : r.drag_particles_by_gap) {
     if (b.faces == 0) continue;  // no forces object
     const ForceZ f = last_force_z(case_dir, b.force_object());
     b.drag_n = f.total, b.viscous_n = f.viscous;
+    b.form_n = f.total - f.viscous - (p_low * b.area_z_m2 - mean_gradient * (b.moment_z_m3 - zl * b.area_z_m2));
   }
   // What pushes the fluid: the pressure on the inlet and outlet, or in a periodic section the
   // driving gradient over the fluid's volume (the cells solved on).

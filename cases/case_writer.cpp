@@ -678,13 +678,13 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                                       fmt::format("bad_polyhedra_{}.vtk", case_dir.filename().string()));
       polyhedra_quality->ears_cut = static_cast<long>(ears.size());
       if (g.periodic) meshing::match_every_cyclic_pair(dual);
-      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(dual, bed, g.d_ref, p.drag_by_gap_d);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(dual, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
     } else if (mesh && (g.periodic || !p.drag_by_gap_d.empty())) {  // a copy, changed
       meshing::PolyMesh changed = *mesh;
       if (g.periodic) meshing::match_every_cyclic_pair(changed);
-      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(changed, bed, g.d_ref, p.drag_by_gap_d);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(changed, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
       write_poly_mesh(tmp / "constant/polyMesh", changed, p.binary, note);
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);

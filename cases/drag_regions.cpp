@@ -11,17 +11,23 @@
 
 namespace bedforge::cases {
 
-std::string GapBand::patch() const { return fmt::format("particles_gap{}", number); }
-std::string GapBand::force_object() const { return fmt::format("forceParticlesGap{}", number); }
+std::string GapBand::patch() const { return in_section ? fmt::format("particles_gap{}", number) : "particles_ends"; }
+std::string GapBand::force_object() const {
+  return in_section ? fmt::format("forceParticlesGap{}", number) : "forceParticlesEnds";
+}
 
 nlohmann::json GapBand::to_json() const {
   return {{"patch", patch()},
+          {"in_section", in_section},
           {"gap_from_d", from_d},
           {"gap_to_d", std::isfinite(to_d) ? nlohmann::json(to_d) : nlohmann::json()},
           {"faces", faces},
           {"area_m2", area_m2},
+          {"area_z_m2", area_z_m2},
+          {"moment_z_m3", moment_z_m3},
           {"drag_n", drag_n},
-          {"viscous_n", viscous_n}};
+          {"viscous_n", viscous_n},
+          {"form_n", form_n}};
 }
 
 GapBand GapBand::from_json(const nlohmann::json& j) {
@@ -30,10 +36,14 @@ GapBand GapBand::from_json(const nlohmann::json& j) {
   b.to_d = j.at("gap_to_d").is_null() ? std::numeric_limits<double>::infinity() : j.at("gap_to_d").get<double>();
   b.faces = j.at("faces").get<long>();
   b.area_m2 = j.at("area_m2").get<double>();
+  b.area_z_m2 = j.at("area_z_m2").get<double>();
+  b.moment_z_m3 = j.at("moment_z_m3").get<double>();
+  b.form_n = j.at("form_n").get<double>();
   b.drag_n = j.at("drag_n").get<double>();
   b.viscous_n = j.at("viscous_n").get<double>();
+  b.in_section = j.at("in_section").get<bool>();
   const std::string patch = j.at("patch").get<std::string>();
-  b.number = std::atoi(patch.c_str() + std::string("particles_gap").size());
+  if (b.in_section) b.number = std::atoi(patch.c_str() + std::string("particles_gap").size());
   return b;
 }
 
@@ -110,16 +120,16 @@ std::vector<double> gaps_at_particle_points(const std::vector<Eigen::Vector3d>& 
 
 namespace {
 
-// Face f's centre (its vertices' mean) and area (a fan from the first vertex: the faces here are
-// triangles or the dual's flat-enough polygons).
+// Face f's centre (its vertices' mean) and area vector (a fan from the first vertex: the faces
+// here are triangles or the dual's flat-enough polygons; out of the owner cell, as OpenFOAM's).
 template <class Mesh>
-std::pair<Eigen::Vector3d, double> centre_and_area(const Mesh& m, int f) {
+std::pair<Eigen::Vector3d, Eigen::Vector3d> centre_and_area(const Mesh& m, int f) {
   const std::vector<int> v = meshing::points_of(m, f);
   Eigen::Vector3d centre = Eigen::Vector3d::Zero(), twice_area = Eigen::Vector3d::Zero();
   for (int p : v) centre += m.points[p] / static_cast<double>(v.size());
   for (std::size_t k = 1; k + 1 < v.size(); ++k)
     twice_area += (m.points[v[k]] - m.points[v[0]]).cross(m.points[v[k + 1]] - m.points[v[0]]);
-  return {centre, 0.5 * twice_area.norm()};
+  return {centre, 0.5 * twice_area};
 }
 
 // The faces of `m` in the order `order` (a permutation of all face labels; owners follow).
@@ -139,27 +149,33 @@ void reorder_faces(meshing::PolyhedralMesh& m, const std::vector<int>& order) {
 }
 
 template <class Mesh>
-std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vector<double>& edges_d) {
+std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vector<double>& edges_d, double z_low,
+                           double z_high) {
   const auto at = std::find_if(m.patches.begin(), m.patches.end(), [](const auto& p) { return p.name == "particles"; });
   if (at == m.patches.end()) return {};
   const meshing::PolyMesh::Patch particles = *at;
   std::vector<Eigen::Vector3d> centres(particles.size);
-  std::vector<double> areas(particles.size);
+  std::vector<Eigen::Vector3d> areas(particles.size);
   for (int k = 0; k < particles.size; ++k) std::tie(centres[k], areas[k]) = centre_and_area(m, particles.start + k);
   const double reach = 2.0 * edges_d.back() * d_ref;  // beyond the last edge the gap's value does not matter
   const std::vector<double> gaps = gaps_at_particle_points(centres, bed, reach);
-  std::vector<GapBand> bands(edges_d.size() + 1);
+  std::vector<GapBand> bands(edges_d.size() + 2);
   std::vector<int> band_of(particles.size);
   for (std::size_t b = 0; b < bands.size(); ++b) {
     bands[b].number = static_cast<int>(b);
-    bands[b].from_d = b == 0 ? 0.0 : edges_d[b - 1];
+    bands[b].from_d = b == 0 || b > edges_d.size() ? 0.0 : edges_d[b - 1];
     bands[b].to_d = b < edges_d.size() ? edges_d[b] : std::numeric_limits<double>::infinity();
+    bands[b].in_section = b <= edges_d.size();
   }
   for (int k = 0; k < particles.size; ++k) {
     const double g = gaps[k] / d_ref;
-    band_of[k] = static_cast<int>(std::upper_bound(edges_d.begin(), edges_d.end(), g) - edges_d.begin());
+    band_of[k] = centres[k].z() < z_low || centres[k].z() > z_high
+                     ? static_cast<int>(edges_d.size()) + 1
+                     : static_cast<int>(std::upper_bound(edges_d.begin(), edges_d.end(), g) - edges_d.begin());
     bands[band_of[k]].faces += 1;
-    bands[band_of[k]].area_m2 += areas[k];
+    bands[band_of[k]].area_m2 += areas[k].norm();
+    bands[band_of[k]].area_z_m2 += areas[k].z();
+    bands[band_of[k]].moment_z_m3 += centres[k].z() * areas[k].z();
   }
   // The patch's faces band by band, each band in the order it had.
   std::vector<int> order(m.owner.size());
@@ -184,12 +200,12 @@ std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vec
 }  // namespace
 
 std::vector<GapBand> split_particles_by_gap(meshing::PolyMesh& mesh, const Bed& bed, double d_ref,
-                                            const std::vector<double>& edges_d) {
-  return split(mesh, bed, d_ref, edges_d);
+                                            const std::vector<double>& edges_d, double z_low, double z_high) {
+  return split(mesh, bed, d_ref, edges_d, z_low, z_high);
 }
 std::vector<GapBand> split_particles_by_gap(meshing::PolyhedralMesh& mesh, const Bed& bed, double d_ref,
-                                            const std::vector<double>& edges_d) {
-  return split(mesh, bed, d_ref, edges_d);
+                                            const std::vector<double>& edges_d, double z_low, double z_high) {
+  return split(mesh, bed, d_ref, edges_d, z_low, z_high);
 }
 
 }  // namespace bedforge::cases

@@ -10,19 +10,28 @@
 
 namespace bedforge::cases {
 
-// The drag on the particles split by where it acts: each particle face goes to a band of the gap
-// at its centre, the distance to the nearest other solid surface (another sphere or a wall), so
-// that a study can say which region carries the pressure drop's discretisation error (near
-// contacts, where one cell spans a narrow gap, or in the open pores). The band edges are
-// case.drag_by_gap_d; the forces come from one OpenFOAM forces object per band.
+// The drag on the particles split by where it acts: each particle face in the bed section (where
+// dp/L is measured) goes to a band of the gap at its centre, the distance to the nearest other
+// solid surface (another sphere or a wall), so that a study can say which region carries the
+// pressure drop's discretisation error (near contacts, where one cell spans a narrow gap, or in
+// the open pores); the faces beyond the section's planes (the bed's ends) go to one more band.
+// The band edges are case.drag_by_gap_d; the forces come from one OpenFOAM forces object per band.
 struct GapBand {
   double from_d = 0.0, to_d = 0.0;  // the gap's band, in reference diameters; to_d infinite for the last
+  bool in_section = true;           // false: the faces beyond the section's planes, whatever their gap
   long faces = 0;                   // particle faces in it
   double area_m2 = 0.0;             // their area
-  double drag_n = 0.0, viscous_n = 0.0;  // the force along the flow on them (N) and its shear part; set by the run
+  // Sums over its faces of S_z and z S_z, S the face's area vector out of the fluid (m^2, m^3):
+  // the force of a pressure field linear in z on them, which a band's pressure force holds
+  // besides its own (its faces are no closed surface).
+  double area_z_m2 = 0.0, moment_z_m3 = 0.0;
+  // Set by the run: the force along the flow on them (N), its shear part, and its pressure part
+  // less that of the section's mean pressure, linear between its planes (in a periodic section,
+  // whose pressure has no mean gradient, less that of p = 0): the band's own form drag.
+  double drag_n = 0.0, viscous_n = 0.0, form_n = 0.0;
   int number = 0;                   // from 0, the narrowest
-  std::string patch() const;        // its patch: particles_gap<number>
-  std::string force_object() const; // its forces function object: forceParticlesGap<number>
+  std::string patch() const;        // its patch: particles_gap<number>, or particles_ends
+  std::string force_object() const; // its forces function object: forceParticlesGap<number>, or forceParticlesEnds
   nlohmann::json to_json() const;
   static GapBand from_json(const nlohmann::json& j);
 };
@@ -36,13 +45,14 @@ std::vector<double> gaps_at_particle_points(const std::vector<Eigen::Vector3d>& 
 
 // Splits `mesh`'s patch "particles" into one patch per band of the gap at its faces' centres,
 // edges `edges_d` (ascending, reference diameters d_ref m): particles_gap0 below the first edge,
-// ..., the last beyond the last edge; each keeps the type "wall", every band is written (empty
-// ones too, so that every case has the same patches). The patch's faces are reordered, the other
-// faces and the cells are not touched. Returns the bands with their faces and areas. A mesh
-// without a particles patch is left as it is (no bands).
+// ..., the last beyond the last edge, of the faces whose centre lies between the section's planes
+// z_low and z_high (m), and particles_ends of the others; each keeps the type "wall", every band is
+// written (empty ones too, so that every case has the same patches). The patch's faces are
+// reordered, the other faces and the cells are not touched. Returns the bands with their faces
+// and areas, particles_ends last. A mesh without a particles patch is left as it is (no bands).
 std::vector<GapBand> split_particles_by_gap(meshing::PolyMesh& mesh, const Bed& bed, double d_ref,
-                                            const std::vector<double>& edges_d);
+                                            const std::vector<double>& edges_d, double z_low, double z_high);
 std::vector<GapBand> split_particles_by_gap(meshing::PolyhedralMesh& mesh, const Bed& bed, double d_ref,
-                                            const std::vector<double>& edges_d);
+                                            const std::vector<double>& edges_d, double z_low, double z_high);
 
 }  // namespace bedforge::cases

@@ -65,7 +65,9 @@ cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1
         meshes from --cost-edge d, contact edge a third, --cost-gap-cells per gap): each level's cells and seconds
         per sphere, its error against the extrapolation with the narrowest band, and the issue's targets.
 cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge d (contact edge half of it,
-        some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed.
+        some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed; the
+        particles' drag split by the gap at their faces (GAP_BANDS_D), each route's drag by kind and band level by
+        level: where the error sits (issue 57, item 1).
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
         and study).
 verification_spheres: on each of the cost sections' routes, a column of a simple cubic array of spheres in
@@ -1513,55 +1515,67 @@ def cost_lines(runs):
 
 
 def error_seat_lines(r):
-    """Issue 57's item 1 on one study: the drag by kind (walls, particles; pressure and viscous) and
-    the particles' by the gap at their faces, level by level: each part's changes between levels
-    and its share of the finest level's error. Nothing for a study without the split."""
+    """Issue 57's item 1 on one study: the drag in the bed section split by kind (walls; the
+    particles' form drag, their pressure less the section's mean linear pressure, and their
+    viscous drag) and the particles' by the gap at their faces, level by level: each part's changes
+    between levels and its share of the finest level's error. Nothing for a study without the split."""
     levels = [lv for lv in r["study"]["levels"] if "failure" not in lv and "drag" in lv]
-    if len(levels) < 3 or "particles_by_gap" not in levels[0]["drag"]:
+    if len(levels) < 3 or "particles_by_gap" not in levels[0]["drag"] or \
+            "form_n" not in levels[0]["drag"]["particles_by_gap"][0]:
         return []
     g = r["study"].get("grid_convergence", {})
     ratio = r["ratio"]
-    parts = [("walls, pressure", lambda d: d["walls_n"] - d["walls_viscous_n"], None),
-             ("walls, viscous", lambda d: d["walls_viscous_n"], None)]
-    for k, band in enumerate(levels[0]["drag"]["particles_by_gap"]):
-        span = (f"gap {band['gap_from_d']:g}-{band['gap_to_d']:g} d" if band["gap_to_d"] is not None
-                else f"gap beyond {band['gap_from_d']:g} d")
-        parts += [(f"particles, {span}, pressure", lambda d, k=k: d["particles_by_gap"][k]["drag_n"]
-                   - d["particles_by_gap"][k]["viscous_n"], k),
+    bands = levels[0]["drag"]["particles_by_gap"]
+    inside = [k for k, b in enumerate(bands) if b["in_section"]]
+    parts = [("walls (whole), pressure", lambda d: d["walls_n"] - d["walls_viscous_n"], None),
+             ("walls (whole), viscous", lambda d: d["walls_viscous_n"], None)]
+    for k in inside:
+        b = bands[k]
+        span = f"gap {b['gap_from_d']:g}-{b['gap_to_d']:g} d" if b["gap_to_d"] is not None \
+            else f"gap beyond {b['gap_from_d']:g} d"
+        parts += [(f"particles, {span}, form", lambda d, k=k: d["particles_by_gap"][k]["form_n"], k),
                   (f"particles, {span}, viscous", lambda d, k=k: d["particles_by_gap"][k]["viscous_n"], k)]
-    total = lambda d: d["walls_n"] + d["particles_n"]
-    f1 = total(levels[0]["drag"])
-    area1 = sum(b["area_m2"] for b in levels[0]["drag"]["particles_by_gap"])
+    # The section's drag less its mean pressure's share: about dp/L times the section's fluid volume.
+    whole = lambda d: d["walls_n"] + sum(d["particles_by_gap"][k]["form_n"] + d["particles_by_gap"][k]["viscous_n"]
+                                         for k in inside)
+    s1 = whole(levels[0]["drag"])
+    area1 = sum(bands[k]["area_m2"] for k in inside)
     p = g.get("apparent_order")
-    # The finest level's error of each part by Richardson with the pressure drop's own order.
-    factor = ratio ** p - 1.0 if p else None
-    err_total = -(f1 - total(levels[1]["drag"])) / factor if factor else None
+    factor = ratio ** p - 1.0 if p else None  # Richardson with the pressure drop's own order
+    err_whole = -(s1 - whole(levels[1]["drag"])) / factor if factor else None
     names = ", ".join(f"{lv['level'] + 1} to {lv['level']}" for lv in reversed(levels[:-1]))
     lines = [f"### Where the error sits: {route(r)} (issue 57, item 1)", "",
-             f"Made at commit {r['commit']} on {r['date']}, the same run as the cost table above: the drag along "
-             "the flow on each level (OpenFOAM's forces, over the whole domain) split by kind and, with "
-             f"`case.drag_by_gap_d = {GAP_BANDS_D}`, the particles' faces by the gap at their centres (to the nearest "
-             "other sphere or wall; the cells are the same with and without the split). Changes are between "
-             "successive levels, coarser to finer, over the finest level's total drag; the order of a part is "
-             f"ln(change / next finer change) / ln {ratio} over the finest three; its error on the finest (finest "
-             f"less extrapolated) is minus its last change / (ratio^p - 1) with p = {p:.2f}, the pressure drop's "
-             "order, and its share is of the whole drag's error." if p else "no order: the study gave none.", "",
-             f"| part | area (of the particles') | share of the finest drag | changes, levels {names} | order "
+             f"Made at commit {r['commit']} on {r['date']}, the same run as the cost table above, with "
+             f"`case.drag_by_gap_d = {GAP_BANDS_D}`: the particles' faces in the bed section (where dp/L is measured) "
+             "split by the gap at their centres (to the nearest other sphere or wall); the cells are the same with "
+             "and without the split. A band's faces are no closed surface, so its pressure force holds the "
+             "section's mean pressure (linear between the section's planes) times their projected area; less that, "
+             "its form drag. The walls' forces are over the whole domain (not split). The parts sum to the "
+             "section's drag less its mean pressure's share, about dp/L times the section's fluid volume. Changes "
+             "are between successive levels, coarser to finer, over that sum on the finest level; the order of a "
+             f"part is ln(change / next finer change) / ln {ratio} over the finest three; its error on the finest "
+             "(finest less extrapolated) is minus its last change / (ratio^p - 1) with p "
+             + (f"= {p:.2f}, the pressure drop's order; its share is of the sum's error." if p
+                else "the pressure drop's order: the study gave none."), "",
+             f"| part | area (of the section's particles') | share of the finest | changes, levels {names} | order "
              "| error on the finest | share of the error |",
              "|---|---|---|---|---|---|---|"]
-    for name, part, k in parts + [("all", total, None)]:
+    for name, part, k in parts + [("all (the sum)", whole, None)]:
         values = [part(lv["drag"]) for lv in levels]
-        changes = [(values[i] - values[i + 1]) / f1 for i in range(len(values) - 1)]  # finer minus coarser
+        changes = [(values[i] - values[i + 1]) / s1 for i in range(len(values) - 1)]  # finer less coarser
         order = (math.log(changes[1] / changes[0]) / math.log(ratio)
                  if changes[0] != 0 and changes[1] / changes[0] > 0 else None)
-        err = -changes[0] * f1 / factor if factor else None  # finest - extrapolated
-        area = (f"{100 * levels[0]['drag']['particles_by_gap'][k]['area_m2'] / area1:.1f} %" if k is not None
-                else "")
-        lines.append(f"| {name} | {area} | {100 * values[0] / f1:.1f} % | "
+        err = -changes[0] * s1 / factor if factor else None
+        area = f"{100 * bands[k]['area_m2'] / area1:.1f} %" if k is not None else ""
+        lines.append(f"| {name} | {area} | {100 * values[0] / s1:.1f} % | "
                      + ", ".join(f"{100 * c:+.2f} %" for c in reversed(changes)) + " | "
                      + (f"{order:.2f}" if order is not None else "-") + " | "
-                     + (f"{100 * err / f1:+.2f} %" if err is not None else "") + " | "
-                     + (f"{100 * err / err_total:.0f} %" if err is not None and err_total else "") + " |")
+                     + (f"{100 * err / s1:+.2f} %" if err is not None else "") + " | "
+                     + (f"{100 * err / err_whole:.0f} %" if err is not None and err_whole else "") + " |")
+    dp = [lv["pressure_gradient_bed_pa_m"] for lv in levels]
+    lines += ["", "Beside it, dp/L's own changes between the same levels: "
+              + ", ".join(f"{100 * (dp[i] - dp[i + 1]) / dp[0]:+.2f} %" for i in reversed(range(len(dp) - 1)))
+              + " of the finest's."]
     return lines + [""]
 
 

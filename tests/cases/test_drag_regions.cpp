@@ -57,14 +57,16 @@ TEST(DragRegions, GapTakesPeriodicImages) {
   EXPECT_NEAR(gaps[0], 0.2, 1e-12);
 }
 
-// Splitting keeps every face with its owner, puts each particle face in its gap's band (faces
-// of one band in the order they had) and leaves the other patches' faces where they were.
+// Splitting keeps every face with its owner, puts each particle face between the section's
+// planes in its gap's band and the others in particles_ends (faces of one band in the order they
+// had), and leaves the other patches' faces where they were.
 TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   const Bed bed = two_spheres();
   meshing::PolyMesh m;
   m.cells = 4;
   // Particle faces: small triangles around points of A at known gaps (0.2 facing B, 0.9 from the
-  // wall on the far side, 0.8 from B on top), interleaved; one inlet face before, one outlet after.
+  // wall on the far side, 0.8 from B on top but above the section's top plane z = 1.4),
+  // interleaved; one inlet face before, one outlet after.
   const std::vector<std::pair<Eigen::Vector3d, double>> at = {
       {{-0.1, 0.0, 1.0}, 0.2}, {{-1.1, 0.0, 1.0}, 0.9}, {{-0.6, 0.0, 1.5}, 0.8}, {{-0.1, 0.0, 1.0}, 0.2}};
   auto triangle = [&](const Eigen::Vector3d& c) {
@@ -82,22 +84,26 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   m.patches = {{"inlet", "patch", 0, 1}, {"particles", "wall", 1, 4}, {"outlet", "patch", 5, 1}};
   const meshing::PolyMesh before = m;
 
-  const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {0.5, 0.85});
-  ASSERT_EQ(bands.size(), 3u);
+  const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {0.5, 0.85}, 0.0, 1.4);
+  ASSERT_EQ(bands.size(), 4u);
   EXPECT_EQ(bands[0].faces, 2);  // the two at 0.2
-  EXPECT_EQ(bands[1].faces, 1);  // 0.8
+  EXPECT_EQ(bands[1].faces, 0);  // 0.8, but beyond the section
   EXPECT_EQ(bands[2].faces, 1);  // 0.9
+  EXPECT_EQ(bands[3].faces, 1);  // the top one
+  EXPECT_FALSE(bands[3].in_section);
   EXPECT_NEAR(bands[0].area_m2, 2.0 * 2e-6, 1e-15);  // each triangle: base 2e-3, height 2e-3
-  ASSERT_EQ(m.patches.size(), 5u);
-  const std::vector<std::string> names = {"inlet", "particles_gap0", "particles_gap1", "particles_gap2", "outlet"};
-  const std::vector<int> starts = {0, 1, 3, 4, 5};
+  ASSERT_EQ(m.patches.size(), 6u);
+  const std::vector<std::string> names = {"inlet",          "particles_gap0", "particles_gap1",
+                                          "particles_gap2", "particles_ends", "outlet"};
+  const std::vector<int> starts = {0, 1, 3, 3, 4, 5};
   for (std::size_t k = 0; k < names.size(); ++k) {
     EXPECT_EQ(m.patches[k].name, names[k]);
     EXPECT_EQ(m.patches[k].start, starts[k]);
   }
   EXPECT_EQ(m.patches[1].type, "wall");
-  // Band by band, in the order they had: faces 1 and 4 (owners 0, 3), then 3 (owner 2), then 2 (owner 1).
-  const std::vector<int> from = {0, 1, 4, 3, 2, 5};
+  // Band by band, in the order they had: faces 1 and 4 (owners 0, 3), then 2 (owner 1), then the
+  // top one, 3 (owner 2).
+  const std::vector<int> from = {0, 1, 4, 2, 3, 5};
   ASSERT_EQ(m.faces.size(), from.size());
   for (std::size_t k = 0; k < from.size(); ++k) {
     EXPECT_EQ(std::vector<int>(m.faces[k].begin(), m.faces[k].end()),
@@ -112,7 +118,7 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   p.owner = before.owner;
   p.patches = before.patches;
   p.cells = before.cells;
-  const std::vector<GapBand> same = split_particles_by_gap(p, bed, 1.0, {0.5, 0.85});
+  const std::vector<GapBand> same = split_particles_by_gap(p, bed, 1.0, {0.5, 0.85}, 0.0, 1.4);
   for (std::size_t k = 0; k < from.size(); ++k) {
     const auto face = p.faces[k];
     EXPECT_EQ(std::vector<int>(face.begin(), face.end()),
@@ -123,6 +129,6 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   // Without a particles patch nothing changes.
   meshing::PolyMesh empty = before;
   empty.patches = {{"inlet", "patch", 0, 6}};
-  EXPECT_TRUE(split_particles_by_gap(empty, bed, 1.0, {0.5}).empty());
+  EXPECT_TRUE(split_particles_by_gap(empty, bed, 1.0, {0.5}, 0.0, 1.4).empty());
   EXPECT_EQ(empty.patches.size(), 1u);
 }
