@@ -132,3 +132,33 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   EXPECT_TRUE(split_particles_by_gap(empty, bed, 1.0, {0.5}, 0.0, 1.4).empty());
   EXPECT_EQ(empty.patches.size(), 1u);
 }
+
+// A band's projected area and moment are OpenFOAM's face area vectors out of the fluid (into the
+// solid): over a closed solid, sum S_z = 0 and sum z S_z = -its volume (Gauss), here an octahedron
+// inscribed in sphere A (volume 4 a^3 / 3), all its faces in one band.
+TEST(DragRegions, ProjectedAreaAndMomentFollowTheFacesIntoTheSolid) {
+  const Bed bed = two_spheres();
+  const Eigen::Vector3d c = bed.centres[0];
+  const double a = 0.5;
+  meshing::PolyMesh m;
+  m.cells = 1;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double sign : {-1.0, 1.0}) m.points.push_back(c + sign * a * Eigen::Vector3d::Unit(axis));
+  for (int sx = 0; sx < 2; ++sx)
+    for (int sy = 0; sy < 2; ++sy)
+      for (int sz = 0; sz < 2; ++sz) {
+        std::array<int, 3> t{sx, 2 + sy, 4 + sz};
+        const Eigen::Vector3d n =
+            (m.points[t[1]] - m.points[t[0]]).cross(m.points[t[2]] - m.points[t[0]]);
+        if (n.dot(m.points[t[0]] - c) > 0.0) std::swap(t[1], t[2]);  // towards the centre: into the solid
+        m.faces.push_back(meshing::Face(t));
+        m.owner.push_back(0);
+      }
+  m.patches = {{"particles", "wall", 0, 8}};
+  const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {10.0}, -5.0, 5.0);
+  ASSERT_EQ(bands.size(), 3u);
+  EXPECT_EQ(bands[0].faces, 8);
+  EXPECT_NEAR(bands[0].area_z_m2, 0.0, 1e-15);
+  EXPECT_NEAR(bands[0].moment_z_m3, -4.0 * a * a * a / 3.0, 1e-12);
+  EXPECT_NEAR(bands[0].area_m2, 8.0 * std::sqrt(3.0) / 2.0 * a * a, 1e-12);  // 8 equilateral of side a sqrt 2
+}
