@@ -149,8 +149,8 @@ std::string dict(const std::string& cls, const std::string& location, const std:
 
 // Walls and particles take the same conditions unless `particles` gives the particles their own
 // (walls that slip); `.*wall` matches wall and inner_wall, `particles.*` the particles' patches
-// split by gap (drag_regions.hpp). The constraint types cover processor
-// patches, so the fields serve snappyHexMesh's cells as they come, decomposed.
+// split by gap (drag_regions.hpp). The constraint types cover processor patches, so the fields
+// serve snappyHexMesh's cells as they come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
                            const std::string& particles = {}) {
   const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles.*)\"\n    {{\n{}    }}\n", walls)
@@ -668,6 +668,9 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
   std::vector<GapBand> gap_bands;
+  auto split_by_gap = [&](auto& written) {
+    return split_particles_by_gap(written, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
+  };
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
     // On polyhedra the case holds the dual of gmsh's cells, made here as `polyDualMesh 80` makes
     // it (which peaked at about 1 kB per tetrahedron).
@@ -678,13 +681,13 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                                                       fmt::format("bad_polyhedra_{}.vtk", case_dir.filename().string()));
       polyhedra_quality->ears_cut = static_cast<long>(ears.size());
       if (g.periodic) meshing::match_every_cyclic_pair(dual);
-      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(dual, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_by_gap(dual);
       write_poly_mesh(tmp / "constant/polyMesh", dual, p.binary, note);
       cells = dual.cells;
     } else if (mesh && (g.periodic || !p.drag_by_gap_d.empty())) {  // a copy, changed
       meshing::PolyMesh changed = *mesh;
       if (g.periodic) meshing::match_every_cyclic_pair(changed);
-      if (!p.drag_by_gap_d.empty()) gap_bands = split_particles_by_gap(changed, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
+      if (!p.drag_by_gap_d.empty()) gap_bands = split_by_gap(changed);
       write_poly_mesh(tmp / "constant/polyMesh", changed, p.binary, note);
     } else if (mesh) {
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);

@@ -66,8 +66,9 @@ cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1
         per sphere, its error against the extrapolation with the narrowest band, and the issue's targets.
 cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge d (contact edge half of it,
         some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed; the
-        particles' drag split by the gap at their faces (GAP_BANDS_D), each route's drag by kind and band level by
-        level: where the error sits (issue 57, item 1).
+        particles' drag in the bed section split by the gap at their faces (GAP_BANDS_D): each route's drag by
+        kind (walls; the particles' form and viscous drag) and band, level by level: where the error sits
+        (issue 57, item 1).
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
         and study).
 verification_spheres: on each of the cost sections' routes, a column of a simple cubic array of spheres in
