@@ -45,18 +45,7 @@ nlohmann::json FlowResult::to_json() const {
           {"pressure_drop_inlet_outlet_pa", pressure_drop_inlet_outlet_pa},
           {"flow_rate_m3_s", flow_rate_m3_s},
           {"flow_rate_relative_error", flow_rate_relative_error},
-          {"drag",
-           {{"walls_n", drag_walls_n},
-            {"walls_viscous_n", drag_walls_viscous_n},
-            {"particles_n", drag_particles_n},
-            {"particles_viscous_n", drag_particles_viscous_n},
-            {"push_inlet_outlet_n", push_inlet_outlet_n},
-            {"wall_share", wall_share_of_drag},
-            {"force_balance_relative_error", force_balance_relative_error}}}};
-  if (!drag_particles_by_gap.empty()) {
-    j["drag"]["particles_by_gap"] = nlohmann::json::array();
-    for (const GapBand& b : drag_particles_by_gap) j["drag"]["particles_by_gap"].push_back(b.to_json());
-  }
+          {"drag", drag.to_json()}};
   if (van_der_hoef_pa_m) {
     j["van_der_hoef_pa_m"] = *van_der_hoef_pa_m;
     j["ratio_to_van_der_hoef"] = *ratio_to_van_der_hoef;
@@ -445,12 +434,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
                                          u * c.inlet_area_m2));
   const ForceZ walls = c.walls ? last_force_z(case_dir, "forceWalls") : ForceZ{};
   const ForceZ particles = c.particles ? last_force_z(case_dir, "forceParticles") : ForceZ{};
-  r.drag_walls_n = walls.total, r.drag_walls_viscous_n = walls.viscous;
-  r.drag_particles_n = particles.total, r.drag_particles_viscous_n = particles.viscous;
-  r.drag_particles_by_gap = c.gap_bands;
+  r.drag.walls_n = walls.total, r.drag.walls_viscous_n = walls.viscous;
+  r.drag.particles_n = particles.total, r.drag.particles_viscous_n = particles.viscous;
+  r.drag.particles_by_gap = c.gap_bands;
   // The section's mean pressure (Pa), linear between its planes: p_low - gradient (z - z_low).
   const double p_low = periodic ? 0.0 : rho * bottom[n - 1], mean_gradient = periodic ? 0.0 : gradient;
-  for (GapBand& b : r.drag_particles_by_gap) {
+  for (GapBand& b : r.drag.particles_by_gap) {
     if (b.faces == 0) continue;  // no forces object
     const ForceZ f = last_force_z(case_dir, b.force_object());
     b.drag_n = f.total, b.viscous_n = f.viscous;
@@ -459,12 +448,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   // What pushes the fluid: the pressure on the inlet and outlet, or in a periodic section the
   // driving gradient over the fluid's volume (the cells solved on).
   if (periodic)
-    r.push_inlet_outlet_n = rho * its[n - 1].driving_gradient * r.solved_volume_m3.value_or(c.fluid_volume_m3.value_or(0.0));
+    r.drag.push_inlet_outlet_n = rho * its[n - 1].driving_gradient * r.solved_volume_m3.value_or(c.fluid_volume_m3.value_or(0.0));
   else
-    r.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet").total + last_force_z(case_dir, "forceOutlet").total);
-  const double drag = r.drag_walls_n + r.drag_particles_n;
-  r.wall_share_of_drag = r.drag_walls_n / drag;
-  r.force_balance_relative_error = drag / r.push_inlet_outlet_n - 1.0;
+    r.drag.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet").total + last_force_z(case_dir, "forceOutlet").total);
+  const double drag = r.drag.walls_n + r.drag.particles_n;
+  r.drag.wall_share = r.drag.walls_n / drag;
+  r.drag.force_balance_relative_error = drag / r.drag.push_inlet_outlet_n - 1.0;
   if (c.stokes_array) {
     r.van_der_hoef_pa_m = c.stokes_array->pa_m;
     r.ratio_to_van_der_hoef = gradient / c.stokes_array->pa_m;

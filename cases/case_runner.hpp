@@ -38,17 +38,7 @@ struct FlowResult {
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
-  // Forces along the flow (N, OpenFOAM's forces function object, pressure and viscous, over the
-  // whole domain): the drag on the walls and on the particles, and the push of the fluid through
-  // the inlet and outlet. Steady flow conserves momentum, so the drag equals the push but for the
-  // momentum flux difference between inlet and outlet (rho u^2 A / 3 from a plug to a parabola),
-  // the solver's convergence and the wall gradient the forces object takes (a discretisation
-  // error, falling as the mesh refines).
-  double drag_walls_n = 0.0, drag_particles_n = 0.0, push_inlet_outlet_n = 0.0;
-  double drag_walls_viscous_n = 0.0, drag_particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
-  std::vector<GapBand> drag_particles_by_gap;  // with case.drag_by_gap_d: the particles' drag by the gap
-  double wall_share_of_drag = 0.0;            // drag_walls / (drag_walls + drag_particles)
-  double force_balance_relative_error = 0.0;  // (drag_walls + drag_particles) / push - 1
+  Drag drag;  // the forces on the walls and particles, and the push through inlet and outlet
   // A case with a known answer (no correlation is compared): the exact gradient and the relative
   // error dp/L / exact - 1. Otherwise unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;

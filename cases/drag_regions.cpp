@@ -3,11 +3,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <unordered_map>
+
+#include "core/sphere_grid.hpp"
 
 namespace bedforge::cases {
 
@@ -18,6 +18,7 @@ std::string GapBand::force_object() const {
 
 nlohmann::json GapBand::to_json() const {
   return {{"patch", patch()},
+          {"number", number},
           {"in_section", in_section},
           {"gap_from_d", from_d},
           {"gap_to_d", std::isfinite(to_d) ? nlohmann::json(to_d) : nlohmann::json()},
@@ -42,76 +43,69 @@ GapBand GapBand::from_json(const nlohmann::json& j) {
   b.drag_n = j.at("drag_n").get<double>();
   b.viscous_n = j.at("viscous_n").get<double>();
   b.in_section = j.at("in_section").get<bool>();
-  const std::string patch = j.at("patch").get<std::string>();
-  if (b.in_section) b.number = std::atoi(patch.c_str() + std::string("particles_gap").size());
+  b.number = j.at("number").get<int>();
   return b;
+}
+
+nlohmann::json Drag::to_json() const {
+  nlohmann::json j{{"walls_n", walls_n},
+                   {"walls_viscous_n", walls_viscous_n},
+                   {"particles_n", particles_n},
+                   {"particles_viscous_n", particles_viscous_n},
+                   {"push_inlet_outlet_n", push_inlet_outlet_n},
+                   {"wall_share", wall_share},
+                   {"force_balance_relative_error", force_balance_relative_error}};
+  if (!particles_by_gap.empty()) {
+    j["particles_by_gap"] = nlohmann::json::array();
+    for (const GapBand& b : particles_by_gap) j["particles_by_gap"].push_back(b.to_json());
+  }
+  return j;
+}
+
+Drag Drag::from_json(const nlohmann::json& j) {
+  Drag d;
+  d.walls_n = j.at("walls_n").get<double>();
+  d.walls_viscous_n = j.at("walls_viscous_n").get<double>();
+  d.particles_n = j.at("particles_n").get<double>();
+  d.particles_viscous_n = j.at("particles_viscous_n").get<double>();
+  d.push_inlet_outlet_n = j.at("push_inlet_outlet_n").get<double>();
+  d.wall_share = j.at("wall_share").get<double>();
+  d.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
+  for (const auto& b : j.value("particles_by_gap", nlohmann::json::array())) d.particles_by_gap.push_back(GapBand::from_json(b));
+  return d;
 }
 
 std::vector<double> gaps_at_particle_points(const std::vector<Eigen::Vector3d>& points, const Bed& bed, double reach) {
   const Periodicity period = bed.container->periodicity();
-  double r_max = 0.0;
-  for (double d : bed.diameters) r_max = std::max(r_max, 0.5 * d);
+  std::vector<double> radii(bed.size());
+  for (std::size_t i = 0; i < bed.size(); ++i) radii[i] = 0.5 * bed.diameters[i];
+  const double r_max = radii.empty() ? 0.0 : *std::max_element(radii.begin(), radii.end());
   // Cells at least as wide as the farthest sphere centre that can matter (its surface within
-  // reach): a periodic axis takes a whole number of them over its period.
-  const double h = reach + 2.0 * r_max;
-  const std::array<double, 3> periods{period.lx, period.ly, period.lz};
-  std::array<int, 3> n{};
-  std::array<double, 3> width{};
-  for (int a = 0; a < 3; ++a) {
-    n[a] = periods[a] > 0.0 ? std::max(1, static_cast<int>(std::floor(periods[a] / h))) : 0;
-    width[a] = periods[a] > 0.0 ? periods[a] / n[a] : h;
-  }
-  auto cell_of = [&](const Eigen::Vector3d& x) {
-    const Eigen::Vector3d w = period.wrapped(x);
-    std::array<long, 3> c{};
-    for (int a = 0; a < 3; ++a) {
-      // Across x and y a period is wrapped to [-L/2, L/2), along z to [0, L).
-      const double from = periods[a] > 0.0 && a < 2 ? -0.5 * periods[a] : 0.0;
-      c[a] = static_cast<long>(std::floor((w[a] - from) / width[a]));
-      if (n[a] > 0) c[a] = std::clamp<long>(c[a], 0, n[a] - 1);
-    }
-    return c;
-  };
-  auto key = [](const std::array<long, 3>& c) {
-    return (static_cast<std::uint64_t>(c[0] + (1 << 20)) << 42) ^ (static_cast<std::uint64_t>(c[1] + (1 << 20)) << 21) ^
-           static_cast<std::uint64_t>(c[2] + (1 << 20));
-  };
-  std::unordered_map<std::uint64_t, std::vector<int>> grid;
-  for (std::size_t i = 0; i < bed.size(); ++i) grid[key(cell_of(bed.centres[i]))].push_back(static_cast<int>(i));
+  // reach of a point on another sphere).
+  SphereGrid grid;
+  grid.build(bed.centres, radii, *bed.container, reach + 2.0 * r_max);
 
   std::vector<double> gaps(points.size(), reach);
 #pragma omp parallel for schedule(static)
   for (std::size_t k = 0; k < points.size(); ++k) {
-    const Eigen::Vector3d& x = points[k];
-    // The spheres in the 27 cells around x (a periodic axis of fewer than 3 cells: each once).
-    const std::array<long, 3> c = cell_of(x);
+    const Eigen::Vector3d x = period.wrapped(points[k]);
     double own = std::numeric_limits<double>::infinity(), nearest = own, second = own;
-    std::array<std::vector<long>, 3> along;
-    for (int a = 0; a < 3; ++a)
-      for (long o = -1; o <= 1; ++o) {
-        long i = c[a] + o;
-        if (n[a] > 0) i = ((i % n[a]) + n[a]) % n[a];
-        if (std::find(along[a].begin(), along[a].end(), i) == along[a].end()) along[a].push_back(i);
-      }
-    for (long i : along[0])
-      for (long j : along[1])
-        for (long l : along[2]) {
-          const auto it = grid.find(key({i, j, l}));
-          if (it == grid.end()) continue;
-          for (int s : it->second) {
-            const double to_surface = period.separation(x, bed.centres[s]).norm() - 0.5 * bed.diameters[s];
-            // The sphere x lies on is the one whose surface is nearest in absolute value.
-            if (std::abs(to_surface) < own) {
-              second = std::min(second, nearest);
-              own = std::abs(to_surface), nearest = to_surface;
-            } else {
-              second = std::min(second, to_surface);
-            }
-          }
+    grid.for_each_run_around(x, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s) {
+        const Eigen::Vector4d& q = grid.centre_and_radius(s);
+        const double to_surface = period.separation(x, q.head<3>()).norm() - q.w();
+        // The sphere x lies on is the one whose surface is nearest in absolute value.
+        if (std::abs(to_surface) < own) {
+          second = std::min(second, nearest);
+          own = std::abs(to_surface), nearest = to_surface;
+        } else {
+          second = std::min(second, to_surface);
         }
+      }
+    });
     double gap = second;
     WallContact walls[Container::kMaxWallContacts];
-    const int touching = bed.container->wall_contacts(x, reach, walls);
+    const int touching = bed.container->wall_contacts(points[k], reach, walls);
     for (int w = 0; w < touching; ++w) gap = std::min(gap, reach - walls[w].overlap);
     gaps[k] = std::clamp(gap, 0.0, reach);
   }

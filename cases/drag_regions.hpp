@@ -29,18 +29,35 @@ struct GapBand {
   // less that of the section's mean pressure, linear between its planes (in a periodic section,
   // whose pressure has no mean gradient, less that of p = 0): the band's own form drag.
   double drag_n = 0.0, viscous_n = 0.0, form_n = 0.0;
-  int number = 0;                   // from 0, the narrowest
+  int number = 0;                   // from 0, the narrowest; particles_ends last
   std::string patch() const;        // its patch: particles_gap<number>, or particles_ends
   std::string force_object() const; // its forces function object: forceParticlesGap<number>, or forceParticlesEnds
   nlohmann::json to_json() const;
   static GapBand from_json(const nlohmann::json& j);
 };
 
+// The forces along the flow (N, OpenFOAM's forces function objects, pressure and viscous, over the
+// whole domain): the drag on the walls and on the particles, and the push of the fluid through
+// the inlet and outlet (in a periodic section, the driving gradient over the fluid's volume).
+// Steady flow conserves momentum, so the drag equals the push but for the momentum flux
+// difference between inlet and outlet (rho u^2 A / 3 from a plug to a parabola), the solver's
+// convergence and the wall gradient the forces object takes (a discretisation error, falling as
+// the mesh refines).
+struct Drag {
+  double walls_n = 0.0, particles_n = 0.0, push_inlet_outlet_n = 0.0;
+  double walls_viscous_n = 0.0, particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
+  std::vector<GapBand> particles_by_gap;     // with case.drag_by_gap_d: the particles' drag by the gap
+  double wall_share = 0.0;                   // walls / (walls + particles)
+  double force_balance_relative_error = 0.0; // (walls + particles) / push - 1
+  nlohmann::json to_json() const;
+  static Drag from_json(const nlohmann::json& j);
+};
+
 // Gap (m) at each point of `points` lying on a particle's surface (as meshed: to within a cell of
 // it): the distance from the point to the nearest sphere (minimum image in a periodic container)
 // other than the one it lies on (the nearest, by |distance to the surface|), or to the nearest
 // wall, whichever is less, at least 0; capped at `reach` (m): a gap wider than it reads `reach`.
-// Spheres are found on a cell grid, so the work is O(points + spheres).
+// Spheres are found on a cell grid (core/sphere_grid.hpp), so the work is O(points + spheres).
 std::vector<double> gaps_at_particle_points(const std::vector<Eigen::Vector3d>& points, const Bed& bed, double reach);
 
 // Splits `mesh`'s patch "particles" into one patch per band of the gap at its faces' centres,

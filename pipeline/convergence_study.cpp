@@ -37,18 +37,8 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged},
                 {"cells_failing_check_mesh", l.cells_failing_check_mesh},
-                {"wall_share_of_drag", l.wall_share_of_drag},
-                {"force_balance_relative_error", l.force_balance_relative_error},
                 {"own_time_s", l.own_time_s},
-                {"drag",
-                 {{"walls_n", l.drag_walls_n},
-                  {"walls_viscous_n", l.drag_walls_viscous_n},
-                  {"particles_n", l.drag_particles_n},
-                  {"particles_viscous_n", l.drag_particles_viscous_n}}}});
-      if (!l.drag_particles_by_gap.empty()) {
-        j["drag"]["particles_by_gap"] = nlohmann::json::array();
-        for (const cases::GapBand& b : l.drag_particles_by_gap) j["drag"]["particles_by_gap"].push_back(b.to_json());
-      }
+                {"drag", l.drag.to_json()}});
       if (exact_pa_m) j["relative_error_to_exact"] = l.pressure_gradient_pa_m / *exact_pa_m - 1.0;
     } else {
       j["failure"] = l.failure;
@@ -84,18 +74,8 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   l.pressure_gradient_pa_m = j.at("pressure_gradient_bed_pa_m").get<double>();
   l.converged = j.at("converged").get<bool>();
   l.cells_failing_check_mesh = j.value("cells_failing_check_mesh", 0L);  // reports before 2026-11-29 lack it
-  l.wall_share_of_drag = j.at("wall_share_of_drag").get<double>();
-  l.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
   l.own_time_s = j.at("own_time_s").get<double>();
-  if (j.contains("drag")) {  // reports before 2026-12-06 lack it
-    const nlohmann::json& drag = j["drag"];
-    l.drag_walls_n = drag.at("walls_n").get<double>();
-    l.drag_walls_viscous_n = drag.at("walls_viscous_n").get<double>();
-    l.drag_particles_n = drag.at("particles_n").get<double>();
-    l.drag_particles_viscous_n = drag.at("particles_viscous_n").get<double>();
-    for (const auto& b : drag.value("particles_by_gap", nlohmann::json::array()))
-      l.drag_particles_by_gap.push_back(cases::GapBand::from_json(b));
-  }
+  l.drag = cases::Drag::from_json(j.at("drag"));
   l.exact_pa_m = exact_pa_m;
   return l;
 }
@@ -119,12 +99,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
   if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
-  l.wall_share_of_drag = solved.flow->wall_share_of_drag;
-  l.drag_walls_n = solved.flow->drag_walls_n, l.drag_walls_viscous_n = solved.flow->drag_walls_viscous_n;
-  l.drag_particles_n = solved.flow->drag_particles_n;
-  l.drag_particles_viscous_n = solved.flow->drag_particles_viscous_n;
-  l.drag_particles_by_gap = solved.flow->drag_particles_by_gap;
-  l.force_balance_relative_error = solved.flow->force_balance_relative_error;
+  l.drag = solved.flow->drag;
   l.exact_pa_m = solved.flow->exact_pa_m;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
   l.time_s = solved.report["time_s"].get<double>();

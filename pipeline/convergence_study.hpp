@@ -23,12 +23,9 @@ struct StudyLevel {
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
   long cells_failing_check_mesh = 0;  // polyhedra that fail checkMesh's limits (meshing::check_polyhedra)
-  double wall_share_of_drag = 0.0;            // the walls' share of the drag (cases::FlowResult)
-  // The drag along the flow (N) by kind, all and its viscous part, and with case.drag_by_gap_d the
-  // particles' by the gap at their faces (cases::FlowResult): where the level's error sits.
-  double drag_walls_n = 0.0, drag_walls_viscous_n = 0.0, drag_particles_n = 0.0, drag_particles_viscous_n = 0.0;
-  std::vector<cases::GapBand> drag_particles_by_gap;
-  double force_balance_relative_error = 0.0;  // drag against the push through inlet and outlet, - 1
+  // The drag by kind, and with case.drag_by_gap_d the particles' by the gap at their faces
+  // (cases::FlowResult): where the level's error sits.
+  cases::Drag drag;
   double time_s = 0.0;        // this run's time for the level: surface, mesh and flow of a coarser one
                               // (every sizing attempt); the flow alone of the finest (its surface and
                               // mesh may be reused)

@@ -1580,13 +1580,20 @@ def error_seat_lines(r):
     return lines + [""]
 
 
+def level_drag(level, key):
+    """A level's drag entry: under "drag" since 2026-12-06, at the level before; runs before
+    2026-11-26 did not record it (None)."""
+    return level.get("drag", {}).get(key, level.get(key + "_of_drag" if key == "wall_share" else key))
+
+
 def drag_share(level):
-    """The walls' share of a level's drag; runs before 2026-11-26 did not record it."""
-    return f"{100 * level['wall_share_of_drag']:.1f} %" if "wall_share_of_drag" in level else "not recorded"
+    share = level_drag(level, "wall_share")
+    return "not recorded" if share is None else f"{100 * share:.1f} %"
 
 
 def drag_balance(level):
-    return f"{100 * level['force_balance_relative_error']:+.2f} %" if "force_balance_relative_error" in level else ""
+    balance = level_drag(level, "force_balance_relative_error")
+    return "" if balance is None else f"{100 * balance:+.2f} %"
 
 
 def study_values(r):

@@ -126,6 +126,18 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   }
   EXPECT_EQ(same[2].faces, 1);
 
+  // The bands, in a Drag, read back from its JSON as they were (a study reads its levels back).
+  Drag drag;
+  drag.particles_by_gap = bands;
+  drag.walls_n = 1.5, drag.particles_by_gap[3].form_n = -0.25;
+  const Drag back = Drag::from_json(drag.to_json());
+  EXPECT_EQ(back.to_json(), drag.to_json());
+  ASSERT_EQ(back.particles_by_gap.size(), bands.size());
+  for (std::size_t k = 0; k < bands.size(); ++k) {
+    EXPECT_EQ(back.particles_by_gap[k].number, bands[k].number);
+    EXPECT_EQ(back.particles_by_gap[k].patch(), bands[k].patch());
+  }
+
   // Without a particles patch nothing changes.
   meshing::PolyMesh empty = before;
   empty.patches = {{"inlet", "patch", 0, 6}};

@@ -362,9 +362,9 @@ TEST(RunScene, TheEmptyTubeExampleMatchesHagenPoiseuille) {
     // from plug to parabola (-0.32 %) and the forces object's wall gradient, whose error grows on
     // coarser cells: measured (2026-11-26) -1.5 % at 5 k cells, -1.5 % at 2 k, -1.8 and -2.1 %
     // at 1 k. Hence 2 % on the finest, 3 % on the others.
-    EXPECT_LT(std::abs(level["force_balance_relative_error"].get<double>()), level["level"] == 1 ? 0.02 : 0.03)
+    EXPECT_LT(std::abs(level["drag"]["force_balance_relative_error"].get<double>()), level["level"] == 1 ? 0.02 : 0.03)
         << level.dump();
-    EXPECT_EQ(level["wall_share_of_drag"].get<double>(), 1.0);  // no particles: no other drag
+    EXPECT_EQ(level["drag"]["wall_share"].get<double>(), 1.0);  // no particles: no other drag
   }
   EXPECT_FALSE(c["flow"].contains("eisfeld_schnitzlein_pa_m"));  // no correlation for an empty tube
   EXPECT_NE(study["conclusion"].get<std::string>().find("against the exact"), std::string::npos);
