@@ -5,10 +5,11 @@
 #include <vector>
 
 #include "core/container.hpp"
+#include "core/sphere_grid.hpp"
 
 namespace bedforge {
 
-// Verlet list built on a cell grid: for each sphere, every sphere whose surface is closer than
+// Verlet list built on a cell grid (core/sphere_grid.hpp): for each sphere, every sphere whose surface is closer than
 // `skin`. The list is rebuilt only when the two largest displacements since the last build sum
 // to more than the skin, so between rebuilds it still holds every touching pair. Work and memory are O(N).
 // Each sphere lists all its neighbours (both directions), so forces are gathered per sphere in
@@ -32,11 +33,8 @@ class NeighbourList {
   std::vector<std::size_t> offsets_;
   std::vector<int> list_;
   std::vector<Eigen::Vector3d> built_at_;
-  // Work arrays of build(), kept so frequent rebuilds allocate nothing.
-  std::vector<long> cell_;
-  std::vector<std::size_t> start_, fill_;
-  std::vector<int> sorted_;
-  std::vector<Eigen::Vector4d> in_cells_;  // centre and radius, in cell order
+  // Kept so frequent rebuilds allocate nothing.
+  SphereGrid grid_;
   std::vector<int> scratch_;    // n rows of capacity_ neighbours
   std::size_t capacity_ = 32;
 };
