@@ -437,6 +437,10 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.drag.walls_n = walls.total, r.drag.walls_viscous_n = walls.viscous;
   r.drag.particles_n = particles.total, r.drag.particles_viscous_n = particles.viscous;
   r.drag.particles_by_gap = c.gap_bands;
+  if (c.wall_faces_beyond_section > 0) {
+    const ForceZ ends = last_force_z(case_dir, "forceWallsEnds");
+    r.drag.walls_ends_n = ends.total, r.drag.walls_ends_viscous_n = ends.viscous;
+  }
   // The section's mean pressure (Pa), linear between its planes: p_low - gradient (z - z_low).
   const double p_low = periodic ? 0.0 : rho * bottom[n - 1], mean_gradient = periodic ? 0.0 : gradient;
   for (GapBand& b : r.drag.particles_by_gap) {

@@ -148,13 +148,13 @@ std::string dict(const std::string& cls, const std::string& location, const std:
 }
 
 // Walls and particles take the same conditions unless `particles` gives the particles their own
-// (walls that slip); `.*wall` matches wall and inner_wall, `particles.*` the particles' patches
-// split by gap (drag_regions.hpp). The constraint types cover processor patches, so the fields
+// (walls that slip); `.*wall` matches wall and inner_wall, `.*wall_ends` their parts beyond the
+// section and `particles.*` the particles' patches split by gap (drag_regions.hpp). The constraint types cover processor patches, so the fields
 // serve snappyHexMesh's cells as they come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
                            const std::string& particles = {}) {
-  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|particles.*)\"\n    {{\n{}    }}\n", walls)
-                                               : fmt::format("    \".*wall\"\n    {{\n{}    }}\n"
+  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|.*wall_ends|particles.*)\"\n    {{\n{}    }}\n", walls)
+                                               : fmt::format("    \"(.*wall|.*wall_ends)\"\n    {{\n{}    }}\n"
                                                              "    \"particles.*\"\n    {{\n{}    }}\n",
                                                              walls, particles);
   return fmt::format("boundaryField\n{{\n    #includeEtc \"caseDicts/setConstraintTypes\"\n"
@@ -388,7 +388,8 @@ void write_fields(const fs::path& tmp, const CaseParams& p, double u, double nu,
 // controlDict: the iteration cap and, as function objects, the pressure averaged over the inlet,
 // the outlet and the section's planes, the flow rate and the forces on every solid patch.
 void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSection& section, bool particles,
-                        bool walls, bool periodic, const std::vector<GapBand>& gap_bands, const std::string& note) {
+                        bool walls, bool periodic, const std::vector<GapBand>& gap_bands, long wall_faces_beyond,
+                        const std::string& note) {
   const std::string fmt_word = p.binary ? "binary" : "ascii";
   // A periodic section's pressure is periodic: the gradient is meanVelocityForce's, and the
   // cyclic patches carry no force.
@@ -403,7 +404,8 @@ void write_control_dict(const fs::path& tmp, const CaseParams& p, const BedSecti
                       surface_value("pBedTop", plane_region("bedTop", section.z_high), "areaAverage", "p")) +
       surface_value("flowRate", patch_region("outlet"), "sum", "phi") +
       // Without walls no patch matches, and OpenFOAM's forces then takes the particles again.
-      (walls ? forces("forceWalls", "\"(.*wall)\"", p.density_kg_m3) : std::string()) +
+      (walls ? forces("forceWalls", "\"(.*wall|.*wall_ends)\"", p.density_kg_m3) : std::string()) +
+      (wall_faces_beyond > 0 ? forces("forceWallsEnds", "\".*wall_ends\"", p.density_kg_m3) : std::string()) +
       (particles ? forces("forceParticles", "\"particles.*\"", p.density_kg_m3) : std::string()) +
       gap_forces +
       (periodic ? std::string()
@@ -668,7 +670,9 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   long cells = mesh ? mesh->cells : 0;  // as written
   std::optional<meshing::JudgedQuality> polyhedra_quality;
   std::vector<GapBand> gap_bands;
+  long wall_faces_beyond_section = 0;
   auto split_by_gap = [&](auto& written) {
+    wall_faces_beyond_section = split_walls_at_section(written, section.z_low, section.z_high);
     return split_particles_by_gap(written, bed, g.d_ref, p.drag_by_gap_d, section.z_low, section.z_high);
   };
   write_directory_atomically(case_dir, [&](const fs::path& tmp) {
@@ -693,7 +697,8 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
       write_poly_mesh(tmp / "constant/polyMesh", *mesh, p.binary, note);
     }
     write_fields(tmp, p, u, nu, g.d_ref, ubar, inlet_flow, note);
-    write_control_dict(tmp, p, section, bed.size() > 0, walls, g.periodic, gap_bands, note);
+    write_control_dict(tmp, p, section, bed.size() > 0, walls, g.periodic, gap_bands, wall_faces_beyond_section,
+                       note);
     write_solver_settings(tmp, p, g.periodic, note);
     write_text(tmp / "Allrun", allrun(p, section, g.periodic), true);
     write_text(tmp / "Allclean", kAllclean, true);
@@ -709,6 +714,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   info.mean_velocity_m_s = ubar;
   info.polyhedra_quality = polyhedra_quality;
   info.gap_bands = std::move(gap_bands);
+  info.wall_faces_beyond_section = wall_faces_beyond_section;
   set_known_answers(info, bed, sphere_scale);
   return info;
 }

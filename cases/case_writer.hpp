@@ -96,8 +96,10 @@ struct CaseInfo {
   std::optional<double> mean_velocity_m_s = std::nullopt;
   // On polyhedra written here: their worst figures, as checked (check_polyhedra).
   std::optional<meshing::JudgedQuality> polyhedra_quality = std::nullopt;
-  // With case.drag_by_gap_d: the particles' patches by gap, their faces and areas (no forces yet).
+  // With case.drag_by_gap_d: the particles' patches by gap, their faces and areas (no forces yet),
+  // and the walls' faces beyond the section's planes (split_walls_at_section).
   std::vector<GapBand> gap_bands{};
+  long wall_faces_beyond_section = 0;
   nlohmann::json to_json() const;        // its report.json entry
 };
 

@@ -58,6 +58,8 @@ nlohmann::json Drag::to_json() const {
   if (!particles_by_gap.empty()) {
     j["particles_by_gap"] = nlohmann::json::array();
     for (const GapBand& b : particles_by_gap) j["particles_by_gap"].push_back(b.to_json());
+    j["walls_ends_n"] = walls_ends_n;
+    j["walls_ends_viscous_n"] = walls_ends_viscous_n;
   }
   return j;
 }
@@ -71,7 +73,11 @@ Drag Drag::from_json(const nlohmann::json& j) {
   d.push_inlet_outlet_n = j.at("push_inlet_outlet_n").get<double>();
   d.wall_share = j.at("wall_share").get<double>();
   d.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
-  for (const auto& b : j.value("particles_by_gap", nlohmann::json::array())) d.particles_by_gap.push_back(GapBand::from_json(b));
+  if (j.contains("particles_by_gap")) {
+    for (const auto& b : j["particles_by_gap"]) d.particles_by_gap.push_back(GapBand::from_json(b));
+    d.walls_ends_n = j.at("walls_ends_n").get<double>();
+    d.walls_ends_viscous_n = j.at("walls_ends_viscous_n").get<double>();
+  }
   return d;
 }
 
@@ -142,6 +148,38 @@ void reorder_faces(meshing::PolyhedralMesh& m, const std::vector<int>& order) {
   m.owner = std::move(owner);
 }
 
+// Splits patch `at` of `m` into one patch per name of `names` (each keeping the patch's type), its
+// face k going to names[band_of[k]], each part in the order its faces had; returns each part's
+// faces. The other patches and the cells are not touched.
+template <class Mesh>
+std::vector<long> split_patch(Mesh& m, std::size_t at, const std::vector<int>& band_of,
+                              const std::vector<std::string>& names) {
+  const meshing::PolyMesh::Patch whole = m.patches[at];
+  std::vector<long> faces(names.size(), 0);
+  for (int b : band_of) ++faces[b];
+  std::vector<int> order(m.owner.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin() + whole.start, order.begin() + whole.start + whole.size,
+                   [&](int a, int b) { return band_of[a - whole.start] < band_of[b - whole.start]; });
+  reorder_faces(m, order);
+  std::vector<meshing::PolyMesh::Patch> patches(m.patches.begin(), m.patches.begin() + at);
+  int start = whole.start;
+  for (std::size_t b = 0; b < names.size(); ++b) {
+    meshing::PolyMesh::Patch p = whole;
+    p.name = names[b];
+    p.start = start, p.size = static_cast<int>(faces[b]);
+    start += p.size;
+    patches.push_back(p);
+  }
+  patches.insert(patches.end(), m.patches.begin() + at + 1, m.patches.end());
+  m.patches = std::move(patches);
+  return faces;
+}
+
+bool beyond(const Eigen::Vector3d& centre, double z_low, double z_high) {
+  return centre.z() < z_low || centre.z() > z_high;
+}
+
 template <class Mesh>
 std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vector<double>& edges_d, double z_low,
                            double z_high) {
@@ -155,15 +193,17 @@ std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vec
   const std::vector<double> gaps = gaps_at_particle_points(centres, bed, reach);
   std::vector<GapBand> bands(edges_d.size() + 2);
   std::vector<int> band_of(particles.size);
+  std::vector<std::string> names;
   for (std::size_t b = 0; b < bands.size(); ++b) {
     bands[b].number = static_cast<int>(b);
     bands[b].from_d = b == 0 || b > edges_d.size() ? 0.0 : edges_d[b - 1];
     bands[b].to_d = b < edges_d.size() ? edges_d[b] : std::numeric_limits<double>::infinity();
     bands[b].in_section = b <= edges_d.size();
+    names.push_back(bands[b].patch());
   }
   for (int k = 0; k < particles.size; ++k) {
     const double g = gaps[k] / d_ref;
-    band_of[k] = centres[k].z() < z_low || centres[k].z() > z_high
+    band_of[k] = beyond(centres[k], z_low, z_high)
                      ? static_cast<int>(edges_d.size()) + 1
                      : static_cast<int>(std::upper_bound(edges_d.begin(), edges_d.end(), g) - edges_d.begin());
     bands[band_of[k]].faces += 1;
@@ -171,24 +211,22 @@ std::vector<GapBand> split(Mesh& m, const Bed& bed, double d_ref, const std::vec
     bands[band_of[k]].area_z_m2 += areas[k].z();
     bands[band_of[k]].moment_z_m3 += centres[k].z() * areas[k].z();
   }
-  // The patch's faces band by band, each band in the order it had.
-  std::vector<int> order(m.owner.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin() + particles.start, order.begin() + particles.start + particles.size,
-                   [&](int a, int b) { return band_of[a - particles.start] < band_of[b - particles.start]; });
-  reorder_faces(m, order);
-  std::vector<meshing::PolyMesh::Patch> patches(m.patches.begin(), at);
-  int start = particles.start;
-  for (const GapBand& b : bands) {
-    meshing::PolyMesh::Patch p = particles;
-    p.name = b.patch();
-    p.start = start, p.size = static_cast<int>(b.faces);
-    start += p.size;
-    patches.push_back(p);
-  }
-  patches.insert(patches.end(), at + 1, m.patches.end());
-  m.patches = std::move(patches);
+  split_patch(m, static_cast<std::size_t>(at - m.patches.begin()), band_of, names);
   return bands;
+}
+
+template <class Mesh>
+long split_walls(Mesh& m, double z_low, double z_high) {
+  long ends = 0;
+  for (std::size_t at = 0; at < m.patches.size(); ++at) {
+    const meshing::PolyMesh::Patch wall = m.patches[at];
+    if (wall.type != "wall" || wall.name.starts_with("particles")) continue;
+    std::vector<int> band_of(wall.size);
+    for (int k = 0; k < wall.size; ++k) band_of[k] = beyond(centre_and_area(m, wall.start + k).first, z_low, z_high);
+    ends += split_patch(m, at, band_of, {wall.name, wall.name + "_ends"})[1];
+    ++at;  // past the ends just made
+  }
+  return ends;
 }
 
 }  // namespace
@@ -200,6 +238,13 @@ std::vector<GapBand> split_particles_by_gap(meshing::PolyMesh& mesh, const Bed& 
 std::vector<GapBand> split_particles_by_gap(meshing::PolyhedralMesh& mesh, const Bed& bed, double d_ref,
                                             const std::vector<double>& edges_d, double z_low, double z_high) {
   return split(mesh, bed, d_ref, edges_d, z_low, z_high);
+}
+
+long split_walls_at_section(meshing::PolyMesh& mesh, double z_low, double z_high) {
+  return split_walls(mesh, z_low, z_high);
+}
+long split_walls_at_section(meshing::PolyhedralMesh& mesh, double z_low, double z_high) {
+  return split_walls(mesh, z_low, z_high);
 }
 
 }  // namespace bedforge::cases

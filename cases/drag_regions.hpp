@@ -46,7 +46,10 @@ struct GapBand {
 struct Drag {
   double walls_n = 0.0, particles_n = 0.0, push_inlet_outlet_n = 0.0;
   double walls_viscous_n = 0.0, particles_viscous_n = 0.0;  // their shear; the rest is pressure (form drag)
-  std::vector<GapBand> particles_by_gap;     // with case.drag_by_gap_d: the particles' drag by the gap
+  // With case.drag_by_gap_d: the particles' drag by the gap, and the walls' beyond the section's
+  // planes (split_walls_at_section; all and viscous), so that walls less these is the section's.
+  std::vector<GapBand> particles_by_gap;
+  double walls_ends_n = 0.0, walls_ends_viscous_n = 0.0;
   double wall_share = 0.0;                   // walls / (walls + particles)
   double force_balance_relative_error = 0.0; // (walls + particles) / push - 1
   nlohmann::json to_json() const;
@@ -71,5 +74,13 @@ std::vector<GapBand> split_particles_by_gap(meshing::PolyMesh& mesh, const Bed& 
                                             const std::vector<double>& edges_d, double z_low, double z_high);
 std::vector<GapBand> split_particles_by_gap(meshing::PolyhedralMesh& mesh, const Bed& bed, double d_ref,
                                             const std::vector<double>& edges_d, double z_low, double z_high);
+
+// Splits each wall patch of `mesh` (type "wall", not the particles') into the faces whose centre
+// lies between the section's planes z_low and z_high (m), keeping its name, and the others,
+// <name>_ends (written even when empty), so that the walls' drag in the section, where dp/L is
+// measured, is told from that along the inlet's and outlet's lengths. The patches' faces are
+// reordered, the other faces and the cells are not touched. Returns the faces beyond the section.
+long split_walls_at_section(meshing::PolyMesh& mesh, double z_low, double z_high);
+long split_walls_at_section(meshing::PolyhedralMesh& mesh, double z_low, double z_high);
 
 }  // namespace bedforge::cases

@@ -294,8 +294,9 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"`[edge, ...]`, ascending, reference diameters, at most 7: the particles' patch split by the gap at each "
         "face's centre (to the nearest other sphere or wall) into `particles_gap0` (below the first edge) to "
         "`particles_gapN` (beyond the last), of the faces in the bed section, and `particles_ends` of those beyond "
-        "its planes, each with its forces object, so that the report and the convergence "
-        "study give the particles' drag band by band: where the discretisation error sits. The cells and the flow "
+        "its planes, each with its forces object, and the walls' patches at those planes (`wall_ends` beyond "
+        "them), so that the report and the convergence study give the particles' drag band by band and the walls' "
+        "in the section: where the discretisation error sits. The cells and the flow "
         "are the same as without it; not with `mesh.pieces` > 1 or `case.mesher = \"snappy\"`"}},
       {"case.section_exclude_d",
        {"the bed section of the pressure drop: floor (or clip inlet) + this to bed top (or clip outlet) - this"}},

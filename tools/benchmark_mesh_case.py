@@ -1528,8 +1528,14 @@ def error_seat_lines(r):
     ratio = r["ratio"]
     bands = levels[0]["drag"]["particles_by_gap"]
     inside = [k for k, b in enumerate(bands) if b["in_section"]]
-    parts = [("walls (whole), pressure", lambda d: d["walls_n"] - d["walls_viscous_n"], None),
-             ("walls (whole), viscous", lambda d: d["walls_viscous_n"], None)]
+    # The walls in the section: theirs less their ends' (runs before 2026-12-06 did not split them).
+    split_walls = "walls_ends_n" in levels[0]["drag"]
+    walls = "walls in the section" if split_walls else "walls (whole)"
+    ends = (lambda d: d["walls_ends_n"]) if split_walls else (lambda d: 0.0)
+    ends_viscous = (lambda d: d["walls_ends_viscous_n"]) if split_walls else (lambda d: 0.0)
+    parts = [(f"{walls}, pressure",
+              lambda d: d["walls_n"] - d["walls_viscous_n"] - (ends(d) - ends_viscous(d)), None),
+             (f"{walls}, viscous", lambda d: d["walls_viscous_n"] - ends_viscous(d), None)]
     for k in inside:
         b = bands[k]
         span = f"gap {b['gap_from_d']:g}-{b['gap_to_d']:g} d" if b["gap_to_d"] is not None \
@@ -1537,7 +1543,7 @@ def error_seat_lines(r):
         parts += [(f"particles, {span}, form", lambda d, k=k: d["particles_by_gap"][k]["form_n"], k),
                   (f"particles, {span}, viscous", lambda d, k=k: d["particles_by_gap"][k]["viscous_n"], k)]
     # The section's drag less its mean pressure's share: about dp/L times the section's fluid volume.
-    whole = lambda d: d["walls_n"] + sum(d["particles_by_gap"][k]["form_n"] + d["particles_by_gap"][k]["viscous_n"]
+    whole = lambda d: d["walls_n"] - ends(d) + sum(d["particles_by_gap"][k]["form_n"] + d["particles_by_gap"][k]["viscous_n"]
                                          for k in inside)
     s1 = whole(levels[0]["drag"])
     area1 = sum(bands[k]["area_m2"] for k in inside)
@@ -1551,7 +1557,10 @@ def error_seat_lines(r):
              "split by the gap at their centres (to the nearest other sphere or wall); the cells are the same with "
              "and without the split. A band's faces are no closed surface, so its pressure force holds the "
              "section's mean pressure (linear between the section's planes) times their projected area; less that, "
-             "its form drag. The walls' forces are over the whole domain (not split). The parts sum to the "
+             "its form drag. "
+             + ("The walls' drag is theirs in the section (less that beyond its planes). " if split_walls
+                else "The walls' forces are over the whole domain (not split). ")
+             + "The parts sum to the "
              "section's drag less its mean pressure's share, about dp/L times the section's fluid volume. Changes "
              "are between successive levels, coarser to finer, over that sum on the finest level; the order of a "
              f"part is ln(change / next finer change) / ln {ratio} over the finest three; its error on the finest "

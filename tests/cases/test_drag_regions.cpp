@@ -148,6 +148,36 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
 // A band's projected area and moment are OpenFOAM's face area vectors out of the fluid (into the
 // solid): over a closed solid, sum S_z = 0 and sum z S_z = -its volume (Gauss), here an octahedron
 // inscribed in sphere A (volume 4 a^3 / 3), all its faces in one band.
+TEST(DragRegions, WallsAreSplitAtTheSectionsPlanes) {
+  // Wall faces at heights 0.5, 2.0 and 1.0 and an inner wall's at 3.0, between an inlet face and
+  // a particle face; the section spans z 0.8 to 1.6.
+  meshing::PolyMesh m;
+  m.cells = 6;
+  for (double z : {0.0, 0.5, 2.0, 1.0, 3.0, 1.2}) {
+    const int first = static_cast<int>(m.points.size());
+    for (const Eigen::Vector3d& e : {Eigen::Vector3d(0, 0, 1e-3), Eigen::Vector3d(1e-3, 0, 0), Eigen::Vector3d(0, 1e-3, 0)})
+      m.points.push_back(Eigen::Vector3d(0, 0, z) + e);
+    m.faces.push_back(meshing::Face{first, first + 1, first + 2});
+    m.owner.push_back(static_cast<int>(m.owner.size()));
+  }
+  m.patches = {{"inlet", "patch", 0, 1}, {"wall", "wall", 1, 3}, {"inner_wall", "wall", 4, 1}, {"particles", "wall", 5, 1}};
+  const meshing::PolyMesh before = m;
+
+  EXPECT_EQ(split_walls_at_section(m, 0.8, 1.6), 3);
+  const std::vector<std::string> names = {"inlet", "wall", "wall_ends", "inner_wall", "inner_wall_ends", "particles"};
+  const std::vector<int> starts = {0, 1, 2, 4, 4, 5}, sizes = {1, 1, 2, 0, 1, 1};
+  ASSERT_EQ(m.patches.size(), names.size());
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    EXPECT_EQ(m.patches[k].name, names[k]);
+    EXPECT_EQ(m.patches[k].start, starts[k]);
+    EXPECT_EQ(m.patches[k].size, sizes[k]);
+  }
+  EXPECT_EQ(m.patches[2].type, "wall");
+  // The face at 1.0 first, then those at 0.5 and 2.0 in their order; the rest in place.
+  const std::vector<int> from = {0, 3, 1, 2, 4, 5};
+  for (std::size_t k = 0; k < from.size(); ++k) EXPECT_EQ(m.owner[k], before.owner[from[k]]);
+}
+
 TEST(DragRegions, ProjectedAreaAndMomentFollowTheFacesIntoTheSolid) {
   const Bed bed = two_spheres();
   const Eigen::Vector3d c = bed.centres[0];
