@@ -22,6 +22,13 @@ Bed two_spheres() {
   return bed;
 }
 
+// A patch of `size` faces from `start` (no cyclic or processor fields).
+meshing::PolyMesh::Patch patch(const std::string& name, const std::string& type, int start, int size) {
+  meshing::PolyMesh::Patch p;
+  p.name = name, p.type = type, p.start = start, p.size = size;
+  return p;
+}
+
 }  // namespace
 
 // The gap at a point on a sphere is the distance to the other sphere or to the wall, whichever is
@@ -81,7 +88,7 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
   for (std::size_t k = 0; k < at.size(); ++k) triangle(at[k].first), m.owner.push_back(static_cast<int>(k));
   triangle({0.0, 0.0, 3.0});
   m.owner.push_back(3);
-  m.patches = {{"inlet", "patch", 0, 1}, {"particles", "wall", 1, 4}, {"outlet", "patch", 5, 1}};
+  m.patches = {patch("inlet", "patch", 0, 1), patch("particles", "wall", 1, 4), patch("outlet", "patch", 5, 1)};
   const meshing::PolyMesh before = m;
 
   const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {0.5, 0.85}, 0.0, 1.4);
@@ -140,7 +147,7 @@ TEST(DragRegions, SplitKeepsTheFacesAndBandsThem) {
 
   // Without a particles patch nothing changes.
   meshing::PolyMesh empty = before;
-  empty.patches = {{"inlet", "patch", 0, 6}};
+  empty.patches = {patch("inlet", "patch", 0, 6)};
   EXPECT_TRUE(split_particles_by_gap(empty, bed, 1.0, {0.5}, 0.0, 1.4).empty());
   EXPECT_EQ(empty.patches.size(), 1u);
 }
@@ -155,12 +162,14 @@ TEST(DragRegions, WallsAreSplitAtTheSectionsPlanes) {
   m.cells = 6;
   for (double z : {0.0, 0.5, 2.0, 1.0, 3.0, 1.2}) {
     const int first = static_cast<int>(m.points.size());
-    for (const Eigen::Vector3d& e : {Eigen::Vector3d(0, 0, 1e-3), Eigen::Vector3d(1e-3, 0, 0), Eigen::Vector3d(0, 1e-3, 0)})
+    for (const Eigen::Vector3d& e :
+         {Eigen::Vector3d(0, 0, 1e-3), Eigen::Vector3d(1e-3, 0, 0), Eigen::Vector3d(0, 1e-3, 0)})
       m.points.push_back(Eigen::Vector3d(0, 0, z) + e);
     m.faces.push_back(meshing::Face{first, first + 1, first + 2});
     m.owner.push_back(static_cast<int>(m.owner.size()));
   }
-  m.patches = {{"inlet", "patch", 0, 1}, {"wall", "wall", 1, 3}, {"inner_wall", "wall", 4, 1}, {"particles", "wall", 5, 1}};
+  m.patches = {patch("inlet", "patch", 0, 1), patch("wall", "wall", 1, 3), patch("inner_wall", "wall", 4, 1),
+               patch("particles", "wall", 5, 1)};
   const meshing::PolyMesh before = m;
 
   EXPECT_EQ(split_walls_at_section(m, 0.8, 1.6), 3);
@@ -196,7 +205,7 @@ TEST(DragRegions, ProjectedAreaAndMomentFollowTheFacesIntoTheSolid) {
         m.faces.push_back(meshing::Face(t));
         m.owner.push_back(0);
       }
-  m.patches = {{"particles", "wall", 0, 8}};
+  m.patches = {patch("particles", "wall", 0, 8)};
   const std::vector<GapBand> bands = split_particles_by_gap(m, bed, 1.0, {10.0}, -5.0, 5.0);
   ASSERT_EQ(bands.size(), 3u);
   EXPECT_EQ(bands[0].faces, 8);

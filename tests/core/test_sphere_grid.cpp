@@ -26,7 +26,8 @@ void expect_finds_all_within(const std::vector<Eigen::Vector3d>& x, const std::v
     });
     for (const auto& [s, n] : visits) EXPECT_EQ(n, 1) << "sphere " << s << " visited " << n << " times";
     for (std::size_t s = 0; s < x.size(); ++s) {
-      if (per.separation(p, x[s]).norm() < h) EXPECT_TRUE(visits.count(static_cast<int>(s))) << "sphere " << s << " missed";
+      if (per.separation(p, x[s]).norm() >= h) continue;
+      EXPECT_TRUE(visits.count(static_cast<int>(s))) << "sphere " << s << " missed";
     }
   }
 }
