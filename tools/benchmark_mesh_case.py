@@ -637,20 +637,13 @@ def touching_lines(v):
              "drag only grows with solid added (the bridges add about 0.2 % solid; docs/findings.md, 2026-11-27). "
              "Against the bound = dp/L / bound - 1; its order is a least-squares fit of ln |against the bound| against "
              "ln h over all levels, which falls short of the true order as the levels near the bridged array's own "
-             "value.", "",
-             "| cells, facets | level | cells solved on | h / d | dp/L (Pa/m) | against the bound | time (s) |",
-             "|---|---|---|---|---|---|---|"]
+             "value.", ""]
+    lines += level_rows(v, "cells, facets", "against the bound",
+                        lambda run, lv: lv["pressure_gradient_bed_pa_m"] / touching_bound_pa_m(run) - 1.0)
     verdicts = []
     for key, run in v["runs"].items():
         bound = touching_bound_pa_m(run)
         ok = [lv for lv in run["study"]["levels"] if "failure" not in lv]
-        for lv in run["study"]["levels"]:
-            if "failure" in lv:
-                lines.append(f"| {key} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
-                continue
-            lines.append(f"| {key} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
-                         f"{lv['pressure_gradient_bed_pa_m']:.5g} | "
-                         f"{100 * (lv['pressure_gradient_bed_pa_m'] / bound - 1):+.2f} % | {lv['time_s']:.1f} |")
         below = [(lv["cell_size_m"], 1.0 - lv["pressure_gradient_bed_pa_m"] / bound) for lv in ok]
         order = None
         if len(below) >= 2 and all(e > 0 for _, e in below):
@@ -2088,10 +2081,10 @@ def write(results):
     open(os.path.join(DOCS, "mesh_case_benchmark.md"), "w").write("\n".join(lines))
 
 
-def verification_lines(v, column, png):
-    """A verification section's levels against the exact value, one table row per level of each
-    run (runs keyed by what `column` names), then each run's order and the study's own verdict."""
-    lines = [f"| {column} | level | cells solved on | h / d | dp/L (Pa/m) | error | time (s) |",
+def level_rows(v, column, error_name, error_of):
+    """A verification section's table: a row per level of each run (runs keyed by what `column`
+    names), its error error_of(run, level) as a fraction headed `error_name`."""
+    lines = [f"| {column} | level | cells solved on | h / d | dp/L (Pa/m) | {error_name} | time (s) |",
              "|---|---|---|---|---|---|---|"]
     for key, run in v["runs"].items():
         for lv in run["study"]["levels"]:
@@ -2099,9 +2092,15 @@ def verification_lines(v, column, png):
                 lines.append(f"| {key} | {lv['level']} | failed: {lv['failure']} | | | | {lv['time_s']:.0f} |")
                 continue
             lines.append(f"| {key} | {lv['level']} | {lv['cells']} | {lv['cell_size_m'] / run['d_m']:.4f} | "
-                         f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * lv['relative_error_to_exact']:+.2f} % | "
+                         f"{lv['pressure_gradient_bed_pa_m']:.5g} | {100 * error_of(run, lv):+.2f} % | "
                          f"{lv['time_s']:.1f} |")
-    lines.append("")
+    return lines
+
+
+def verification_lines(v, column, png):
+    """A verification section's levels against the exact value, one table row per level of each
+    run (runs keyed by what `column` names), then each run's order and the study's own verdict."""
+    lines = level_rows(v, column, "error", lambda run, lv: lv["relative_error_to_exact"]) + [""]
     for key, run in v["runs"].items():
         st = run["study"]
         order = st.get("order_from_exact")
