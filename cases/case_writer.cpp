@@ -149,14 +149,17 @@ std::string dict(const std::string& cls, const std::string& location, const std:
 
 // Walls and particles take the same conditions unless `particles` gives the particles their own
 // (walls that slip); `.*wall` matches wall and inner_wall, `.*wall_ends` their parts beyond the
-// section and `particles.*` the particles' patches split by gap (drag_regions.hpp). The constraint types cover processor patches, so the fields
-// serve snappyHexMesh's cells as they come, decomposed.
+// section and `particles.*` the particles' patches split by gap (drag_regions.hpp). The
+// constraint types cover processor patches, so the fields serve snappyHexMesh's cells as they
+// come, decomposed.
 std::string boundary_field(const std::string& inlet, const std::string& outlet, const std::string& walls,
                            const std::string& particles = {}) {
-  const std::string solids = particles.empty() ? fmt::format("    \"(.*wall|.*wall_ends|particles.*)\"\n    {{\n{}    }}\n", walls)
-                                               : fmt::format("    \"(.*wall|.*wall_ends)\"\n    {{\n{}    }}\n"
-                                                             "    \"particles.*\"\n    {{\n{}    }}\n",
-                                                             walls, particles);
+  const std::string solids =
+      particles.empty()
+          ? fmt::format("    \"(.*wall|.*wall_ends|particles.*)\"\n    {{\n{}    }}\n", walls)
+          : fmt::format("    \"(.*wall|.*wall_ends)\"\n    {{\n{}    }}\n"
+                        "    \"particles.*\"\n    {{\n{}    }}\n",
+                        walls, particles);
   return fmt::format("boundaryField\n{{\n    #includeEtc \"caseDicts/setConstraintTypes\"\n"
                      "    inlet\n    {{\n{}    }}\n    outlet\n    {{\n{}    }}\n{}}}\n",
                      inlet, outlet, solids);
