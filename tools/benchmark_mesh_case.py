@@ -1494,6 +1494,33 @@ def route(r):
     return r["cells"] + (", facets holding the spheres' volume" if r.get("sphere_facets") == "volume" else "")
 
 
+def band_agreement_lines(runs, fits):
+    """Issue 57's target that the new mesh's extrapolation (the last route's) and today's agree
+    within their bands: each band the finest level's dp/L +- its GCI (Celik et al. 2008), the
+    new route's against each other route's."""
+    def band(r):
+        g = fits(r)[0]
+        finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+        if g.get("gci_fine") is None or finest is None:
+            return None
+        dp = finest["pressure_gradient_bed_pa_m"]
+        return dp * (1 - g["gci_fine"]), dp * (1 + g["gci_fine"])
+
+    new = runs[-1]
+    lines = [f"Issue 57's target that the extrapolations of the new mesh ({route(new)}) and of today's agree within "
+             "their bands (each the finest level's dp/L +- its GCI, the band Celik et al. 2008 give the finest "
+             "solution; the extrapolation lies inside it):", ""]
+    for r in runs[:-1]:
+        a, b = band(new), band(r)
+        if a is None or b is None:
+            lines.append(f"- against {route(r)}: no band for " + (route(new) if a is None else route(r)) + ": not met.")
+            continue
+        overlap = a[0] <= b[1] and b[0] <= a[1]
+        lines.append(f"- against {route(r)}: {a[0]:.4g}-{a[1]:.4g} Pa/m and {b[0]:.4g}-{b[1]:.4g} Pa/m: "
+                     + ("**met** (they overlap)." if overlap else "**not met** (apart)."))
+    return lines
+
+
 def cost_lines(runs):
     """Issue 57's cost curve on one bed: each route's levels as error against the best
     extrapolation, against cells and seconds per sphere; the route whose band is narrowest gives
@@ -1559,6 +1586,7 @@ def cost_lines(runs):
         lines.append(f"| {route(r)} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | "
                      + (f"{ls['order']:.2f}, {ls['extrapolated']:.4g}" if ls.get("order") is not None else "none")
                      + f" | {g['extrapolated']:.4g} | " + ("met" if not missed else "not met: " + ", ".join(missed)) + " |")
+    lines += [""] + band_agreement_lines(runs, fits)
     if not r0.get("default_scene"):
         return lines + [""]
     # The README's scene is the bed of issue 57's target on this machine.
