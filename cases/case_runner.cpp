@@ -455,9 +455,6 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
     r.drag.push_inlet_outlet_n = rho * its[n - 1].driving_gradient * r.solved_volume_m3.value_or(c.fluid_volume_m3.value_or(0.0));
   else
     r.drag.push_inlet_outlet_n = -(last_force_z(case_dir, "forceInlet").total + last_force_z(case_dir, "forceOutlet").total);
-  const double drag = r.drag.walls_n + r.drag.particles_n;
-  r.drag.wall_share = r.drag.walls_n / drag;
-  r.drag.force_balance_relative_error = drag / r.drag.push_inlet_outlet_n - 1.0;
   if (c.stokes_array) {
     r.van_der_hoef_pa_m = c.stokes_array->pa_m;
     r.ratio_to_van_der_hoef = gradient / c.stokes_array->pa_m;

@@ -53,8 +53,8 @@ nlohmann::json Drag::to_json() const {
                    {"particles_n", particles_n},
                    {"particles_viscous_n", particles_viscous_n},
                    {"push_inlet_outlet_n", push_inlet_outlet_n},
-                   {"wall_share", wall_share},
-                   {"force_balance_relative_error", force_balance_relative_error}};
+                   {"wall_share", wall_share()},
+                   {"force_balance_relative_error", force_balance_relative_error()}};
   if (!particles_by_gap.empty()) {
     j["particles_by_gap"] = nlohmann::json::array();
     for (const GapBand& b : particles_by_gap) j["particles_by_gap"].push_back(b.to_json());
@@ -71,8 +71,6 @@ Drag Drag::from_json(const nlohmann::json& j) {
   d.particles_n = j.at("particles_n").get<double>();
   d.particles_viscous_n = j.at("particles_viscous_n").get<double>();
   d.push_inlet_outlet_n = j.at("push_inlet_outlet_n").get<double>();
-  d.wall_share = j.at("wall_share").get<double>();
-  d.force_balance_relative_error = j.at("force_balance_relative_error").get<double>();
   if (j.contains("particles_by_gap")) {
     for (const auto& b : j["particles_by_gap"]) d.particles_by_gap.push_back(GapBand::from_json(b));
     d.walls_ends_n = j.at("walls_ends_n").get<double>();

@@ -50,9 +50,9 @@ struct Drag {
   // planes (split_walls_at_section; all and viscous), so that walls less these is the section's.
   std::vector<GapBand> particles_by_gap;
   double walls_ends_n = 0.0, walls_ends_viscous_n = 0.0;
-  double wall_share = 0.0;                   // walls / (walls + particles)
-  double force_balance_relative_error = 0.0; // (walls + particles) / push - 1
-  nlohmann::json to_json() const;
+  double wall_share() const { return walls_n / (walls_n + particles_n); }
+  double force_balance_relative_error() const { return (walls_n + particles_n) / push_inlet_outlet_n - 1.0; }
+  nlohmann::json to_json() const;  // with wall_share and force_balance_relative_error, for the reader
   static Drag from_json(const nlohmann::json& j);
 };
 

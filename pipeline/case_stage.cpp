@@ -25,7 +25,7 @@ void run_flow(CaseStage& out, std::string& line, const Console& console) {
   if (flow.ratio_to_eisfeld_schnitzlein)
     line += fmt::format(" ({:.3f} x at the meshed eps)", *flow.ratio_to_eisfeld_schnitzlein);
   if (!out.info.walls) return;
-  line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.drag.wall_share);
+  line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.drag.wall_share());
   if (!flow.exact_pa_m)
     line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);
 }

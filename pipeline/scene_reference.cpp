@@ -191,7 +191,7 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"where the spheres' vertices lie: `inscribed`, on the sphere (its flat triangles then cut off some of it: the "
         "fluid is larger by about the triangles' mean depth, edge^2 / (8 r), over the spheres' area), or `volume`, "
         "moved out along the radius so that the triangles hold each sphere's volume (the loops where a sphere meets a "
-        "contact, a wall or a plane stay on it)"}},
+        "contact, a wall or a plane stay on it, and so do vertices in gaps narrower than their triangles' edge)"}},
       {"surface.cells_per_gap",
        {"cells across narrow gaps: where a sphere or wall faces another surface closer than this times "
         "`edge_length_d`, its edge shrinks to gap / this (not below `contact_edge_length_d`), and the volume mesh gets "

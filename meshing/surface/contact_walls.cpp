@@ -168,6 +168,7 @@ void ContactTreatment::wall_union(std::size_t i, const Wall& w, const Eigen::Vec
   cut.spacing = perimeter / n;
   cut.axis = a;
   cut.removed = [w](const Eigen::Vector3d& q) { return w.beyond(q); };
+  cut.fluid_ends = true;
   add_cut(i, std::move(cut), "union with the " + w.name, beta_max);
   open_hole(i, holes, -w.towards(out_.cuts[i].back().loop[0]));
   const double rho = std::hypot(c.x(), c.y());
@@ -190,6 +191,7 @@ void ContactTreatment::cross_plane(std::size_t i, const Eigen::Vector3d& a, doub
                  std::vector<WallHole>& holes, std::optional<Eigen::Vector3d> at) {
   const double r = out_.radius[i], rho = std::sqrt(std::max(0.0, r * r - h * h));
   plane_cut(i, a, h, rho, ring_points(rho, edge_c_), kBreakCocircular, name, at);
+  out_.cuts[i].back().fluid_ends = true;
   open_hole(i, holes, -a);
 }
 

@@ -69,7 +69,7 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   p.edge_length_d = s.number("edge_length_d", kSceneEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.contact_edge_length_d = s.number("contact_edge_length_d", kSceneContactEdgeLengthD, Range{1e-3, 1.0, false, false});
   p.growth = s.number("growth", p.growth, Range{1.05, 2.0, false, false});
-  p.facets_hold_sphere_volume = s.choice("sphere_facets", "inscribed", {"inscribed", "volume"}) == "volume";
+  p.facets_hold_sphere_volume = s.choice("sphere_facets", p.facets_hold_sphere_volume ? "volume" : "inscribed", {"inscribed", "volume"}) == "volume";
   p.cells_per_gap = s.number("cells_per_gap", kSceneCellsPerGap, Range::closed(0.0, 20.0));
   p.inlet_length_d = s.number("inlet_length_d", p.inlet_length_d, Range::non_negative());
   p.outlet_length_d = s.number("outlet_length_d", p.outlet_length_d, Range::non_negative());
@@ -290,6 +290,14 @@ std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const st
   return GapSpacing(centres, radii, kept, container, p.cells_per_gap, std::min(p.contact_edge_length_d * d, edge), edge);
 }
 
+std::optional<GapSpacing> facet_clearance(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                          const std::vector<double>& radii, const std::vector<char>& kept,
+                                          const Container& container) {
+  if (!p.facets_hold_sphere_volume) return std::nullopt;
+  const double edge = p.edge_length_d * d;
+  return GapSpacing(centres, radii, kept, container, 3.0, edge, edge);
+}
+
 namespace {
 
 // The planes asked for below and above the fluid domain (m), before treat_contacts moves clip planes.
@@ -482,6 +490,7 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
   // spheres' ends near the planes it is cut at (its rings) or ends at (a clip window's, a
   // periodic section's).
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, bed.centres, tb.radius, tb.kept, c);
+  const std::optional<GapSpacing> clearance = facet_clearance(p, d, bed.centres, tb.radius, tb.kept, c);
   // At the planes it ends at, sphere_mesh cuts the spheres along loops of their own spacing,
   // which seeds finer than it beside them would break: there only the ends not cut are graded.
   std::vector<EndNearPlane> ends = ends_near_planes(bed.centres, tb.radius, rings, edge);
@@ -517,7 +526,9 @@ FluidSurface build_fluid_surface(const Bed& given, const SurfaceParams& p) {
         spheres[i] = sphere_mesh(bed.centres[i], tb.radius[i], tb.cuts[i], edge, p.growth, true, "particles",
                                  field(static_cast<int>(i)));
         chordal[i] = chordal_deviation(spheres[i], bed.centres[i], tb.radius[i]);
-        if (p.facets_hold_sphere_volume) pushed[i] = match_sphere_volume(spheres[i], bed.centres[i], tb.radius[i], tb.cuts[i]);
+        if (clearance)
+          pushed[i] = match_sphere_volume(spheres[i], bed.centres[i], tb.radius[i], tb.cuts[i],
+                                          [&clearance, i](const Eigen::Vector3d& x) { return clearance->gap(x, static_cast<int>(i)); });
       } catch (const CutConflict& e) {
         failure[i] = fmt::format("sphere {} (cuts: {}): {}; allowed: a shorter surface.contact_edge_length_d or "
                                  "another treatment",

@@ -40,7 +40,7 @@ struct SurfaceParams {
   double growth = 1.5;                  // edge growth per ring away from those loops
   // The spheres' vertices moved out so that their facets hold each sphere's volume
   // (match_sphere_volume), instead of lying on the sphere, inscribed, with less solid than it.
-  bool facets_hold_sphere_volume = false;
+  bool facets_hold_sphere_volume = true;
   // Cells across narrow gaps: where a sphere or wall faces another surface closer than
   // cells_per_gap x edge_length_d, its edge shrinks to gap / cells_per_gap (not below
   // contact_edge_length_d), and the volume mesh follows. 0: edge_length_d everywhere.
@@ -92,6 +92,14 @@ nlohmann::json to_json(const SurfaceParams& p);
 std::optional<GapSpacing> gap_spacing(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
                                       const std::vector<double>& radii, const std::vector<char>& kept,
                                       const Container& container);
+
+// The spheres' clearance as match_sphere_volume limits their vertices' move by it: GapSpacing's
+// gap() out to three surface edges (beyond the edge of a vertex's triangles and eight moves of
+// edge^2 / (8 r), it does not limit the move); unset when p.facets_hold_sphere_volume is false.
+// Inputs as gap_spacing's.
+std::optional<GapSpacing> facet_clearance(const SurfaceParams& p, double d, const std::vector<Eigen::Vector3d>& centres,
+                                          const std::vector<double>& radii, const std::vector<char>& kept,
+                                          const Container& container);
 
 // The fluid domain of `bed` under `p`, known before its surface is meshed, from one sampling of
 // its narrow gaps. Throws treat_contacts's InputErrors.

@@ -25,6 +25,9 @@ class GapSpacing {
              double coarsest);
   double at(const Eigen::Vector3d& p, int self) const;
   double finest() const { return finest_; }
+  // Distance (m) from p to the nearest surface other than sphere `self`'s (the walls too when
+  // self >= 0, as at()), up to cells_per_gap x coarsest.
+  double gap(const Eigen::Vector3d& p, int self) const;
 
   // The tetrahedra a volume mesh gains from this spacing over one of the coarsest edge
   // everywhere (a count, no unit). Each kept sphere's surface between heights `z0` and `z1`
@@ -39,9 +42,6 @@ class GapSpacing {
   std::vector<double> added_cells_profile(double volume_per_cell, double z0, double z1, int bins) const;
 
  private:
-  // Distance from p to the nearest surface other than sphere `self`'s, up to cells_per_gap x
-  // coarsest.
-  double gap(const Eigen::Vector3d& p, int self) const;
   // Distance from p to the nearest wall, up to cells_per_gap x coarsest.
   double wall_distance(const Eigen::Vector3d& p) const;
   // Distance along the unit normal `n` from p on sphere `self` to the medial surface, up to

@@ -305,6 +305,7 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
         }
   const std::vector<char> kept(near_centres.size(), 1);
   const std::optional<GapSpacing> gaps = gap_spacing(p, d, near_centres, near_radii, kept, box);
+  const std::optional<GapSpacing> clearance = facet_clearance(p, d, near_centres, near_radii, kept, box);
   const double grade = std::max(p.growth - 1.0, 1e-3), graded_reach = (edge - fine) / grade;
 
   // 6. The circles as they fall on each side (2D: the side's u and v), moved by the periods of
@@ -488,6 +489,7 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
     const SpacingField field = gaps ? SpacingField{[&gaps, i](const Eigen::Vector3d& q) { return gaps->at(q, static_cast<int>(i)); },
                                                    gaps->finest()}
                                     : SpacingField{};
+    const auto gap_to_others = [&clearance, i](const Eigen::Vector3d& x) { return clearance->gap(x, static_cast<int>(i)); };
     std::vector<int> crossed;
     for (int a = 0; a < 3; ++a)
       if (s.cross[a] != 0) crossed.push_back(a);
@@ -549,6 +551,7 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
           cut.spacing = fine;
           cut.axis = axis.normalized();
           cut.removed = removed;
+          cut.fluid_ends = true;
           // The faces spanning the removed part lie in one of the planes (their coordinate exact).
           cut.spans = [crossed, plane = s.plane](const Eigen::Vector3d& x, const Eigen::Vector3d& y, const Eigen::Vector3d& z) {
             return std::any_of(crossed.begin(), crossed.end(),
@@ -558,14 +561,14 @@ FluidSurface build_periodic_box_surface(const Bed& bed, const SurfaceParams& p) 
         }
         TriangleMesh part = sphere_mesh(s.c, s.r, cuts, edge, p.growth, true, "particles", field);
         chordal[i] = std::max(chordal[i], chordal_deviation(part, s.c, s.r));
-        if (p.facets_hold_sphere_volume) pushed[i] = std::max(pushed[i], match_sphere_volume(part, s.c, s.r, cuts));
+        if (clearance) pushed[i] = std::max(pushed[i], match_sphere_volume(part, s.c, s.r, cuts, gap_to_others));
         for (auto& x : part.points) x += move;
         parts[i].push_back(std::move(part));
       }
       if (crossed.empty()) {
         parts[i].push_back(sphere_mesh(s.c, s.r, {}, edge, p.growth, true, "particles", field));
         chordal[i] = chordal_deviation(parts[i].back(), s.c, s.r);
-        if (p.facets_hold_sphere_volume) pushed[i] = match_sphere_volume(parts[i].back(), s.c, s.r, {});
+        if (clearance) pushed[i] = match_sphere_volume(parts[i].back(), s.c, s.r, {}, gap_to_others);
       }
     } catch (const CutConflict& e) {
       std::string where;

@@ -368,7 +368,8 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
   return m;
 }
 
-double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts) {
+double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts,
+                           const std::function<double(const Eigen::Vector3d&)>& clearance) {
   std::size_t on_loops = 0;  // sphere_mesh's first points
   for (const SphereCut& cut : cuts) on_loops += cut.loop.size();
   // Per vertex: the area of its triangles, and their area times their mean depth inside the sphere.
@@ -383,10 +384,26 @@ double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, 
   for (std::size_t v = on_loops; v < m.points.size(); ++v) {
     Eigen::Vector3d& x = m.points[v];
     if (!(area[v] > 0.0)) continue;
-    const double push = deficit[v] / area[v];
-    const Eigen::Vector3d moved = c + (x - c) * ((r + push) / (x - c).norm());
-    if (std::any_of(cuts.begin(), cuts.end(), [&](const SphereCut& cut) { return cut.removed(moved); })) continue;
-    x = moved;
+    // The move wanted, and the room for it: the distance to the nearest other surface, or along
+    // the ray to where the fluid ends (bisection; a plane or a wall is crossed once), looked for
+    // out to where it no longer limits the move.
+    const double wanted = deficit[v] / area[v];
+    const double edge = std::sqrt(8.0 * r * wanted);  // the root mean square of its triangles' edges
+    const double reach = edge + 8.0 * wanted;
+    double room = clearance ? std::min(reach, clearance(x)) : reach;
+    const Eigen::Vector3d out = (x - c).normalized();
+    const auto removed = [&](double t) {
+      return std::any_of(cuts.begin(), cuts.end(),
+                         [&](const SphereCut& cut) { return cut.fluid_ends && cut.removed(x + t * out); });
+    };
+    if (removed(room)) {
+      double lo = 0.0, hi = room;
+      for (int k = 0; k < 30; ++k) (removed(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+      room = lo;
+    }
+    const double push = std::clamp((room - edge) / 8.0, 0.0, wanted);
+    if (std::any_of(cuts.begin(), cuts.end(), [&](const SphereCut& cut) { return cut.removed(x + push * out); })) continue;
+    x += push * out;
     largest = std::max(largest, push);
   }
   return largest;

@@ -59,6 +59,10 @@ struct SphereCut {
   double jitter = kBreakCocircular;               // of the rings graded from the loop
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, from the centre into the removed part
   std::function<bool(const Eigen::Vector3d&)> removed;
+  // The fluid ends at the cut (a wall, a clip, slab or periodic plane): `removed` holds beyond the
+  // loop off the sphere too, and match_sphere_volume keeps the moved vertices clear of it. False
+  // for a contact's cut (bridge, cap, union), beyond whose plane the fluid goes on around it.
+  bool fluid_ends = false;
   // Whether a hull face whose three vertices all lie on this loop spans the removed part (and is
   // dropped); unset: every such face does. A loop along two planes (a sphere cut at a box's edge)
   // also holds faces on the sphere that turn its corners, which are kept.
@@ -90,10 +94,17 @@ TriangleMesh sphere_mesh(const Eigen::Vector3d& c, double r, const std::vector<S
 // a sphere of radius r lies on average (a^2 + b^2 + c^2) / (24 r) inside it, and each vertex moves
 // by the area-weighted mean of that over its triangles, which puts back what they cut off to
 // second order. The loops' vertices stay where they are (other shapes share them), and so does a
-// vertex the move would take into a cut's removed part. Each vertex stays on its ray from the
-// centre, so the mesh stays a radial graph over the same spherical triangles and cannot cross
-// itself. Returns the largest move (m), for the ball that holds the mesh.
-double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts);
+// vertex the move would take into a cut's removed part. A vertex moves at most an eighth of its
+// room beyond its triangles' edge e (root mean square); room: the distance to the nearest other
+// surface (`clearance`, m, at a vertex; none: no other surface) or, along its ray, to the removed
+// part of a cut the fluid ends at (SphereCut::fluid_ends). Where the room is less than e the gap
+// is not resolved, its cells across it already the thinnest, and moving would thin them more
+// (shrunk beds at a 0.2 d edge then fail the volume mesh's quality gate): the vertex stays. Each
+// vertex stays on its ray from the centre, so the mesh stays a radial graph over the same
+// spherical triangles and cannot cross itself. Returns the largest move (m), for the ball that
+// holds the mesh.
+double match_sphere_volume(TriangleMesh& m, const Eigen::Vector3d& c, double r, const std::vector<SphereCut>& cuts,
+                           const std::function<double(const Eigen::Vector3d&)>& clearance = {});
 
 // Largest distance between a sphere (c, r) and the planes of the mesh's triangles: an upper
 // bound of the chordal deviation of an inscribed mesh.

@@ -103,6 +103,7 @@ TEST(PeriodicBox, OppositeSidesAreOneTriangulationAndTheSurfaceIsClosed) {
 TEST(PeriodicBox, SpheresHoldingTheirVolumeKeepTheSidesAndTheVolume) {
   const Bed bed = random_array(25, 3.5, 1);
   SurfaceParams p = plain();
+  p.cells_per_gap = kSceneCellsPerGap;
   std::array<double, 2> error{};
   for (bool volume : {false, true}) {
     p.facets_hold_sphere_volume = volume;
@@ -115,8 +116,10 @@ TEST(PeriodicBox, SpheresHoldingTheirVolumeKeepTheSidesAndTheVolume) {
     EXPECT_EQ(s.report["sphere_vertices_moved_out_d"].get<double>() > 0.0, volume);
   }
   EXPECT_GT(error[0], 0.0);  // inscribed: the spheres' facets inside them, the fluid larger
-  // Measured 2026-12-06: +1.34 % inscribed, +0.059 % holding their volume (0.044 of it): what stays
-  // is beside the loops where the sides cut the spheres, whose vertices stay on them.
+  // Measured 2026-12-06 under the scenes' gap rule: +0.57 % inscribed, +0.030 % holding their
+  // volume (0.053 of it): what stays is beside the loops where the sides cut the spheres, whose
+  // vertices stay on them or within an edge of the sides (match_sphere_volume); without the gap
+  // rule 0.13 of it, the vertices in unresolved gaps staying too.
   EXPECT_LT(std::abs(error[1]), 0.1 * error[0]) << error[0] << " -> " << error[1];
 }
 

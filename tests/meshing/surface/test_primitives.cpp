@@ -104,6 +104,41 @@ TEST(Primitives, SphereMovedToHoldItsVolumeKeepsItsLoops) {
   EXPECT_GT(moved, static_cast<long>(m.points.size()) / 2);
 }
 
+// A vertex moves at most an eighth of its room beyond its triangles' edge: with no room (another
+// surface touching) none moves; with room to spare the move is the one wanted. Cut by a plane the
+// fluid ends at, grazing the sphere (0.49 from its centre, r = 0.5), no vertex moves farther than
+// an eighth of its distance to the plane along its ray; the same plane as a contact's cut (a
+// bridge's, fluid beyond it) does not hold them back.
+TEST(Primitives, SphereMovedToHoldItsVolumeKeepsClearOfWhatIsNear) {
+  const Eigen::Vector3d c(1.0, 2.0, 3.0);
+  const double r = 0.5, edge = 0.1;
+  const TriangleMesh start = sphere_mesh(c, r, {}, edge, 1.3, true, "particles");
+  TriangleMesh free = start, touching = start, spare = start;
+  const double wanted = match_sphere_volume(free, c, r, {});
+  EXPECT_EQ(match_sphere_volume(touching, c, r, {}, [](const Eigen::Vector3d&) { return 0.0; }), 0.0);
+  EXPECT_EQ(touching.points, start.points);
+  EXPECT_EQ(match_sphere_volume(spare, c, r, {}, [](const Eigen::Vector3d&) { return 1.0; }), wanted);
+  EXPECT_EQ(spare.points, free.points);
+
+  SphereCut ends = plane(c, r, Eigen::Vector3d::UnitZ(), 0.49, 0.0125);
+  ends.fluid_ends = true;
+  const SphereCut contact = plane(c, r, Eigen::Vector3d::UnitZ(), 0.49, 0.0125);
+  TriangleMesh at_end = sphere_mesh(c, r, {ends}, edge, 1.3, true, "particles"), at_contact = at_end;
+  const TriangleMesh before = at_end;
+  match_sphere_volume(at_end, c, r, {ends});
+  match_sphere_volume(at_contact, c, r, {contact});
+  long held = 0;
+  for (std::size_t v = ends.loop.size(); v < before.points.size(); ++v) {
+    const Eigen::Vector3d out = (before.points[v] - c).normalized();
+    if (out.z() <= 0.0) continue;  // its ray never meets the plane
+    const double along = ((c.z() + 0.49) - before.points[v].z()) / out.z();  // to the plane along the ray
+    const double moved = (at_end.points[v] - before.points[v]).norm();
+    EXPECT_LE(moved, std::max(0.0, along / 8.0) + 1e-12) << v;
+    held += moved < (at_contact.points[v] - before.points[v]).norm();
+  }
+  EXPECT_GT(held, 0) << "the plane the fluid ends at holds some vertices back, a contact's cut none";
+}
+
 TEST(Primitives, CappedSphereClosesWithItsDisksAndHasTheCapVolume) {
   // A sphere cut flat by three planes (a large cap, two small ones 60 degrees apart, as where
   // three spheres touch), each closed by a disk sharing the cut's loop.

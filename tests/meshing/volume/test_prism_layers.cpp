@@ -17,8 +17,9 @@ using namespace bedforge::meshing;
 namespace {
 
 FluidSurface surface_of(const Bed& b, SurfaceParams::Treatment treatment = SurfaceParams::Treatment::shrink,
-                        double edge_length_d = 0.15) {
+                        double edge_length_d = 0.15, bool facets_hold_sphere_volume = true) {
   SurfaceParams p;
+  p.facets_hold_sphere_volume = facets_hold_sphere_volume;
   p.edge_length_d = edge_length_d;
   p.contact_edge_length_d = 0.05;
   p.treatment = treatment;
@@ -44,7 +45,8 @@ PrismLayerParams three_layers(double thickness_d) {
 
 TEST(PrismLayers, AFreeSphereGetsFullStacksFillingTheShellAroundIt) {
   const Bed b = bed_of(3.0, {{0.0, 0.0, 1.0}});
-  const FluidSurface s = surface_of(b);
+  // The sphere's vertices on it (inscribed facets), for which the layers' volume below is exact.
+  const FluidSurface s = surface_of(b, SurfaceParams::Treatment::shrink, 0.15, false);
   const double h = 0.05;
   const PrismLayers layers = build_prism_layers(s.fluid, 1.0, three_layers(h));
   // Nothing in front of the sphere within 0.05 / 0.2 d: every stack is whole, every cell a prism.
