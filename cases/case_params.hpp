@@ -15,6 +15,17 @@ inline constexpr double kResidualULayered = 1.0e-2;  // on cells with prism laye
 inline constexpr std::size_t kMostGapBands = 8;
 // The meshes of a convergence study when the case is run and the scene names none.
 inline constexpr int kStudyLevels = 3;
+// What the contact treatment did to the bed's spheres, as a case compares it with known answers
+// (meshing::SurfaceParams::sphere_scale and solid_change).
+struct TreatedSolid {
+  // The one scale every sphere took: 1 the bed's own, the condition for comparing a bed with a
+  // known answer; the shrink factor when every sphere was shrunk; 0 not one scale.
+  double sphere_scale = 1.0;
+  // +1 solid only added (bridges, enlarged spheres), -1 only taken (shrink, caps), 0 kept, both
+  // or not known.
+  int change = 0;
+};
+
 // The OpenFOAM case, scene section [case]: steady laminar incompressible flow (simpleFoam) up
 // through the bed, inlet at the bottom.
 struct CaseParams {

@@ -50,6 +50,10 @@ nlohmann::json FlowResult::to_json() const {
     j["van_der_hoef_pa_m"] = *van_der_hoef_pa_m;
     j["ratio_to_van_der_hoef"] = *ratio_to_van_der_hoef;
   }
+  if (bound) {
+    j["bound"] = {{"pa_m", bound->pa_m}, {"side", bound->side()}};
+    j["ratio_to_bound"] = ratio_to_bound;
+  }
   if (exact_pa_m) {
     j["exact_pa_m"] = *exact_pa_m;
     j["relative_error_to_exact"] = relative_error_to_exact;
@@ -458,6 +462,10 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   if (c.stokes_array) {
     r.van_der_hoef_pa_m = c.stokes_array->pa_m;
     r.ratio_to_van_der_hoef = gradient / c.stokes_array->pa_m;
+  }
+  if (c.bound) {
+    r.bound = c.bound;
+    r.ratio_to_bound = gradient / c.bound->pa_m;
   }
   if (c.exact_pressure_gradient_pa_m) {
     r.exact_pa_m = c.exact_pressure_gradient_pa_m;

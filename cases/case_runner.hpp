@@ -43,6 +43,10 @@ struct FlowResult {
   // error dp/L / exact - 1. Otherwise unset and the correlation's fields below are filled.
   std::optional<double> exact_pa_m;
   double relative_error_to_exact = 0.0;
+  // A treated simple cubic column or array (CaseInfo::bound): its untreated answer, a bound from
+  // below or above, and dp/L over it; the correlation's fields below are filled too.
+  std::optional<KnownBound> bound;
+  double ratio_to_bound = 0.0;
   // A random array's Stokes drag (CaseInfo::stokes_array): van der Hoef et al.'s gradient and
   // dp/L over it.
   std::optional<double> van_der_hoef_pa_m, ratio_to_van_der_hoef;

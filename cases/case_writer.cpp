@@ -122,6 +122,7 @@ nlohmann::json CaseInfo::to_json() const {
           {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
           {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr},
+          {"bound", bound ? nlohmann::json{{"pa_m", bound->pa_m}, {"side", bound->side()}} : nlohmann::json()},
           {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr},
           {"walls", walls},
           {"stokes_array", stokes_array ? nlohmann::json{{"solid_fraction", stokes_array->solid_fraction},
@@ -600,23 +601,26 @@ void put_pieces_back(const fs::path& aside, const fs::path& case_dir, int pieces
   fs::remove_all(aside);  // pieces beyond the count
 }
 
-void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale) {
+void set_known_answers(CaseInfo& info, const Bed& bed, const TreatedSolid& treated) {
   const CaseParams& p = info.params;
   const double u = info.velocity_m_s;
   const BedSection& section = info.section;
+  const double sphere_scale = treated.sphere_scale;
   if (!info.particles && !p.slip_walls)
     info.exact_pressure_gradient_pa_m = analysis::laminar_duct_gradient(*bed.container, p.viscosity_pa_s, u);
   // Zick & Homsy's drag is Stokes flow's; at Re_p <= 0.01 inertia's share of the momentum balance
   // is at most 1 %, and in an array symmetric fore and aft its effect on the drag goes as Re_p^2.
-  if (info.particles && sphere_scale == 1.0 && p.slip_walls && p.reynolds <= 0.01)
-    info.exact_pressure_gradient_pa_m =
-        analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
-  if (info.particles && sphere_scale == 1.0 && !info.walls && p.reynolds <= 0.01)
-    info.exact_pressure_gradient_pa_m = analysis::simple_cubic_array_gradient(bed, p.viscosity_pa_s, u);
+  std::optional<double> lattice;  // the untreated bed's, when it is a simple cubic column or array
+  if (info.particles && p.slip_walls && p.reynolds <= 0.01)
+    lattice = analysis::simple_cubic_column_gradient(bed, p.viscosity_pa_s, u, section.z_low, section.z_high);
+  if (!lattice && info.particles && !info.walls && p.reynolds <= 0.01)
+    lattice = analysis::simple_cubic_array_gradient(bed, p.viscosity_pa_s, u);
+  if (lattice && sphere_scale == 1.0) info.exact_pressure_gradient_pa_m = lattice;
+  if (lattice && sphere_scale != 1.0 && treated.change != 0) info.bound = KnownBound{*lattice, treated.change > 0};
   // A random array with no wall, as van der Hoef et al. simulated it: equal spheres in a box
   // periodic on every side, Stokes flow (inertia's share at most 1 %, as above), at the spheres'
   // size and solid fraction as solved; not a lattice, whose answer is known.
-  const bool random_array = info.particles && !info.exact_pressure_gradient_pa_m && !info.walls &&
+  const bool random_array = info.particles && !lattice && !info.walls &&
                             bed.container->periodicity().lz > 0.0 && sphere_scale > 0.0 && p.reynolds <= 0.01;
   const bool equal = std::all_of(bed.diameters.begin(), bed.diameters.end(),
                                  [&bed](double x) { return x == bed.diameters[0]; });
@@ -632,7 +636,7 @@ void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale) {
 CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& given, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const fs::path& fluid_stl, double sphere_scale) {
+                    const std::string& bed_csv, const fs::path& fluid_stl, const TreatedSolid& treated) {
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
   if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
@@ -718,7 +722,7 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
   info.polyhedra_quality = polyhedra_quality;
   info.gap_bands = std::move(gap_bands);
   info.wall_faces_beyond_section = wall_faces_beyond_section;
-  set_known_answers(info, bed, sphere_scale);
+  set_known_answers(info, bed, treated);
   return info;
 }
 

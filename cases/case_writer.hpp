@@ -61,6 +61,17 @@ BedSection bed_section(const meshing::CellGeometry* cells, const CaseGeometry& g
 // callers check first to refuse before the long stages).
 void refuse_existing_case(const std::filesystem::path& case_dir, bool overwrite);
 
+// A bound on a treated bed's answer: the untreated bed's known answer (Pa/m). Stokes drag at a
+// set flow rate only grows with the solid (Helmholtz's minimum dissipation), so it bounds a bed
+// whose treatment added solid from below and one whose treatment took solid from above.
+struct KnownBound {
+  double pa_m = 0.0;
+  bool from_below = true;
+  const char* side() const { return from_below ? "below" : "above"; }
+  // Whether `pa_m_solved` lies on the bound's side of it.
+  bool holds(double pa_m_solved) const { return from_below ? pa_m_solved >= pa_m : pa_m_solved <= pa_m; }
+};
+
 // A case as written: what running it and comparing its pressure drop need.
 struct CaseInfo {
   std::filesystem::path directory;
@@ -80,6 +91,8 @@ struct CaseInfo {
   // gradient, or a simple cubic column's Stokes drag (analysis/stokes_arrays.hpp). Unset for
   // other beds, which are compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
+  // Such a column or array whose contacts were treated: its untreated answer, as a bound.
+  std::optional<KnownBound> bound;
   bool particles = false;                // the bed has spheres (a particles patch)
   bool walls = true;                     // the container has walls (a box periodic on every side has none)
   // A random array of equal spheres in a box periodic on every side at Re_p <= 0.01: van der Hoef
@@ -106,10 +119,11 @@ struct CaseInfo {
 // The known answers and references a case is compared with, set in `info` from `bed` and what
 // info already holds (params, velocity_m_s, section, particles, walls): exact_pressure_gradient_pa_m
 // for an empty container (Hagen-Poiseuille or the duct's series) or a simple cubic column or
-// array at Re_p <= 0.01 (Zick & Homsy); else, for a box periodic on every side at Re_p <= 0.01,
-// stokes_array (equal spheres: van der Hoef et al. at the solid fraction and diameter solved) or
-// stokes_array_not_compared (why not). `sphere_scale` as write_case's. Called by write_case.
-void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale);
+// array at Re_p <= 0.01 (Zick & Homsy) whose spheres are the bed's own; `bound` for such a
+// column or array whose treatment only added or only took solid; else, for a box periodic on
+// every side at Re_p <= 0.01, stokes_array (equal spheres: van der Hoef et al. at the solid
+// fraction and diameter solved) or stokes_array_not_compared (why not). Called by write_case.
+void set_known_answers(CaseInfo& info, const Bed& bed, const TreatedSolid& treated);
 
 // Writes the whole case into `case_dir`, built under a temporary name and renamed at the end;
 // an existing case is replaced (only with `overwrite`) once the new one is complete:
@@ -119,14 +133,12 @@ void set_known_answers(CaseInfo& info, const Bed& bed, double sphere_scale);
 // flow function objects, fvSchemes, fvSolution, decomposeParDict, Allrun, Allclean, the records
 // `bedforge/scene.toml` and `bedforge/bed.csv`, and with p.snappy the snappyHexMesh set-up for the surface `fluid_stl`
 // (ASCII STL, a solid per patch, named in `patches`; copied into constant/triSurface).
-// `sphere_scale`: the one scale the contact treatment gave every sphere (1: the bed's own, the
-// condition for comparing a bed with a known answer, a simple cubic column's; 0: not one scale),
-// with which a box periodic on every side of equal spheres at Re_p <= 0.01 is compared with van der
-// Hoef et al.'s Stokes drag at the spheres solved (CaseInfo::stokes_array).
+// `treated`: what the contact treatment did to the spheres, which decides the known answers the
+// case is compared with (set_known_answers).
 CaseInfo write_case(const std::filesystem::path& case_dir, bool overwrite, const meshing::PolyMesh* mesh,
                     const std::vector<std::string>& patches, const CaseGeometry& g, const Bed& bed,
                     const CaseParams& p, const std::string& note, const std::string& scene_toml,
-                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, double sphere_scale);
+                    const std::string& bed_csv, const std::filesystem::path& fluid_stl, const TreatedSolid& treated);
 
 // The pieces an earlier run of a case left (processor*/ and piece_layers/) moved out of
 // case_dir while the case is written anew (returns where to), and put back after it, those of

@@ -20,13 +20,16 @@ void run_flow(CaseStage& out, std::string& line, const Console& console) {
                       flow.residual_p, flow.pressure_gradient_bed_pa_m);
   if (flow.exact_pa_m)
     line += fmt::format("the exact {:.4g} Pa/m {:+.3f} %", *flow.exact_pa_m, 100.0 * flow.relative_error_to_exact);
+  else if (flow.bound)
+    line += fmt::format("{:.4f} x the untreated array's {:.4g} Pa/m, a bound from {}", flow.ratio_to_bound,
+                        flow.bound->pa_m, flow.bound->side());
   else
     line += fmt::format("{:.3f} x Eisfeld & Schnitzlein at the bed's eps", flow.ratio_to_eisfeld_schnitzlein_bed);
-  if (flow.ratio_to_eisfeld_schnitzlein)
+  if (flow.ratio_to_eisfeld_schnitzlein && !flow.bound)
     line += fmt::format(" ({:.3f} x at the meshed eps)", *flow.ratio_to_eisfeld_schnitzlein);
   if (!out.info.walls) return;
   line += fmt::format("; the walls carry {:.1f} % of the drag", 100.0 * flow.drag.wall_share());
-  if (!flow.exact_pa_m)
+  if (!flow.exact_pa_m && !flow.bound)
     line += fmt::format(" ({:.1f} % of the wetted area)", 100.0 * flow.wall_share_of_drag_eisfeld_schnitzlein);
 }
 
@@ -36,7 +39,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const Bed& bed,
                      const cases::CaseParams& p, const Provenance& prov, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     double sphere_scale, const Console& console, const CasePieces* pieces) {
+                     const cases::TreatedSolid& treated, const Console& console, const CasePieces* pieces) {
   const StageMeter meter;
   const std::string note = fmt::format("bedforge {}, seed {}", prov.version, prov.seed ? std::to_string(*prov.seed) : "none");
   // The domain's extent and patches: from gmsh's cells, from the surface snappyHexMesh meshes, or
@@ -55,7 +58,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
   // from the same inputs.
   const std::filesystem::path aside = pieces ? cases::set_pieces_aside(case_dir) : std::filesystem::path();
   out.info = cases::write_case(case_dir, overwrite, mesh.get(), patches, g, bed, p, note, scene_toml, bed_to_csv(bed, prov),
-                               fluid_stl, sphere_scale);
+                               fluid_stl, treated);
   if (pieces) {
     cases::put_pieces_back(aside, case_dir, pieces->count);
     pieces->write(out.info);

@@ -23,9 +23,9 @@ struct CaseStage {
 };
 
 // Writes the case of `bed` (m) into `case_dir` (replacing one only with `overwrite`), recording
-// `scene_toml` and the bed, and runs it when params.run. `sphere_scale`: the one scale the contact
-// treatment gave every sphere (SurfaceParams::sphere_scale: 1 the bed's own, 0 not one scale), so a
-// known answer or a Stokes drag law for the bed applies to the spheres solved.
+// `scene_toml` and the bed, and runs it when params.run. `treated`: what the contact treatment did
+// to the spheres (treated_solid in scene.hpp), so a known answer, a bound or a Stokes drag law for
+// the bed applies to the spheres solved.
 // On gmsh's cells `mesh`; or, when params.snappy_cells, with no cells (mesh null) for
 // snappyHexMesh to make from `surface`, the fluid surface whose ASCII STL is `fluid_stl` (also
 // needed, with params.snappy, beside gmsh's).
@@ -45,7 +45,7 @@ CaseStage case_stage(std::shared_ptr<const meshing::PolyMesh> mesh, std::shared_
                      const Bed& bed,
                      const cases::CaseParams& params, const Provenance& provenance, const std::string& scene_toml,
                      const std::filesystem::path& fluid_stl, const std::filesystem::path& case_dir, bool overwrite,
-                     double sphere_scale, const Console& console, const CasePieces* pieces = nullptr);
+                     const cases::TreatedSolid& treated, const Console& console, const CasePieces* pieces = nullptr);
 
 // Runs a case that case_stage wrote without running it (a convergence level in pieces, sized on
 // its cells before it is solved): its flow into `written` (flow, report["flow"]) and a stage line

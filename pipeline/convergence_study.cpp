@@ -53,6 +53,11 @@ nlohmann::json ConvergenceStudy::to_json() const {
     if (complete && std::isfinite(convergence.extrapolated))
       out["extrapolated_error_to_exact"] = convergence.extrapolated / *exact_pa_m - 1.0;
   }
+  if (bound) {
+    out["bound"] = {{"pa_m", bound->pa_m}, {"side", bound->side()}};
+    if (complete && std::isfinite(convergence.extrapolated))
+      out["extrapolated_ratio_to_bound"] = convergence.extrapolated / bound->pa_m;
+  }
   return out;
 }
 
@@ -101,6 +106,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
   l.drag = solved.flow->drag;
   l.exact_pa_m = solved.flow->exact_pa_m;
+  l.bound = solved.flow->bound;
   if (!l.converged) l.failure = "simpleFoam did not converge to the residual targets";
   l.time_s = solved.report["time_s"].get<double>();
   l.own_time_s = surface_mesh_s + l.time_s;
@@ -155,7 +161,7 @@ CaseStage write_level_in_pieces(const Scene& scene, const Bed& bed, const LevelL
   params.run = false;  // sized first, solved once
   const CasePieces pieces = case_pieces(bed, lengths.surface, scene.mesh.pieces, level_dir, console);
   return case_stage(nullptr, nullptr, bed, params, prov, toml_text, {}, level_dir / "case", true,
-                    scene.surface.sphere_scale(), console, &pieces);
+                    treated_solid(scene.surface, bed), console, &pieces);
 }
 
 // Level k of the study, solved in `case_dir`, its cells of size `target_h_m`. The mesh lengths
@@ -214,7 +220,7 @@ StudyLevel solve_level(const Scene& scene, const Bed& bed, int k, double target_
       params.snappy = false;  // a coarser level is solved on its gmsh cells only
       const meshing::PolyMesh* cells = &m->volume->mesh;
       c = case_stage({std::move(m->volume), cells}, nullptr, bed, params, prov, scene_to_toml(scene.table), {}, case_dir,
-                     true, scene.surface.sphere_scale(), console);
+                     true, treated_solid(scene.surface, bed), console);
     }
     StudyLevel solved = study_level(*c, k, scale, surface_mesh_s);
     solved.sizing = std::move(l.sizing);
@@ -312,6 +318,26 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
     if (study.complete && std::isfinite(study.convergence.extrapolated))
       study.conclusion += fmt::format(", extrapolated {:+.3f} %",
                                       100.0 * (study.convergence.extrapolated / exact - 1.0));
+  }
+  if (finest.bound && !solved.empty()) {
+    const cases::KnownBound& b = *finest.bound;
+    study.bound = b;
+    study.conclusion += fmt::format("; against the untreated array's {:.5g} Pa/m, a bound from {} (the treatment {} "
+                                    "solid): finest solved level {:+.3f} %",
+                                    b.pa_m, b.side(), b.from_below ? "adds" : "takes",
+                                    100.0 * (solved.front().value / b.pa_m - 1.0));
+    if (study.complete && std::isfinite(study.convergence.extrapolated)) {
+      // The band (the finest value +- its GCI) should reach the bound's side: the mesh-independent
+      // value lies there.
+      const double x = study.convergence.extrapolated, f = solved.front().value;
+      const double half = study.convergence.gci_fine * std::abs(f);
+      const bool band_reaches = b.holds(f + half) || b.holds(f - half);
+      study.conclusion += fmt::format(", extrapolated {:+.3f} %", 100.0 * (x / b.pa_m - 1.0));
+      if (!b.holds(x))
+        study.conclusion += band_reaches ? ", past the bound but within its band"
+                                         : ", past the bound with its whole band, where the mesh-independent value "
+                                           "cannot lie: the band is too narrow";
+    }
   }
   return study;
 }

@@ -34,6 +34,7 @@ struct StudyLevel {
                               // failed has none)
   std::string failure;        // why the level gave no value (empty when it did)
   std::optional<double> exact_pa_m;  // an empty container's known answer (the case's)
+  std::optional<cases::KnownBound> bound;  // a treated lattice's: its untreated answer (the case's)
   // The scales tried to bring a coarser level's cells to their target size, with the cell size
   // each mesh promised ((fluid volume / cells to solve)^(1/3), m), the last one solved.
   std::vector<std::pair<double, double>> sizing;
@@ -58,6 +59,9 @@ struct ConvergenceStudy {
   // error against it and the order of those errors, the verification of the whole route.
   std::optional<double> exact_pa_m;
   double order_from_exact = 0.0;         // observed_order over the levels that gave a value
+  // A treated simple cubic column's or array's: its untreated answer, which the extrapolation
+  // (the treated bed's mesh-independent value) must not pass (cases::KnownBound).
+  std::optional<cases::KnownBound> bound;
   nlohmann::json to_json() const;
 };
 

@@ -200,13 +200,13 @@ void case_directory(const fs::path& dir, const std::vector<Override>& overrides,
     mesh = std::make_shared<const meshing::PolyMesh>(meshing::read_msh(dir / "fluid.msh"));
   const Provenance prov{kVersion, d.report.data().value("seed", 0ULL), d.report.data().value("scene", nlohmann::json())};
 #ifdef BEDFORGE_HAVE_CGAL
-  const double sphere_scale = read_surface_sections(d.scene).sphere_scale();
+  const cases::TreatedSolid treated = treated_solid(read_surface_sections(d.scene), d.bed);
 #else
-  const double sphere_scale = 0.0;  // without a surface stage the treatment is not known
+  const cases::TreatedSolid treated{0.0, 0};  // without a surface stage the treatment is not known
 #endif
   const CaseStage c = case_stage(std::move(mesh), std::move(surface), d.bed, params, prov,
                                  scene_to_toml(d.scene), params.snappy ? stl : fs::path(), dir / "case", overwrite,
-                                 sphere_scale, console);
+                                 treated, console);
   nlohmann::json entry = c.report;
 #ifdef BEDFORGE_HAVE_VOLUME_MESH
   // The coarser levels need the whole scene: their surface and mesh settings, scaled.

@@ -20,7 +20,7 @@ namespace bedforge::pipeline {
 //                  lies 1 / 1.25 of the half-width from the finest value;
 //   reference:     Eisfeld & Schnitzlein (2001) at the section's void fraction of the spheres as
 //                  packed, +- its stated accuracy (docs/reference.md), or a known answer (an
-//                  empty tube's, a simple cubic array's), exact.
+//                  empty tube's, a simple cubic array's), exact, or a treated array's bound.
 struct PressureDropAnswer {
   double section_low_m = 0.0, section_high_m = 0.0;  // the section's planes
   bool periodic = false;                              // the section is one period of a periodic bed
@@ -38,6 +38,9 @@ struct PressureDropAnswer {
   double reference_pa_m = 0.0;
   std::optional<double> reference_accuracy;          // relative, e.g. 0.2; none for an exact answer
   std::optional<double> void_fraction_bed;           // where the correlation was taken
+  // A treated simple cubic column or array (cases::KnownBound): the reference is its untreated
+  // answer, a bound from "below" or "above"; empty otherwise.
+  std::string reference_bound_side;
   // A random array in a box periodic on every side (cases::CaseInfo::stokes_array): van der Hoef et
   // al.'s Stokes drag (Pa/m) at the solid fraction of the spheres as solved, said beside the reference.
   std::optional<double> stokes_array_pa_m, stokes_array_solid_fraction;

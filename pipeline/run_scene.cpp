@@ -199,7 +199,7 @@ void run_scene(const Scene& scene, const fs::path& dir, const RunOptions& opt, c
         in_pieces ? std::optional(case_pieces(bed, scene.surface, scene.mesh.pieces, dir, console)) : std::nullopt;
     const CaseStage c = case_stage(std::move(mesh), std::move(fluid), bed, case_scene.case_params, prov,
                                    read_file(dir / "scene.toml"), scene.case_params.snappy ? dir / "fluid.stl" : fs::path(),
-                                   dir / "case", opt.overwrite, scene.surface.sphere_scale(), console,
+                                   dir / "case", opt.overwrite, treated_solid(scene.surface, bed), console,
                                    pieces ? &*pieces : nullptr);
     nlohmann::json entry = c.report;
     std::optional<ConvergenceStudy> s;

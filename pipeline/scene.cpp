@@ -353,6 +353,12 @@ SceneSchema scene_schema() {
   return schema;
 }
 
+#ifdef BEDFORGE_HAVE_CGAL
+cases::TreatedSolid treated_solid(const meshing::SurfaceParams& surface, const Bed& bed) {
+  return {surface.sphere_scale(), surface.solid_change(bed.container->periodicity().any())};
+}
+#endif
+
 Scene read_scene_file(const std::filesystem::path& path) {
   return read_scene(parse_scene_text(read_file(path), path.string()), path.string(), path.parent_path());
 }

@@ -81,6 +81,12 @@ struct Scene {
 Scene read_scene(const toml::table& table, const std::string& source, const std::filesystem::path& base_dir = {});
 Scene read_scene_file(const std::filesystem::path& path);
 
+#ifdef BEDFORGE_HAVE_CGAL
+// What the contact treatment `surface` does to `bed`'s spheres, as its case compares them with a
+// known answer (cases::set_known_answers).
+cases::TreatedSolid treated_solid(const meshing::SurfaceParams& surface, const Bed& bed);
+#endif
+
 // Every key a scene can hold, with its type, range and default, as the section readers ask for
 // them (for the command line's help and docs/scene_reference.md).
 SceneSchema scene_schema();

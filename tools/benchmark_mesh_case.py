@@ -544,8 +544,7 @@ def study_run(path):
     """`bedforge run` of path.toml into path, timed: its wall time, convergence study and d (m)."""
     wall, _ = timed([BEDFORGE, "--quiet", "run", path + ".toml", "-o", path, "--overwrite"])
     case = json.load(open(os.path.join(path, "report.json")))["stages"]["case"]
-    return {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"], "velocity_m_s": case["velocity_m_s"],
-            "parameters": {"viscosity_pa_s": case["parameters"]["viscosity_pa_s"]}}
+    return {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
 
 
 def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case="", surface="", treatment="none"):
@@ -599,10 +598,6 @@ def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, ce
     return out
 
 
-# Zick & Homsy (1982, Table 2): K of the simple cubic array of touching spheres (solid fraction pi / 6).
-ZICK_HOMSY_TOUCHING_K = 42.1
-
-
 def verification_touching(tmp, edge, levels, count=6, cells_measured=4):
     """The touching simple cubic column (solid fraction pi / 6, each sphere touching its neighbours
     and the four mirror walls) with its contacts bridged, on each of the cost sections' routes."""
@@ -616,12 +611,9 @@ def verification_touching(tmp, edge, levels, count=6, cells_measured=4):
 
 
 def touching_bound_pa_m(run):
-    """Zick & Homsy's drag of the untreated touching array as a pressure gradient (Pa/m) at the run's
-    flow: 6 pi mu a K U per sphere over a cell of side L = d. Stokes drag only grows with solid added
-    at a fixed flow rate, so it bounds the bridged array's from below."""
-    p = run["parameters"]
-    d = run["d_m"]
-    return 6.0 * math.pi * p["viscosity_pa_s"] * (d / 2.0) * ZICK_HOMSY_TOUCHING_K * run["velocity_m_s"] / d ** 3
+    """The bound bedforge gives a treated simple cubic column (Pa/m): the untreated array's drag,
+    Zick & Homsy's (the study's "bound"), from below for bridges."""
+    return run["study"]["bound"]["pa_m"]
 
 
 def touching_lines(v):
@@ -633,8 +625,9 @@ def touching_lines(v):
              "pressure drop over the middle four, Stokes flow (Re_p = 0.01), through the same route as a bed, on "
              f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}, on the cost sections' "
              "routes. No exact value is known for the bridged array; Zick & Homsy's untreated touching array "
-             f"(1982, Table 2, K = {ZICK_HOMSY_TOUCHING_K}) bounds it from below, since at a fixed flow rate Stokes "
-             "drag only grows with solid added (the bridges add about 0.2 % solid; docs/findings.md, 2026-11-27). "
+             "(1982, Table 2) bounds it from below, since at a fixed flow rate Stokes drag only grows with solid "
+             "added (the bridges add about 0.2 % solid; docs/findings.md, 2026-11-27): the bound bedforge reports "
+             "for a treated simple cubic column (report.json, stages.case.convergence.bound). "
              "Against the bound = dp/L / bound - 1; its order is a least-squares fit of ln |against the bound| against "
              "ln h over all levels, which falls short of the true order as the levels near the bridged array's own "
              "value.", ""]

@@ -96,6 +96,16 @@ SurfaceParams read_surface_params(SceneSection& c, SceneSection& s) {
   return p;
 }
 
+int SurfaceParams::solid_change(bool periodic) const {
+  auto sign = [](Treatment t) {
+    return t == Treatment::bridge || t == Treatment::enlarge ? 1 : t == Treatment::none ? 0 : -1;
+  };
+  const int spheres = sign(treatment), walls = sign(wall_treatment);
+  const int change = spheres == 0 ? walls : (walls == 0 || walls == spheres) ? spheres : 0;
+  const bool opened = (periodic && !cut_at_periodic_planes) || (clip && !cut_at_clip_planes);
+  return change > 0 && opened ? 0 : change;
+}
+
 nlohmann::json to_json(const SurfaceParams& p) {
   nlohmann::json j = {{"treatment", treatment_name(p.treatment)},
           {"wall_treatment", treatment_name(p.wall_treatment)},

@@ -75,6 +75,11 @@ struct SurfaceParams {
                         (wall_treatment == Treatment::shrink || wall_treatment == Treatment::none);
     return shrunk ? shrink_factor : 0.0;
   }
+  // +1 when the treatment only adds solid to the spheres (bridges, enlarged spheres), -1 when it
+  // only takes it (shrink, caps), 0 when it keeps them or does both. On a bed periodic along some
+  // side (`periodic`), contacts opened at its planes have their spheres shrunk, and so do those at
+  // clip planes left open: a treatment that adds solid then does both.
+  int solid_change(bool periodic) const;
 };
 const char* treatment_name(SurfaceParams::Treatment t);
 // A scene's defaults are those of a pressure-drop run, where they differ from the struct's (the

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cases/case_writer.hpp"
+#include "analysis/stokes_arrays.hpp"
 #include "core/container.hpp"
 
 using bedforge::Bed;
@@ -45,7 +46,7 @@ TEST(CaseWriter, ARandomArrayIsComparedWithVanDerHoefOnlyWhenItsSpheresAreEqual)
   // Equal spheres at Stokes flow: van der Hoef et al. at the solid fraction and size solved.
   const Bed equal = random_array(0.001);
   CaseInfo info = periodic_info(equal, 0.01);
-  bedforge::cases::set_known_answers(info, equal, 1.0);
+  bedforge::cases::set_known_answers(info, equal, {1.0, 0});
   ASSERT_TRUE(info.stokes_array.has_value());
   EXPECT_NEAR(info.stokes_array->solid_fraction, 3.0 * kPi / 6.0 / 64.0, 1e-12);
   EXPECT_DOUBLE_EQ(info.stokes_array->diameter_m, 0.001);
@@ -55,7 +56,7 @@ TEST(CaseWriter, ARandomArrayIsComparedWithVanDerHoefOnlyWhenItsSpheresAreEqual)
 
   // Shrunk by one scale: the spheres as solved, a solid fraction smaller by its cube.
   CaseInfo shrunk = periodic_info(equal, 0.01);
-  bedforge::cases::set_known_answers(shrunk, equal, 0.98);
+  bedforge::cases::set_known_answers(shrunk, equal, {0.98, -1});
   ASSERT_TRUE(shrunk.stokes_array.has_value());
   EXPECT_NEAR(shrunk.stokes_array->solid_fraction, 3.0 * kPi / 6.0 / 64.0 * 0.98 * 0.98 * 0.98, 1e-12);
   EXPECT_DOUBLE_EQ(shrunk.stokes_array->diameter_m, 0.00098);
@@ -63,13 +64,63 @@ TEST(CaseWriter, ARandomArrayIsComparedWithVanDerHoefOnlyWhenItsSpheresAreEqual)
   // Unequal spheres: no drag from a fit for equal ones, and the reason said.
   const Bed unequal = random_array(0.0012);
   CaseInfo mixed = periodic_info(unequal, 0.01);
-  bedforge::cases::set_known_answers(mixed, unequal, 1.0);
+  bedforge::cases::set_known_answers(mixed, unequal, {1.0, 0});
   EXPECT_FALSE(mixed.stokes_array.has_value());
   EXPECT_NE(mixed.stokes_array_not_compared.find("equal spheres"), std::string::npos) << mixed.stokes_array_not_compared;
 
   // Past Stokes flow (Re_p 1) neither: their drag is Stokes flow's.
   CaseInfo inertial = periodic_info(equal, 1.0);
-  bedforge::cases::set_known_answers(inertial, equal, 1.0);
+  bedforge::cases::set_known_answers(inertial, equal, {1.0, 0});
   EXPECT_FALSE(inertial.stokes_array.has_value());
   EXPECT_TRUE(inertial.stokes_array_not_compared.empty());
+}
+
+// A simple cubic column in a slip-walled box (the array's mirror planes) at Stokes flow: exact with
+// its own spheres; treated, Zick & Homsy's untreated array bounds it, from below when the treatment
+// adds solid and from above when it takes it; a treatment doing both, or not known, gets neither.
+TEST(CaseWriter, ATreatedSimpleCubicColumnIsBoundedByTheUntreatedArray) {
+  const double d = 0.003, L = d;  // touching: solid fraction pi / 6, tabulated (K = 42.1)
+  Bed column;
+  column.container = std::make_shared<bedforge::Box>(L, L, false, false);
+  for (int k = 0; k < 6; ++k) column.centres.emplace_back(0.0, 0.0, (k + 0.5) * L), column.diameters.push_back(d);
+  auto info_for = [&] {
+    CaseInfo info;
+    info.params.reynolds = 0.01;
+    info.params.viscosity_pa_s = 1e-3;
+    info.params.slip_walls = true;
+    info.velocity_m_s = 0.01 * 1e-6 / d;
+    info.particles = true;
+    info.section.z_low = 1.0 * L, info.section.z_high = 5.0 * L;
+    return info;
+  };
+  const std::optional<double> untreated = bedforge::analysis::simple_cubic_column_gradient(
+      column, 1e-3, 0.01 * 1e-6 / d, 1.0 * L, 5.0 * L);
+  ASSERT_TRUE(untreated.has_value());
+
+  CaseInfo kept = info_for();
+  bedforge::cases::set_known_answers(kept, column, {1.0, 0});
+  ASSERT_TRUE(kept.exact_pressure_gradient_pa_m.has_value());
+  EXPECT_DOUBLE_EQ(*kept.exact_pressure_gradient_pa_m, *untreated);
+  EXPECT_FALSE(kept.bound.has_value());
+
+  CaseInfo bridged = info_for();
+  bedforge::cases::set_known_answers(bridged, column, {0.0, 1});
+  EXPECT_FALSE(bridged.exact_pressure_gradient_pa_m.has_value());
+  ASSERT_TRUE(bridged.bound.has_value());
+  EXPECT_DOUBLE_EQ(bridged.bound->pa_m, *untreated);
+  EXPECT_TRUE(bridged.bound->from_below);
+  EXPECT_TRUE(bridged.bound->holds(1.001 * *untreated));
+  EXPECT_FALSE(bridged.bound->holds(0.999 * *untreated));
+
+  CaseInfo shrunk = info_for();
+  bedforge::cases::set_known_answers(shrunk, column, {0.99, -1});
+  ASSERT_TRUE(shrunk.bound.has_value());
+  EXPECT_FALSE(shrunk.bound->from_below);
+  EXPECT_TRUE(shrunk.bound->holds(0.999 * *untreated));
+  EXPECT_FALSE(shrunk.stokes_array.has_value());  // a lattice, not a random array
+
+  CaseInfo both = info_for();
+  bedforge::cases::set_known_answers(both, column, {0.0, 0});
+  EXPECT_FALSE(both.bound.has_value());
+  EXPECT_FALSE(both.exact_pressure_gradient_pa_m.has_value());
 }

@@ -227,3 +227,30 @@ TEST(PressureDropAnswer, AReynoldsNumberPastSteadyFlowIsSaidBesideTheAnswer) {
     EXPECT_EQ(has(a->lines(), "Dybbs & Edwards"), re > kUnsteadyFlowReynolds) << "Re_p " << re;
   }
 }
+
+// A treated simple cubic column's reference is its untreated array's answer, said as a bound; a
+// band wholly on the wrong side of it is said to be too narrow. Values 30 - 10 (h / h1)^2 give the
+// band [7.5, 32.5] (as above): a bound from below at 25 lies inside it, one at 33 above it all.
+TEST(PressureDropAnswer, ATreatedArraysBoundIsTheReferenceAndABandPastItIsSaid) {
+  const ConvergenceStudy study = study_of(30.0, -10.0, 2.0);
+  auto with_bound = [](double pa_m, const std::string& side) {
+    nlohmann::json entry = case_entry(20.0);
+    entry["flow"]["bound"] = {{"pa_m", pa_m}, {"side", side}};
+    return entry;
+  };
+  const auto inside = pressure_drop_answer(scene_with(), with_bound(25.0, "below"), &study);
+  ASSERT_TRUE(inside.has_value());
+  EXPECT_EQ(inside->reference_bound_side, "below");
+  EXPECT_DOUBLE_EQ(inside->reference_pa_m, 25.0);
+  EXPECT_TRUE(has(inside->lines(), "the simple cubic array untreated: 25 Pa/m, a bound from below"));
+  EXPECT_TRUE(has(inside->lines(), "best estimate / reference: 1.200"));
+  EXPECT_FALSE(has(inside->lines(), "band is too narrow"));
+  EXPECT_EQ(inside->to_json()["reference"]["bound"], "below");
+  const auto past = pressure_drop_answer(scene_with(), with_bound(33.0, "below"), &study);
+  EXPECT_TRUE(has(past->lines(), "the whole band lies below the bound")) << past->lines().back();
+  // From above (a treatment that takes solid): the same band wholly above 7 is past it.
+  EXPECT_TRUE(has(pressure_drop_answer(scene_with(), with_bound(7.0, "above"), &study)->lines(),
+                  "the whole band lies above the bound"));
+  EXPECT_FALSE(has(pressure_drop_answer(scene_with(), with_bound(31.0, "above"), &study)->lines(),
+                   "the whole band lies"));
+}

@@ -422,15 +422,24 @@ TEST(RunScene, TheSimpleCubicExampleConvergesToZickAndHomsy) {
 }
 
 // A treatment that changes the spheres changes the array: shrink (every sphere scaled by 0.99,
-// contacts or not) leaves no known answer, and the bed is compared with the correlation.
-TEST(RunScene, ASimpleCubicColumnWhoseSpheresAreShrunkHasNoExactAnswer) {
+// contacts or not) leaves no known answer; the untreated array's bounds it from above (solid
+// taken), the bed's reference (cases::KnownBound), the correlation beside it.
+TEST(RunScene, ASimpleCubicColumnWhoseSpheresAreShrunkIsBoundedByTheUntreatedArray) {
   const Scene scene = example_scene("simple_cubic_verification.toml",
                                     {{"surface.edge_length_d", 0.15}, {"surface.contact_edge_length_d", 0.075},
                                      {"contacts.treatment", std::string("shrink")}, {"case.convergence.levels", 0LL}});
   const fs::path dir = test_support::fresh_dir("simple_cubic_shrunk");
   const RunOutcome r = run(scene, dir);
-  EXPECT_TRUE(r.stages["case"]["exact_pressure_gradient_pa_m"].is_null()) << r.stages["case"].dump();
-  EXPECT_TRUE(r.stages["case"]["flow"].contains("eisfeld_schnitzlein_pa_m"));
+  const nlohmann::json& c = r.stages["case"];
+  EXPECT_TRUE(c["exact_pressure_gradient_pa_m"].is_null()) << c.dump();
+  EXPECT_TRUE(c["flow"].contains("eisfeld_schnitzlein_pa_m"));
+  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
+  const double side = d * std::cbrt(pi / (6.0 * 0.216)), untreated = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
+  ASSERT_TRUE(c["flow"]["bound"].is_object()) << c["flow"].dump();
+  EXPECT_NEAR(c["flow"]["bound"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
+  EXPECT_EQ(c["flow"]["bound"]["side"], "above");
+  EXPECT_NEAR(c["flow"]["ratio_to_bound"].get<double>(),
+              c["flow"]["pressure_gradient_bed_pa_m"].get<double>() / untreated, 1e-12);
 }
 
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three

@@ -1138,3 +1138,32 @@ TEST(FluidSurface, AClipPlaneCutsThroughTheContactsItCrossesWhenAsked) {
       EXPECT_LT(outlet - fs.report["domain_m"]["inlet_z"].get<double>(), 1.2) << label;
     }
 }
+
+// Which way a treatment moves the solid decides which side the untreated bed's known answer bounds
+// (cases::KnownBound): bridges and enlarged spheres only add, shrink and caps only take, and a
+// treatment that adds is opened (its spheres shrunk) at periodic or clip planes left open.
+TEST(FluidSurface, TheTreatmentSaysWhetherItAddsOrTakesSolid) {
+  using T = SurfaceParams::Treatment;
+  auto change = [](T spheres, T walls, bool periodic = false) {
+    SurfaceParams p;
+    p.treatment = spheres, p.wall_treatment = walls;
+    return p.solid_change(periodic);
+  };
+  EXPECT_EQ(change(T::none, T::none), 0);
+  EXPECT_EQ(change(T::bridge, T::bridge), 1);
+  EXPECT_EQ(change(T::enlarge, T::enlarge), 1);
+  EXPECT_EQ(change(T::bridge, T::none), 1);
+  EXPECT_EQ(change(T::none, T::bridge), 1);
+  EXPECT_EQ(change(T::shrink, T::shrink), -1);
+  EXPECT_EQ(change(T::cap, T::none), -1);
+  EXPECT_EQ(change(T::bridge, T::cap), 0);  // both
+  EXPECT_EQ(change(T::bridge, T::bridge, true), 0);  // opened at the periodic planes, the scene's default
+  EXPECT_EQ(change(T::cap, T::cap, true), -1);       // opening takes solid too
+  SurfaceParams cut;
+  cut.treatment = cut.wall_treatment = T::bridge;
+  cut.cut_at_periodic_planes = true;
+  EXPECT_EQ(cut.solid_change(true), 1);
+  cut.clip = true;
+  cut.cut_at_clip_planes = false;
+  EXPECT_EQ(cut.solid_change(false), 0);
+}
