@@ -442,6 +442,26 @@ TEST(RunScene, ASimpleCubicColumnWhoseSpheresAreShrunkIsBoundedByTheUntreatedArr
               c["flow"]["pressure_gradient_bed_pa_m"].get<double>() / untreated, 1e-12);
 }
 
+// The touching array with its contacts bridged (scenes/examples/touching_cubic_bridged.toml), one
+// coarse mesh: no exact answer, the untreated touching array's (Zick & Homsy 1982, Table 2, K =
+// 42.1 at pi / 6) its bound from below, the answer's reference.
+TEST(RunScene, TheBridgedTouchingExampleIsBoundedFromBelowByTheUntreatedArray) {
+  const Scene scene = example_scene("touching_cubic_bridged.toml", {{"surface.edge_length_d", 0.15},
+                                                                    {"surface.contact_edge_length_d", 0.075},
+                                                                    {"case.convergence.levels", 0LL}});
+  const fs::path dir = test_support::fresh_dir("touching_bridged");
+  const RunOutcome r = run(scene, dir);
+  const nlohmann::json& c = r.stages["case"];
+  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
+  const double untreated = 3.0 * pi * mu * d * 42.1 * u / (d * d * d);
+  EXPECT_TRUE(c["exact_pressure_gradient_pa_m"].is_null()) << c.dump();
+  ASSERT_TRUE(c["flow"]["bound"].is_object()) << c["flow"].dump();
+  EXPECT_NEAR(c["flow"]["bound"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
+  EXPECT_EQ(c["flow"]["bound"]["side"], "below");
+  EXPECT_EQ(c["answer"]["reference"]["bound"], "below");
+  EXPECT_NEAR(c["answer"]["reference"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
+}
+
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three
 // cells, cyclic inlet and outlet, meanVelocityForce; order 2.05 measured at the example's
 // settings, 2026-11-28).
