@@ -70,6 +70,9 @@ struct KnownBound {
   const char* side() const { return from_below ? "below" : "above"; }
   // Whether `pa_m_solved` lies on the bound's side of it.
   bool holds(double pa_m_solved) const { return from_below ? pa_m_solved >= pa_m : pa_m_solved <= pa_m; }
+  // Whether an uncertainty band [low, high] (Pa/m) reaches the bound's side, where the
+  // mesh-independent value lies.
+  bool reached_by(double low, double high) const { return holds(from_below ? high : low); }
 };
 
 // A case as written: what running it and comparing its pressure drop need.

@@ -327,11 +327,9 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
                                     b.pa_m, b.side(), b.from_below ? "adds" : "takes",
                                     100.0 * (solved.front().value / b.pa_m - 1.0));
     if (study.complete && std::isfinite(study.convergence.extrapolated)) {
-      // The band (the finest value +- its GCI) should reach the bound's side: the mesh-independent
-      // value lies there.
       const double x = study.convergence.extrapolated, f = solved.front().value;
-      const double half = study.convergence.gci_fine * std::abs(f);
-      const bool band_reaches = b.holds(f + half) || b.holds(f - half);
+      const double half = study.convergence.gci_fine * std::abs(f);  // the band: the finest +- its GCI
+      const bool band_reaches = b.reached_by(f - half, f + half);
       study.conclusion += fmt::format(", extrapolated {:+.3f} %", 100.0 * (x / b.pa_m - 1.0));
       if (!b.holds(x))
         study.conclusion += band_reaches ? ", past the bound but within its band"

@@ -85,9 +85,9 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.reference_name = "the exact answer of this case";
     a.reference_pa_m = flow["exact_pa_m"].get<double>();
   } else if (flow.contains("bound")) {
-    a.reference_bound_side = flow["bound"]["side"].get<std::string>();
     a.reference_name = "Zick & Homsy (1982), the simple cubic array untreated";
     a.reference_pa_m = flow["bound"]["pa_m"].get<double>();
+    a.reference_bound = cases::KnownBound{a.reference_pa_m, flow["bound"]["side"].get<std::string>() == "below"};
   } else {
     a.reference_name = "Eisfeld & Schnitzlein (2001)";
     a.reference_pa_m = flow["eisfeld_schnitzlein_bed_pa_m"].get<double>();
@@ -152,12 +152,12 @@ std::vector<std::string> PressureDropAnswer::lines() const {
           ? fmt::format("  {}: {:.4g} Pa/m +- {:.0f} % (its stated accuracy, docs/reference.md), at the section's void "
                         "fraction of the spheres as packed, {:.4f}",
                         reference_name, reference_pa_m, 100.0 * *reference_accuracy, void_fraction_bed.value_or(0.0))
-          : reference_bound_side.empty()
+          : !reference_bound
               ? fmt::format("  {}: {:.6g} Pa/m", reference_name, reference_pa_m)
               : fmt::format("  {}: {:.6g} Pa/m, a bound from {}: the contact treatment {} solid, and Stokes drag at "
                             "a set flow rate only grows with the solid",
-                            reference_name, reference_pa_m, reference_bound_side,
-                            reference_bound_side == "below" ? "adds" : "takes");
+                            reference_name, reference_pa_m, reference_bound->side(),
+                            reference_bound->from_below ? "adds" : "takes");
   const std::string stokes_array =
       stokes_array_pa_m
           ? fmt::format("  van der Hoef, Beetstra & Kuipers (2005), Stokes drag of random arrays: {:.4g} Pa/m at the "
@@ -177,11 +177,10 @@ std::vector<std::string> PressureDropAnswer::lines() const {
                               *band_low_pa_m, *band_high_pa_m, finest_pa_m, finest_cells, 100.0 * gci_fine));
     out.push_back(reference);
     out.push_back(fmt::format("  best estimate / reference: {:.3f}", *best_pa_m / reference_pa_m));
-    const bool below = reference_bound_side == "below", above = reference_bound_side == "above";
-    if ((below && *band_high_pa_m < reference_pa_m) || (above && *band_low_pa_m > reference_pa_m))
+    if (reference_bound && !reference_bound->reached_by(*band_low_pa_m, *band_high_pa_m))
       out.push_back(fmt::format("  the whole band lies {} the bound, where the mesh-independent value cannot: the "
                                 "band is too narrow; refine the study",
-                                below ? "below" : "above"));
+                                reference_bound->side()));
     if (stokes_array_pa_m)
       out.push_back(stokes_array + fmt::format("; best estimate / it: {:.3f}", *best_pa_m / *stokes_array_pa_m));
     else if (!stokes_array.empty())
@@ -227,7 +226,7 @@ nlohmann::json PressureDropAnswer::to_json() const {
                         {"pa_m", reference_pa_m},
                         {"relative_accuracy", reference_accuracy ? nlohmann::json(*reference_accuracy) : nullptr},
                         {"void_fraction_bed", void_fraction_bed ? nlohmann::json(*void_fraction_bed) : nullptr},
-                        {"bound", reference_bound_side.empty() ? nlohmann::json() : nlohmann::json(reference_bound_side)}}},
+                        {"bound", reference_bound ? nlohmann::json(reference_bound->side()) : nlohmann::json()}}},
                       {"lines", lines()}};
   if (stokes_array_pa_m)
     j["stokes_array"] = {{"name", "van der Hoef, Beetstra & Kuipers (2005)"},

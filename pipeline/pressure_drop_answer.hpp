@@ -38,9 +38,8 @@ struct PressureDropAnswer {
   double reference_pa_m = 0.0;
   std::optional<double> reference_accuracy;          // relative, e.g. 0.2; none for an exact answer
   std::optional<double> void_fraction_bed;           // where the correlation was taken
-  // A treated simple cubic column or array (cases::KnownBound): the reference is its untreated
-  // answer, a bound from "below" or "above"; empty otherwise.
-  std::string reference_bound_side;
+  // A treated simple cubic column or array: the reference is its untreated answer, this bound.
+  std::optional<cases::KnownBound> reference_bound;
   // A random array in a box periodic on every side (cases::CaseInfo::stokes_array): van der Hoef et
   // al.'s Stokes drag (Pa/m) at the solid fraction of the spheres as solved, said beside the reference.
   std::optional<double> stokes_array_pa_m, stokes_array_solid_fraction;

@@ -111,12 +111,16 @@ TEST(CaseWriter, ATreatedSimpleCubicColumnIsBoundedByTheUntreatedArray) {
   EXPECT_TRUE(bridged.bound->from_below);
   EXPECT_TRUE(bridged.bound->holds(1.001 * *untreated));
   EXPECT_FALSE(bridged.bound->holds(0.999 * *untreated));
+  EXPECT_TRUE(bridged.bound->reached_by(0.9 * *untreated, 1.001 * *untreated));  // a band
+  EXPECT_FALSE(bridged.bound->reached_by(0.9 * *untreated, 0.999 * *untreated));
 
   CaseInfo shrunk = info_for();
   bedforge::cases::set_known_answers(shrunk, column, {0.99, -1});
   ASSERT_TRUE(shrunk.bound.has_value());
   EXPECT_FALSE(shrunk.bound->from_below);
   EXPECT_TRUE(shrunk.bound->holds(0.999 * *untreated));
+  EXPECT_TRUE(shrunk.bound->reached_by(0.999 * *untreated, 1.1 * *untreated));
+  EXPECT_FALSE(shrunk.bound->reached_by(1.001 * *untreated, 1.1 * *untreated));
   EXPECT_FALSE(shrunk.stokes_array.has_value());  // a lattice, not a random array
 
   CaseInfo both = info_for();

@@ -240,7 +240,8 @@ TEST(PressureDropAnswer, ATreatedArraysBoundIsTheReferenceAndABandPastItIsSaid) 
   };
   const auto inside = pressure_drop_answer(scene_with(), with_bound(25.0, "below"), &study);
   ASSERT_TRUE(inside.has_value());
-  EXPECT_EQ(inside->reference_bound_side, "below");
+  ASSERT_TRUE(inside->reference_bound.has_value());
+  EXPECT_TRUE(inside->reference_bound->from_below);
   EXPECT_DOUBLE_EQ(inside->reference_pa_m, 25.0);
   EXPECT_TRUE(has(inside->lines(), "the simple cubic array untreated: 25 Pa/m, a bound from below"));
   EXPECT_TRUE(has(inside->lines(), "best estimate / reference: 1.200"));
