@@ -123,7 +123,8 @@ TEST(CommandLine, EveryShippedSceneRuns) {
   EXPECT_EQ(with_a_case, (std::set<std::string>{"default.toml", "small_bed_flow.toml", "box_bed_flow.toml",
                                                 "empty_tube_verification.toml", "simple_cubic_verification.toml",
                                                 "periodic_section_flow.toml", "periodic_cubic_verification.toml",
-                                                "periodic_box_cubic_verification.toml", "random_array_stokes.toml"}));
+                                                "periodic_box_cubic_verification.toml", "random_array_stokes.toml",
+                                                "touching_cubic_bridged.toml"}));
 #endif
 }
 
