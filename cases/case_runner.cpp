@@ -51,7 +51,7 @@ nlohmann::json FlowResult::to_json() const {
     j["ratio_to_van_der_hoef"] = *ratio_to_van_der_hoef;
   }
   if (bound) {
-    j["bound"] = {{"pa_m", bound->pa_m}, {"side", bound->side()}};
+    j["bound"] = bound->to_json();
     j["ratio_to_bound"] = ratio_to_bound;
   }
   if (exact_pa_m) {

@@ -105,6 +105,13 @@ Eigen::Vector3d fluid_point(const Bed& bed, const CaseGeometry& g) {
   return best;
 }
 
+KnownBound KnownBound::from_json(const nlohmann::json& j) {
+  const auto side = j.at("side").get<std::string>();
+  if (side != "below" && side != "above")
+    throw std::runtime_error(fmt::format("a bound's side is \"{}\"; allowed: \"below\", \"above\"", side));
+  return {j.at("pa_m").get<double>(), side == "below"};
+}
+
 nlohmann::json CaseInfo::to_json() const {
   return {{"directory", directory.string()},
           {"parameters", cases::to_json(params)},
@@ -122,7 +129,7 @@ nlohmann::json CaseInfo::to_json() const {
           {"fluid_volume_m3", fluid_volume_m3 ? nlohmann::json(*fluid_volume_m3) : nullptr},
           {"surface_volume_m3", surface_volume_m3 ? nlohmann::json(*surface_volume_m3) : nullptr},
           {"exact_pressure_gradient_pa_m", exact_pressure_gradient_pa_m ? nlohmann::json(*exact_pressure_gradient_pa_m) : nullptr},
-          {"bound", bound ? nlohmann::json{{"pa_m", bound->pa_m}, {"side", bound->side()}} : nlohmann::json()},
+          {"bound", bound ? bound->to_json() : nlohmann::json()},
           {"periodic_mean_velocity_m_s", mean_velocity_m_s ? nlohmann::json(*mean_velocity_m_s) : nullptr},
           {"walls", walls},
           {"stokes_array", stokes_array ? nlohmann::json{{"solid_fraction", stokes_array->solid_fraction},

@@ -73,6 +73,10 @@ struct KnownBound {
   // Whether an uncertainty band [low, high] (Pa/m) reaches the bound's side, where the
   // mesh-independent value lies.
   bool reached_by(double low, double high) const { return holds(from_below ? high : low); }
+  // {"pa_m", "side"} as report.json and study.json hold it; from_json reads it back and throws
+  // std::runtime_error when "side" is neither "below" nor "above".
+  nlohmann::json to_json() const { return {{"pa_m", pa_m}, {"side", side()}}; }
+  static KnownBound from_json(const nlohmann::json& j);
 };
 
 // A case as written: what running it and comparing its pressure drop need.

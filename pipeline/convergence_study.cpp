@@ -54,7 +54,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
       out["extrapolated_error_to_exact"] = convergence.extrapolated / *exact_pa_m - 1.0;
   }
   if (bound) {
-    out["bound"] = {{"pa_m", bound->pa_m}, {"side", bound->side()}};
+    out["bound"] = bound->to_json();
     if (complete && std::isfinite(convergence.extrapolated))
       out["extrapolated_ratio_to_bound"] = convergence.extrapolated / bound->pa_m;
   }

@@ -86,8 +86,8 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.reference_pa_m = flow["exact_pa_m"].get<double>();
   } else if (flow.contains("bound")) {
     a.reference_name = "Zick & Homsy (1982), the simple cubic array untreated";
-    a.reference_pa_m = flow["bound"]["pa_m"].get<double>();
-    a.reference_bound = cases::KnownBound{a.reference_pa_m, flow["bound"]["side"].get<std::string>() == "below"};
+    a.reference_bound = cases::KnownBound::from_json(flow["bound"]);
+    a.reference_pa_m = a.reference_bound->pa_m;
   } else {
     a.reference_name = "Eisfeld & Schnitzlein (2001)";
     a.reference_pa_m = flow["eisfeld_schnitzlein_bed_pa_m"].get<double>();

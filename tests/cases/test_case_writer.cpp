@@ -128,3 +128,17 @@ TEST(CaseWriter, ATreatedSimpleCubicColumnIsBoundedByTheUntreatedArray) {
   EXPECT_FALSE(both.bound.has_value());
   EXPECT_FALSE(both.exact_pressure_gradient_pa_m.has_value());
 }
+
+// The bound as report.json and study.json hold it reads back as it was; a side other than below
+// or above is refused rather than read as one of them.
+TEST(CaseWriter, ABoundReadsBackFromItsJson) {
+  using bedforge::cases::KnownBound;
+  for (const KnownBound b : {KnownBound{0.147, true}, KnownBound{2.5e3, false}}) {
+    const KnownBound read = KnownBound::from_json(b.to_json());
+    EXPECT_EQ(read.pa_m, b.pa_m);
+    EXPECT_EQ(read.from_below, b.from_below);
+  }
+  EXPECT_EQ((KnownBound{1.0, false}.to_json()["side"]), "above");
+  EXPECT_THROW(KnownBound::from_json({{"pa_m", 1.0}, {"side", "Below"}}), std::runtime_error);
+  EXPECT_THROW(KnownBound::from_json({{"pa_m", 1.0}}), nlohmann::json::exception);
+}

@@ -235,7 +235,7 @@ TEST(PressureDropAnswer, ATreatedArraysBoundIsTheReferenceAndABandPastItIsSaid) 
   const ConvergenceStudy study = study_of(30.0, -10.0, 2.0);
   auto with_bound = [](double pa_m, const std::string& side) {
     nlohmann::json entry = case_entry(20.0);
-    entry["flow"]["bound"] = {{"pa_m", pa_m}, {"side", side}};
+    entry["flow"]["bound"] = cases::KnownBound{pa_m, side == "below"}.to_json();
     return entry;
   };
   const auto inside = pressure_drop_answer(scene_with(), with_bound(25.0, "below"), &study);
