@@ -377,13 +377,20 @@ TEST(RunScene, TheEmptyTubeExampleMatchesHagenPoiseuille) {
 // bounds are the 1-3 the study's order must lie in (issue 24).
 namespace {
 
-// A simple cubic array's case (phi = 0.216, d = 3 mm, water, Re_p = 0.01) against Zick & Homsy:
-// the exact gradient 6 pi mu a K U / L^3 with K = 7.442, L = d (pi / (6 phi))^(1/3); its three
-// levels each below it and nearer than the coarser one, at an order between 1 and 3; or, given
+// Zick & Homsy's (1982) gradient (Pa/m) through a simple cubic array at solid fraction `phi`,
+// their drag K there, for the examples' spheres (d = 3 mm, water, Re_p = 0.01): 6 pi mu a K U / L^3
+// with L = d (pi / (6 phi))^(1/3).
+double zick_homsy_gradient(double phi, double K) {
+  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
+  const double side = d * std::cbrt(pi / (6.0 * phi));
+  return 3.0 * pi * mu * d * K * u / std::pow(side, 3);
+}
+
+// A simple cubic array's case (phi = 0.216) against Zick & Homsy (K = 7.442): its three levels
+// each below it and nearer than the coarser one, at an order between 1 and 3; or, given
 // `finest_error`, the finest level's error there instead of the order.
 void expect_converging_to_zick_homsy(const nlohmann::json& c, double* finest_error = nullptr) {
-  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
-  const double side = d * std::cbrt(pi / (6.0 * 0.216)), exact = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
+  const double exact = zick_homsy_gradient(0.216, 7.442);
   ASSERT_TRUE(c["exact_pressure_gradient_pa_m"].is_number()) << c.dump();
   EXPECT_NEAR(c["exact_pressure_gradient_pa_m"].get<double>(), exact, 1e-9 * exact);
   const nlohmann::json& study = c["convergence"];
@@ -433,8 +440,7 @@ TEST(RunScene, ASimpleCubicColumnWhoseSpheresAreShrunkIsBoundedByTheUntreatedArr
   const nlohmann::json& c = r.stages["case"];
   EXPECT_TRUE(c["exact_pressure_gradient_pa_m"].is_null()) << c.dump();
   EXPECT_TRUE(c["flow"].contains("eisfeld_schnitzlein_pa_m"));
-  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
-  const double side = d * std::cbrt(pi / (6.0 * 0.216)), untreated = 3.0 * pi * mu * d * 7.442 * u / std::pow(side, 3);
+  const double untreated = zick_homsy_gradient(0.216, 7.442);
   ASSERT_TRUE(c["flow"]["bound"].is_object()) << c["flow"].dump();
   EXPECT_NEAR(c["flow"]["bound"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
   EXPECT_EQ(c["flow"]["bound"]["side"], "above");
@@ -452,8 +458,7 @@ TEST(RunScene, TheBridgedTouchingExampleIsBoundedFromBelowByTheUntreatedArray) {
   const fs::path dir = test_support::fresh_dir("touching_bridged");
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& c = r.stages["case"];
-  const double pi = std::acos(-1.0), mu = 1.0e-3, d = 0.003, u = 0.01 * mu / (1000.0 * d);
-  const double untreated = 3.0 * pi * mu * d * 42.1 * u / (d * d * d);
+  const double untreated = zick_homsy_gradient(std::acos(-1.0) / 6.0, 42.1);
   EXPECT_TRUE(c["exact_pressure_gradient_pa_m"].is_null()) << c.dump();
   ASSERT_TRUE(c["flow"]["bound"].is_object()) << c["flow"].dump();
   EXPECT_NEAR(c["flow"]["bound"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
