@@ -208,7 +208,10 @@ void insert_layers(const PrismLayers& layers) {
     if (tags[k] < 1 || tags[k] > n_top) continue;
     const Eigen::Vector3d& p = layers.top.points[tags[k] - 1];
     if (p != Eigen::Vector3d(xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]))
-      throw std::runtime_error("volume mesh: gmsh renumbered the surface nodes; the prism layers cannot be joined");
+      throw std::runtime_error(fmt::format(
+          "volume mesh: gmsh renumbered the surface nodes (node {} is at ({:.9g}, {:.9g}, {:.9g}) m, the layers' top "
+          "point {} at ({:.9g}, {:.9g}, {:.9g}) m); the prism layers cannot be joined",
+          tags[k], xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2], tags[k] - 1, p.x(), p.y(), p.z()));
     ++checked;
   }
   if (checked != n_top) throw std::runtime_error("volume mesh: gmsh dropped surface nodes; the prism layers cannot be joined");
@@ -339,6 +342,9 @@ VolumeMesh build_volume_mesh(const TriangleMesh& surface, const Bed& bed, double
       gmsh::model::add("bedforge");
       tetrahedra = load_surface(boundary);
       gmsh::option::setNumber("Mesh.Algorithm3D", algorithm == Algorithm::hxt ? 10 : 1);
+      // The layers join the surface's nodes by their tags (index + 1), which gmsh's renumbering
+      // after meshing shuffled on issue 57's bed at a 0.28 d edge (docs/findings.md, 2026-12-07).
+      gmsh::option::setNumber("Mesh.Renumber", layers ? 0 : 1);
       // HXT's optimisation on two threads once left a boundary face that is no surface triangle
       // (a = 5, N = 300, enlarge); on one thread it did not.
       const int threads =

@@ -113,6 +113,33 @@ TEST(VolumeMesh, PrismLayersAndTetrahedraFillTheSurfaceTogether) {
   EXPECT_NEAR(cell_quality(again).total_volume, enclosed, 1e-9 * enclosed);
 }
 
+// Issue 57's bed (a = 4, N = 40, seed 1, bridges) at the coarsest level of a layered study (edge
+// 0.283 d, 2 layers of 0.0227 d): gmsh's renumbering of the nodes after meshing shuffled the
+// surface's tags there, and every algorithm failed to join the layers (2026-12-07).
+TEST(VolumeMesh, PrismLayersJoinACoarseBridgedBed) {
+  // In metres, d = 3 mm, as a scene has it: at d = 1 m the same bed met no renumbering.
+  const double d = 0.003;
+  Bed b = test_support::packed_bed(40, 4.0, 1);
+  for (auto& c : b.centres) c *= d;
+  for (auto& x : b.diameters) x *= d;
+  b.container = std::make_shared<Cylinder>(2.0 * d);
+  SurfaceParams sp;
+  sp.treatment = sp.wall_treatment = SurfaceParams::Treatment::bridge;
+  sp.edge_length_d = 0.28324;
+  sp.contact_edge_length_d = 0.081947;
+  sp.cells_per_gap = 2.11864;
+  const FluidSurface s = build_fluid_surface(b, sp);
+  VolumeMeshParams p;
+  p.max_size_d = 0.47206;
+  p.layers.count = 2;
+  p.layers.thickness_d = 0.022659;
+  Progress quiet("mesh", false);
+  const VolumeMesh vm = build_volume_mesh(s.fluid, b, d, p, {}, {}, quiet);
+  EXPECT_GT(vm.report["layers"]["cells"]["prisms"].get<long>(), 0);
+  const double enclosed = check_surface(s.fluid, SelfIntersectionTest::skip).volume;
+  EXPECT_NEAR(vm.quality.total_volume, enclosed, 1e-9 * enclosed);
+}
+
 TEST(VolumeMesh, AMeshBelowTheGateIsLocatedAndWrittenForParaView) {
   const Bed b = small_bed();
   const FluidSurface s = coarse_surface(b);
