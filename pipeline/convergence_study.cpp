@@ -85,6 +85,14 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   return l;
 }
 
+namespace {
+// The first guess of the exponent in cell size ~ lengths^alpha: a calibration on the a = 5,
+// N = 500 studies, whose level 2 measured 0.80-0.91 over four treatments and Reynolds numbers
+// (docs/findings.md, session 35). With 1, the cells grow less than the lengths, so level 2 came
+// out 4-5 % small and was meshed twice in every one of them.
+constexpr double kFirstSizingExponent = 0.85;
+}  // namespace
+
 LevelLengths level_lengths(const Scene& scene, double scale) {
   LevelLengths l{scene.surface, scene.mesh};
   l.surface.edge_length_d *= scale;
@@ -92,7 +100,14 @@ LevelLengths level_lengths(const Scene& scene, double scale) {
   l.surface.cells_per_gap /= scale;
   l.mesh.max_size_d *= scale;
   l.mesh.layers.thickness_d *= scale;  // the layers' count and growth stay: each layer scales
+  l.mesh.layers.room_scale /= scale;    // their room rule applied at the same lengths on every level
   return l;
+}
+
+meshing::PrismLayerParams layers_for_study(meshing::PrismLayerParams layers, const cases::CaseParams::Convergence& study) {
+  if (layers.count > 0 && study.levels > 0)
+    layers.room_scale = std::pow(study.ratio, (study.levels - 1) / kFirstSizingExponent);
+  return layers;
 }
 
 StudyLevel study_level(const CaseStage& solved, int level, double scale, double surface_mesh_s) {
@@ -118,11 +133,6 @@ namespace {
 // A level's cells must reach their target size within this fraction, tried at most this often.
 constexpr double kSizeTolerance = 0.03;
 constexpr int kSizingAttempts = 4;
-// The first guess of the exponent in cell size ~ lengths^alpha: a calibration on the a = 5,
-// N = 500 studies, whose level 2 measured 0.80-0.91 over four treatments and Reynolds numbers
-// (docs/findings.md, session 35). With 1, the cells grow less than the lengths, so level 2 came
-// out 4-5 % small and was meshed twice in every one of them.
-constexpr double kFirstSizingExponent = 0.85;
 
 // The cells the flow will be solved on, from the tetrahedra before the case is written:
 // the dual has one polyhedron per point.

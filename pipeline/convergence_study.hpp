@@ -66,8 +66,8 @@ struct ConvergenceStudy {
 };
 
 // The surface and mesh settings of a level whose lengths are `scale` times the scene's: the
-// surface's edge and contact edge, the mesh's largest cell, the prism layers' thickness, and the
-// edge across narrow gaps
+// surface's edge and contact edge, the mesh's largest cell, the prism layers' thickness (their
+// room rule kept at the finest's lengths: layers_for_study), and the edge across narrow gaps
 // (gap / cells_per_gap: cells_per_gap is divided by `scale`, and the gaps it refines stay the
 // same). Celik et al.'s procedure needs meshes refined alike everywhere; with cells_per_gap
 // kept, the gaps' cells were the same on every level.
@@ -76,6 +76,12 @@ struct LevelLengths {
   meshing::VolumeMeshParams mesh;
 };
 LevelLengths level_lengths(const Scene& scene, double scale);
+
+// The prism layers of a study's finest level (the scene's own mesh): with `study` levels > 0 and
+// layers, room_scale is the scale of the coarsest level's lengths as first guessed, so that the
+// finest decides its stacks as the coarsest will and level_lengths carries that to every level
+// (room_scale / scale): the same region layered on every level. Else `layers` unchanged.
+meshing::PrismLayerParams layers_for_study(meshing::PrismLayerParams layers, const cases::CaseParams::Convergence& study);
 
 // Level `level` (lengths x `scale`) from its solved case, its time the flow's; `surface_mesh_s`
 // the time its surface and mesh took to make.

@@ -111,6 +111,8 @@ void surface_directory(const fs::path& dir, const std::vector<Override>& overrid
 void mesh_directory(const fs::path& dir, const std::vector<Override>& overrides, const Console& console) {
   Directory d = open_directory(dir, overrides);
   meshing::VolumeMeshParams params = read_section(d.scene, "mesh", meshing::read_volume_mesh_params);
+  // The finest level of the study `bedforge case DIR` will make, layered as its coarsest.
+  params.layers = layers_for_study(params.layers, read_section(d.scene, "case", cases::read_case_params).convergence);
   // Slabs are surfaces built again from the bed; here the surface is fluid.stl as it is.
   if (params.slabs > 1)
     throw InputError(fmt::format("mesh.slabs = {}: `bedforge mesh DIR` meshes DIR/fluid.stl as it is, in one piece; "

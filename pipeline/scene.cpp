@@ -13,6 +13,9 @@
 #include "meshing/surface/clip_planes.hpp"
 #include "meshing/surface/periodic_box.hpp"
 #include "meshing/surface/periodic_cut.hpp"
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+#include "pipeline/convergence_study.hpp"
+#endif
 #endif
 
 namespace bedforge::pipeline {
@@ -308,6 +311,7 @@ Scene read_scene_into(const toml::table& table, const std::string& source, const
     throw InputError("contacts.at_periodic_planes = \"cut\" without container.period_z_d (or period_z_m): there are no "
                      "periodic planes; allowed: \"open\" (the default), or a periodic section");
   if (sc.mesh.pieces > 1) check_pieces(sc);
+  sc.mesh.layers = layers_for_study(sc.mesh.layers, sc.case_params.convergence);
 #endif
   mesh.finish();
   case_section.finish();

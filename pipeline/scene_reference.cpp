@@ -260,7 +260,8 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"mesh.layers.gap_fraction",
        {"largest share of the gap in front of a vertex one stack takes; where that leaves less than half of "
         "`thickness_d` there is no stack, and stacks taper to nothing where particles meet a wall, the inlet or the "
-        "outlet",
+        "outlet. With a convergence study every level, the scene's own included, applies this rule at the coarsest "
+        "level's lengths and scales the stacks it allows to its own, so that every level layers the same region",
         "1", kWhyLayers}},
       // [case]
       {"case.reynolds",

@@ -51,7 +51,12 @@ StageKeys stage_keys(const Scene& scene) {
   k.pack = scene_stage_key(sc, inputs, {"container", "particles", "packing"});
   k.analysis = downstream_key(sc, k.pack, {"analysis"});
   k.surface = downstream_key(sc, k.pack, {"contacts", "surface"});
-  k.mesh = downstream_key(sc, k.surface, {"mesh"});
+  nlohmann::json mesh_inputs = {{"upstream", k.surface}};
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+  // A study's layers are decided as on its coarsest level ([case.convergence]: layers_for_study).
+  if (scene.mesh.layers.room_scale != 1.0) mesh_inputs["layers_room_scale"] = scene.mesh.layers.room_scale;
+#endif
+  k.mesh = scene_stage_key(sc, mesh_inputs, {"mesh"});
   nlohmann::json without_study = sc;
   if (without_study.contains("case")) without_study["case"].erase("convergence");
   k.case_ = downstream_key(without_study, scene.case_params.snappy_cells ? k.surface : k.mesh, {"case"});

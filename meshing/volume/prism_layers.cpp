@@ -27,7 +27,11 @@ PrismLayerParams read_prism_layer_params(SceneSection& s) {
 }
 
 nlohmann::json to_json(const PrismLayerParams& p) {
-  return {{"count", p.count}, {"thickness_d", p.thickness_d}, {"growth", p.growth}, {"gap_fraction", p.gap_fraction}};
+  return {{"count", p.count},
+          {"thickness_d", p.thickness_d},
+          {"growth", p.growth},
+          {"gap_fraction", p.gap_fraction},
+          {"room_scale", p.room_scale}};
 }
 
 namespace {
@@ -158,8 +162,8 @@ PrismLayers build_prism_layers(const TriangleMesh& surface, double d_ref, const 
 
   // Room: at most `gap_fraction` of the free path ahead, and the tetrahedra keep at least one
   // local edge of it (a stack may face another one); a stack with room for less than half the
-  // target goes. Without these rules the tetrahedra in narrowed gaps failed the gate or stopped
-  // the solver (measurements: docs/defaults.md).
+  // target goes (room_scale: see PrismLayerParams). Without these rules the tetrahedra in
+  // narrowed gaps failed the gate or stopped the solver (measurements: docs/defaults.md).
   Triangles soup;
   soup.reserve(surface.triangles.size());
   for (const auto& t : surface.triangles)
@@ -172,8 +176,9 @@ PrismLayers build_prism_layers(const TriangleMesh& surface, double d_ref, const 
   for (long k = 0; k < static_cast<long>(candidates.size()); ++k) {
     const std::size_t v = static_cast<std::size_t>(candidates[k]);
     const double path = free_path(tree, surface.points[v], normal[v], 1e-6 * d_ref);
-    const double room = std::min(p.gap_fraction * path, 0.5 * (path - edge[v]));
-    h[v] = room < 0.5 * target ? 0.0 : std::min(h[v], room);
+    const double r = p.room_scale;  // the rule at lengths r times this level's, its stacks shrunk back
+    const double room = std::min(p.gap_fraction * path, 0.5 * (path - r * edge[v]));
+    h[v] = room < 0.5 * r * target ? 0.0 : std::min(r * h[v], room) / r;
   }
 
   // Stacks change by at most half the distance between neighbours: relax over the edges of

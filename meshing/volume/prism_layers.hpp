@@ -23,6 +23,12 @@ struct PrismLayerParams {
   double thickness_d = 0.02;  // total thickness of a stack with room to grow
   double growth = 1.2;        // each layer this much thicker than the one below it
   double gap_fraction = 0.2;  // largest share of the gap in front of a vertex one stack takes
+  // Not a scene key: the room rule above is applied with the thickness and the local edge this
+  // many times larger, and the stacks it allows shrunk back by the same factor. A convergence
+  // study sets it so that every level decides its stacks as its coarsest level would
+  // (pipeline::layers_for_study): the same region layered on every level, every stack scaled
+  // with the level's lengths, a systematic refinement. 1: the rule at the level's own lengths.
+  double room_scale = 1.0;
 };
 PrismLayerParams read_prism_layer_params(SceneSection& layers);
 nlohmann::json to_json(const PrismLayerParams& p);

@@ -14,10 +14,11 @@ using namespace bedforge::pipeline;
 // the gap rule itself (meshing::gap_spacing, as the surface stage applies it, lengths in d)
 // at points facing gaps from under the finest edge to past the coarsest.
 TEST(ConvergenceStudy, ACoarserLevelScalesEveryLengthTheSurfaceAsksFor) {
-  const Scene scene = read_scene(toml::parse("[container]\ndiameter_d = 5\n[particles]\ncount = 2\ndiameter_m = 0.003\n"
-                                             "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\n"
-                                             "cells_per_gap = 3\n[mesh.layers]\ncount = 3\nthickness_d = 0.05\n"),
-                                 "test");
+  const std::string text = "[container]\ndiameter_d = 5\n[particles]\ncount = 2\ndiameter_m = 0.003\n"
+                           "[surface]\nedge_length_d = 0.15\ncontact_edge_length_d = 0.05\n"
+                           "cells_per_gap = 3\n[mesh.layers]\ncount = 3\nthickness_d = 0.05\n";
+  const Scene scene = read_scene(toml::parse(text + "[case]\nrun = true\n"), "test");
+  EXPECT_EQ(read_scene(toml::parse(text), "test").mesh.layers.room_scale, 1.0);  // no study: the rule at its own lengths
   const double scale = 1.62;
   const LevelLengths level = level_lengths(scene, scale);
   EXPECT_DOUBLE_EQ(level.surface.edge_length_d, scale * scene.surface.edge_length_d);
@@ -27,6 +28,12 @@ TEST(ConvergenceStudy, ACoarserLevelScalesEveryLengthTheSurfaceAsksFor) {
   // thickness, so a layered study refined only along the walls).
   EXPECT_DOUBLE_EQ(level.mesh.layers.thickness_d, scale * 0.05);
   EXPECT_EQ(level.mesh.layers.count, 3);
+  // Their room rule at one set of lengths on every level, the coarsest's (layers_for_study): the
+  // same region layered on each (before 2026-12-07 each level dropped the stacks its own
+  // thickness found no room for, so the coarser levels layered less of the bed).
+  EXPECT_GT(scene.mesh.layers.room_scale, 1.0);
+  EXPECT_DOUBLE_EQ(level.mesh.layers.room_scale * level.mesh.layers.thickness_d,
+                   scene.mesh.layers.room_scale * scene.mesh.layers.thickness_d);
 
   // Two spheres of diameter 1 whose surfaces are `gap` apart along x, in a wide tube; the edge
   // asked for on the first, facing the second.

@@ -95,6 +95,36 @@ TEST(PrismLayers, StacksThinBeforeAGapAndGoWhereItIsNarrow) {
   EXPECT_GE(closest(layers.top.points), (1.0 - 2.0 * p.gap_fraction) * closest(s.fluid.points));
 }
 
+TEST(PrismLayers, AStudysLevelsLayerTheSameVerticesWithTheirRoomRuleAtOneScale) {
+  // Two levels of a study on the gap of the test above, their lengths 0.6 apart: the finer, its
+  // room rule at the coarser's lengths (room_scale 1 / 0.6), stacks the same vertices, none under
+  // 0.6 of the coarser's stack (its stacks start at 0.6 of the coarser's and taper at the same
+  // slope). At its own lengths (room_scale 1) it stacks more, in the narrow gap the coarser left
+  // bare. One surface serves both, so the rule's local-edge term is kept out of play: at 0.1 d
+  // the gap fraction binds first on both.
+  const Bed b = bed_of(3.0, {{-0.51, 0.0, 1.0}, {0.51, 0.0, 1.0}});
+  const FluidSurface s = surface_of(b, SurfaceParams::Treatment::shrink, 0.05);
+  const double thickness = 0.1, scale = 0.6;
+  PrismLayerParams finer = three_layers(thickness * scale);
+  const PrismLayers own = build_prism_layers(s.fluid, 1.0, finer);
+  finer.room_scale = 1.0 / scale;
+  const PrismLayers coarser = build_prism_layers(s.fluid, 1.0, three_layers(thickness)),
+                    same = build_prism_layers(s.fluid, 1.0, finer);
+  ASSERT_EQ(coarser.report["stacks_halved"], 0);  // the rule alone decides: no check thinned a stack
+  ASSERT_EQ(same.report["stacks_halved"], 0);
+  auto height = [&](const PrismLayers& l, std::size_t v) { return (l.top.points[v] - s.fluid.points[v]).norm(); };
+  long stacked = 0;
+  for (std::size_t v = 0; v < s.fluid.points.size(); ++v) {
+    const double c = height(coarser, v), f = height(same, v);
+    EXPECT_EQ(c > 0.0, f > 0.0) << "vertex " << v << ": coarser " << c << ", finer " << f;
+    EXPECT_GE(f, scale * c * (1.0 - 1e-12)) << "vertex " << v;
+    stacked += c > 0.0;
+  }
+  EXPECT_EQ(stacked, coarser.report["stacks"].get<long>());
+  EXPECT_LT(stacked, coarser.report["particle_vertices"].get<long>());  // the gap is in play
+  EXPECT_GT(own.report["stacks"].get<long>(), stacked);
+}
+
 TEST(PrismLayers, StacksCollapseWhereAParticleMeetsTheWall) {
   // A sphere bridged to the wall: the bridge's foot on the wall belongs to both patches, so the
   // stacks there have no height and the cells beside them are pyramids and tetrahedra.
