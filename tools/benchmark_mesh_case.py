@@ -65,7 +65,8 @@ cost: issue 57's cost curve on its bed (a = 4, N = 40, seed 1, bridges, Re_p = 1
         meshes from --cost-edge d, contact edge a third, --cost-gap-cells per gap): each level's cells and seconds
         per sphere, its error against the extrapolation with the narrowest band, and the issue's targets.
 cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge d (contact edge half of it,
-        some 20 k cells per sphere on the finest), ratio --target-ratio: issue 57's target on this bed; the
+        some 20 k cells per sphere on the finest), and "volume" with 3 prism layers of 0.02 d from
+        --layered-edge and --layered-contact-edge d, ratio --target-ratio: issue 57's target on this bed; the
         particles' drag in the bed section split by the gap at their faces (GAP_BANDS_D): each route's drag by
         kind (walls; the particles' form and viscous drag) and band, level by level: where the error sits
         (issue 57, item 1).
@@ -356,17 +357,21 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
 
 
 def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra",
-          contact_edge=None, sphere_facets="inscribed", drag_by_gap=()):
+          contact_edge=None, sphere_facets="inscribed", drag_by_gap=(), layers=0, layer_thickness=0.02):
     """One run of the scene with a mesh-convergence study; its levels and verdict. contact_edge:
-    the contact edge (d), else a third of `edge`; drag_by_gap: case.drag_by_gap_d."""
-    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{cells_per_gap}_{reynolds}_{cells}_{ratio}_{sphere_facets}")
-    text = scene(a, n, treatment, edge, True, cells_per_gap, reynolds=reynolds, levels=levels, ratio=ratio, cells=cells,
-                 contact_edge=contact_edge, sphere_facets=sphere_facets, drag_by_gap=drag_by_gap)
+    the contact edge (d), else a third of `edge`; drag_by_gap: case.drag_by_gap_d; layers prism
+    layers of layer_thickness d in all."""
+    path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{contact_edge}_{cells_per_gap}_{reynolds}_{cells}_{ratio}_"
+                             f"{sphere_facets}_{layers}")
+    text = scene(a, n, treatment, edge, True, cells_per_gap, layers=layers, layer_thickness=layer_thickness,
+                 reynolds=reynolds, levels=levels, ratio=ratio, cells=cells, contact_edge=contact_edge,
+                 sphere_facets=sphere_facets, drag_by_gap=drag_by_gap)
     open(path + ".toml", "w").write(text)
     return study_record(path, {"a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
                                "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap,
                                "contact_edge_d": edge / 3 if contact_edge is None else contact_edge,
-                               "sphere_facets": sphere_facets})
+                               "sphere_facets": sphere_facets, "layers": layers,
+                               "layer_thickness_d": layer_thickness if layers else 0})
 
 
 def default_study(tmp, cells, sphere_facets):
@@ -1483,8 +1488,11 @@ def study_lines(r):
 
 
 def route(r):
-    """A cost run's cells and, where set, its spheres' facets (runs before 2026-12-06 were inscribed)."""
-    return r["cells"] + (", facets holding the spheres' volume" if r.get("sphere_facets") == "volume" else "")
+    """A cost run's cells and, where set, its spheres' facets (runs before 2026-12-06 were inscribed)
+    and its prism layers, named with the run's own surface lengths."""
+    return r["cells"] + (", facets holding the spheres' volume" if r.get("sphere_facets") == "volume" else "") + \
+        (f", {r['layers']} prism layers of {r['layer_thickness_d']:g} d in all (edge {r['edge_d']:g} d, contact edge "
+         f"{r['contact_edge_d']:g} d)" if r.get("layers") else "")
 
 
 def band_agreement_lines(runs, fits):
@@ -1542,6 +1550,9 @@ def cost_lines(runs):
              + ("`case.cells` and `surface.sphere_facets` (inscribed: vertices on the spheres; volume: moved out so "
                 "that the facets hold each sphere's volume) the only differences"
                 if any(r.get("sphere_facets") for r in runs) else "`case.cells` the only difference")
+             + ("; a route with prism layers has its own surface lengths, named in it (its study's levels decide "
+                "their stacks at the coarsest level's lengths, so that every level layers the same region)"
+                if any(r.get("layers") for r in runs) else "")
              + ". Seconds per sphere are a level's wall time (surface, mesh, case and "
              "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
              "with the narrowest GCI band"
@@ -2197,6 +2208,11 @@ def main():
     ap.add_argument("--target-edge", type=float, default=0.0868,
                     help="cost_20k: finest surface edge (d), contact edge half of it: some 20 k tetrahedra per sphere")
     ap.add_argument("--target-ratio", type=float, default=1.2, help="cost_20k: cell size ratio between levels")
+    ap.add_argument("--layered-edge", type=float, default=0.17,
+                    help="cost_20k's layered route (3 prism layers of 0.02 d): finest surface edge (d)")
+    ap.add_argument("--layered-contact-edge", type=float, default=0.046,
+                    help="cost_20k's layered route: finest contact edge (d); with --layered-edge some 19 k cells per "
+                         "sphere (docs/findings.md, 2026-12-07, session 91)")
     ap.add_argument("--reynolds", type=float, nargs="+", default=[10, 100], help="study_reynolds: Re_p values")
     ap.add_argument("--treatments", nargs="+", default=["shrink", "cap"], help="study_treatments: contacts.treatment")
     ap.add_argument("--default-reference-levels", type=int, default=4,
@@ -2276,6 +2292,10 @@ def main():
                                          a=4, n=40, cells="tetrahedra", contact_edge=args.target_edge / 2,
                                          sphere_facets=facets, drag_by_gap=GAP_BANDS_D)
                                    for facets in ("inscribed", "volume")]
+            results["cost_20k"].append(study(tmp, args.layered_edge, args.cost_levels, args.target_ratio,
+                                             args.cost_gap_cells, a=4, n=40, cells="tetrahedra",
+                                             contact_edge=args.layered_contact_edge, sphere_facets="volume",
+                                             drag_by_gap=GAP_BANDS_D, layers=3, layer_thickness=0.02))
             write(results)
         if "cost_500" in args.only:
             results["cost_500"] = [default_study(tmp, cells, facets) for cells, facets in COST_ROUTES]
