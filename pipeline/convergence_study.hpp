@@ -67,7 +67,7 @@ struct ConvergenceStudy {
 
 // The surface and mesh settings of a level whose lengths are `scale` times the scene's: the
 // surface's edge and contact edge, the mesh's largest cell, the prism layers' thickness (their
-// room rule kept at the finest's lengths: layers_for_study), and the edge across narrow gaps
+// room rule kept at the coarsest level's lengths: layers_for_study), and the edge across narrow gaps
 // (gap / cells_per_gap: cells_per_gap is divided by `scale`, and the gaps it refines stay the
 // same). Celik et al.'s procedure needs meshes refined alike everywhere; with cells_per_gap
 // kept, the gaps' cells were the same on every level.
