@@ -2,6 +2,7 @@
 // in the directory, without running anything.
 #include "pipeline/stage_cache.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <set>
@@ -156,3 +157,21 @@ TEST(StageCache, AChangedBedRebuildsEverythingAndForceIsNoEarlierRun) {
   EXPECT_EQ(built(p), 5);
   EXPECT_TRUE(p.write_bed_csv && p.write_bed_vtp);
 }
+
+#ifdef BEDFORGE_HAVE_VOLUME_MESH
+TEST(StageCache, AStudysRatioChangesTheMeshOnlyWhenTheMeshHasPrismLayers) {
+  // A study's layers are decided at its coarsest level's lengths (layers_for_study), so with
+  // layers a new ratio is a new finest mesh; without them only the study changes.
+  auto keys = [](int layers, double ratio) {
+    const std::string text = fmt::format("[container]\ndiameter_d = 5\n[particles]\ncount = 2\ndiameter_m = 0.003\n"
+                                         "[mesh.layers]\ncount = {}\n[case]\nrun = true\n[case.convergence]\n"
+                                         "ratio = {}\n[outputs]\nfiles = [\"case\"]\n",
+                                         layers, ratio);
+    return stage_keys(read_scene(toml::parse(text), "test"));
+  };
+  EXPECT_NE(keys(3, 1.3).mesh, keys(3, 1.2).mesh);
+  EXPECT_EQ(keys(3, 1.3).surface, keys(3, 1.2).surface);
+  EXPECT_EQ(keys(0, 1.3).mesh, keys(0, 1.2).mesh);
+  EXPECT_NE(keys(0, 1.3).study, keys(0, 1.2).study);
+}
+#endif
