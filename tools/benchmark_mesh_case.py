@@ -71,16 +71,17 @@ cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge
         kind (walls; the particles' form and viscous drag) and band, level by level: where the error sits
         (issue 57, item 1).
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
-        and study).
-verification_spheres: on each of the cost sections' routes, a column of a simple cubic array of spheres in
+        and study), and the layered route (LAYERS prism layers of LAYER_THICKNESS_D on tetrahedra with volume
+        facets) at the scene's own lengths.
+verification_spheres: on each of the cost sections' routes and the layered route, a column of a simple cubic array of spheres in
         Stokes flow (Re_p = 0.01) in a square box whose slip walls are the array's mirror planes, as
         scenes/examples/simple_cubic_verification.toml
         (solid fraction 0.216) and at 0.45 (gaps of 0.05 d between neighbours), whose exact drag Zick & Homsy
         (1982) tabulate: one `bedforge run` each with [case.convergence] (--sphere-levels meshes from
         --sphere-edge d, ratio 1.3); each level's error, the order of the errors, the study's own verdict.
 verification_touching: the same column with touching spheres (solid fraction pi / 6), its contacts bridged, on
-        each of the cost sections' routes, against Zick & Homsy's untreated touching array as a bound from below
-        (issue 57, item 4: the bridged touching column keeps its order through the volume facets).
+        each of the cost sections' routes and the layered route, against Zick & Homsy's untreated touching array as
+        a bound from below (issue 57, item 4: the bridged touching column keeps its order through the new meshes).
 verification_periodic: periodic sections, cyclic cases driven by meanVelocityForce: the empty tube of the
         verification (D = 2 d) one period of 3 d long, whose fully developed flow is Hagen-Poiseuille's in every
         cell; and three cells of a simple cubic array as scenes/examples/periodic_cubic_verification.toml at each
@@ -152,6 +153,18 @@ SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_ou
             "projection_1e4"]
 # The cost sections' routes: case.cells, surface.sphere_facets.
 COST_ROUTES = [("polyhedra", "inscribed"), ("tetrahedra", "inscribed"), ("tetrahedra", "volume")]
+# Issue 57's layered route, which met its target on the 40-sphere bed (cost_20k): tetrahedra with volume facets
+# and this many prism layers of this total thickness (d) on the particles, [mesh.layers].
+LAYERS, LAYER_THICKNESS_D = 3, 0.02
+LAYERS_TOML = f"[mesh.layers]\ncount = {LAYERS}\nthickness_d = {LAYER_THICKNESS_D}\n"
+# The routes verification_spheres, verification_touching and cost_500 run: the cost routes and the layered one
+# (cells, facets, prism layers).
+ROUTES = [(cells, facets, 0) for cells, facets in COST_ROUTES] + [("tetrahedra", "volume", LAYERS)]
+
+
+def route_key(cells, facets, layers):
+    """A verification run's route as its key names it: "cells, facets[, N layers of T d]"."""
+    return f"{cells}, {facets}" + (f", {layers} layers of {LAYER_THICKNESS_D:g} d" if layers else "")
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
@@ -374,9 +387,9 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
                                "layer_thickness_d": layer_thickness if layers else 0})
 
 
-def default_study(tmp, cells, sphere_facets):
+def default_study(tmp, cells, sphere_facets, layers=0):
     """scenes/default.toml as it is, its study included, on `cells` ("polyhedra" or "tetrahedra")
-    with `sphere_facets` ("inscribed" or "volume")."""
+    with `sphere_facets` ("inscribed" or "volume") and, if `layers`, LAYERS_TOML's prism layers."""
     text, n = re.subn(r'^cells = "\w+"', f'cells = "{cells}"', open(DEFAULT_SCENE).read(), count=1, flags=re.M)
     if n != 1:
         raise SystemExit("scenes/default.toml: no line sets cells; update default_study")
@@ -384,13 +397,18 @@ def default_study(tmp, cells, sphere_facets):
     text, n = re.subn(r'^\[surface\]\n', f'[surface]\nsphere_facets = "{sphere_facets}"\n', text, count=1, flags=re.M)
     if n != 1:
         raise SystemExit("scenes/default.toml: no [surface] section; update default_study")
-    path = os.path.join(tmp, f"default_study_{cells}_{sphere_facets}")
+    if layers:
+        text, n = re.subn(r'^\[case\]\n', LAYERS_TOML + "\n[case]\n", text, count=1, flags=re.M)
+        if n != 1:
+            raise SystemExit("scenes/default.toml: no [case] section; update default_study")
+    path = os.path.join(tmp, f"default_study_{cells}_{sphere_facets}_{layers}")
     open(path + ".toml", "w").write(text)
     sc = lambda key: float(scene_value(text, key))
     return study_record(path, {"a": sc("diameter_d"), "n": int(sc("count")), "treatment": scene_value(text, "treatment"),
                                "reynolds": sc("reynolds"), "cells": cells, "edge_d": sc("edge_length_d"),
                                "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"),
                                "contact_edge_d": sc("contact_edge_length_d"), "sphere_facets": sphere_facets,
+                               "layers": layers, "layer_thickness_d": LAYER_THICKNESS_D if layers else 0,
                                "default_scene": True})
 
 
@@ -552,11 +570,12 @@ def study_run(path):
     return {"wall_s": wall, "study": case["convergence"], "d_m": case["d_ref_m"]}
 
 
-def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case="", surface="", treatment="none"):
+def cubic_column_run(tmp, name, phi, count, edge, levels, container="", case="", surface="", treatment="none", mesh=""):
     """One column of a simple cubic array at solid fraction phi, `count` spheres of 3 mm at the
     centres of L-long cells in a square box of side L with slip sides, Stokes flow: one
     `bedforge run` with a convergence study (`levels` meshes from `edge` d, ratio 1.3).
-    `container`, `case` and `surface` add keys to those sections; `treatment` is contacts.treatment."""
+    `container`, `case` and `surface` add keys to those sections, `mesh` whole mesh sections; `treatment` is
+    contacts.treatment."""
     side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
     path = os.path.join(tmp, name)
     with open(path + ".txt", "w") as f:
@@ -575,7 +594,7 @@ treatment = "{treatment}"
 edge_length_d = {edge}
 contact_edge_length_d = {edge / 2}
 cells_per_gap = 4
-{surface}[case]
+{surface}{mesh}[case]
 walls = "slip"
 reynolds = 0.01
 {case}processors = 2
@@ -588,7 +607,7 @@ files = ["case"]
 
 
 def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, cells_measured=4):
-    """Simple cubic columns at each solid fraction, on each of the cost sections' routes: count
+    """Simple cubic columns at each solid fraction, on each of ROUTES: count
     spheres, the pressure drop over the middle cells_measured, whose planes lie a whole number of
     cells apart at the same phase."""
     out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
@@ -596,22 +615,24 @@ def verification_spheres(tmp, edge, levels, fractions=(0.216, 0.45), count=6, ce
         side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
         # From the box's bottom and the top sphere's top, both planes at the same phase:
         exclude = ((count - 0.5 - cells_measured) * side + 0.5) / 2.0
-        for cells, facets in COST_ROUTES:
-            out["runs"][f"{phi}, {cells}, {facets}"] = cubic_column_run(
-                tmp, f"simple_cubic_{phi}_{cells}_{facets}", phi, count, edge, levels,
-                case=f'section_exclude_d = {exclude:.12f}\ncells = "{cells}"\n', surface=f'sphere_facets = "{facets}"\n')
+        for cells, facets, layers in ROUTES:
+            out["runs"][f"{phi}, {route_key(cells, facets, layers)}"] = cubic_column_run(
+                tmp, f"simple_cubic_{phi}_{cells}_{facets}_{layers}", phi, count, edge, levels,
+                case=f'section_exclude_d = {exclude:.12f}\ncells = "{cells}"\n', surface=f'sphere_facets = "{facets}"\n',
+                mesh=LAYERS_TOML if layers else "")
     return out
 
 
 def verification_touching(tmp, edge, levels, count=6, cells_measured=4):
     """The touching simple cubic column (solid fraction pi / 6, each sphere touching its neighbours
-    and the four mirror walls) with its contacts bridged, on each of the cost sections' routes."""
+    and the four mirror walls) with its contacts bridged, on each of ROUTES."""
     out = {**commit_and_date(), "edge_d": edge, "levels": levels, "ratio": 1.3, "runs": {}}
     exclude = ((count - 0.5 - cells_measured) + 0.5) / 2.0  # L = d: the planes a whole number of cells apart
-    for cells, facets in COST_ROUTES:
-        out["runs"][f"{cells}, {facets}"] = cubic_column_run(
-            tmp, f"touching_bridged_{cells}_{facets}", math.pi / 6.0, count, edge, levels, treatment="bridge",
-            case=f'section_exclude_d = {exclude:.12f}\ncells = "{cells}"\n', surface=f'sphere_facets = "{facets}"\n')
+    for cells, facets, layers in ROUTES:
+        out["runs"][route_key(cells, facets, layers)] = cubic_column_run(
+            tmp, f"touching_bridged_{cells}_{facets}_{layers}", math.pi / 6.0, count, edge, levels, treatment="bridge",
+            case=f'section_exclude_d = {exclude:.12f}\ncells = "{cells}"\n', surface=f'sphere_facets = "{facets}"\n',
+            mesh=LAYERS_TOML if layers else "")
     return out
 
 
@@ -629,7 +650,8 @@ def touching_lines(v):
              "the flow slips along: the array's mirror planes), `contacts.treatment = \"bridge\"`, six cells, the "
              "pressure drop over the middle four, Stokes flow (Re_p = 0.01), through the same route as a bed, on "
              f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}, on the cost sections' "
-             "routes. No exact value is known for the bridged array; Zick & Homsy's untreated touching array "
+             "routes" + (" and the layered one (prism layers on the particles, their thickness in all as named)"
+                         if any("layers" in k for k in v["runs"]) else "") + ". No exact value is known for the bridged array; Zick & Homsy's untreated touching array "
              "(1982, Table 2) bounds it from below, since at a fixed flow rate Stokes drag only grows with solid "
              "added (the bridges add about 0.2 % solid; docs/findings.md, 2026-11-27): the bound bedforge reports "
              "for a treated simple cubic column (report.json, stages.case.convergence.bound). "
@@ -2077,8 +2099,11 @@ def write(results):
                   "least-squares fit of ln |error| against ln h over all levels."
                   + (" Each fraction on the cost sections' routes: `case.cells` and `surface.sphere_facets` "
                      "(inscribed: vertices on the spheres; volume: moved out so that the facets hold each sphere's "
-                     "volume)." if on_routes else ""), ""]
-        lines += verification_lines(v, "solid fraction" + (", cells, facets" if on_routes else ""),
+                     "volume)" + (", and on the layered route: prism layers on the particles, `[mesh.layers]`, their "
+                                  "thickness in all as named"
+                                  if any("layers" in k for k in v["runs"]) else "") + "." if on_routes else ""), ""]
+        lines += verification_lines(v, "solid fraction" + (", cells, facets" if on_routes else "")
+                                    + (", layers" if any("layers" in k for k in v["runs"]) else ""),
                                     "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")
@@ -2295,10 +2320,10 @@ def main():
             results["cost_20k"].append(study(tmp, args.layered_edge, args.cost_levels, args.target_ratio,
                                              args.cost_gap_cells, a=4, n=40, cells="tetrahedra",
                                              contact_edge=args.layered_contact_edge, sphere_facets="volume",
-                                             drag_by_gap=GAP_BANDS_D, layers=3, layer_thickness=0.02))
+                                             drag_by_gap=GAP_BANDS_D, layers=LAYERS, layer_thickness=LAYER_THICKNESS_D))
             write(results)
         if "cost_500" in args.only:
-            results["cost_500"] = [default_study(tmp, cells, facets) for cells, facets in COST_ROUTES]
+            results["cost_500"] = [default_study(tmp, cells, facets, layers) for cells, facets, layers in ROUTES]
             write(results)
         # Runs at other Re_p or treatments are kept, so one can be redone alone.
         for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
