@@ -124,7 +124,7 @@ TEST(CommandLine, EveryShippedSceneRuns) {
                                                 "empty_tube_verification.toml", "simple_cubic_verification.toml",
                                                 "periodic_section_flow.toml", "periodic_cubic_verification.toml",
                                                 "periodic_box_cubic_verification.toml", "random_array_stokes.toml",
-                                                "touching_cubic_bridged.toml"}));
+                                                "touching_cubic_bridged.toml", "layered_bed_accuracy.toml"}));
 #endif
 }
 

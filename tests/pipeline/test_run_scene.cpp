@@ -467,6 +467,30 @@ TEST(RunScene, TheBridgedTouchingExampleIsBoundedFromBelowByTheUntreatedArray) {
   EXPECT_NEAR(c["answer"]["reference"]["pa_m"].get<double>(), untreated, 1e-9 * untreated);
 }
 
+// Issue 57's layered route as shipped (scenes/examples/layered_bed_accuracy.toml), one coarse mesh:
+// its particles carry prism stacks, the solve is on the tetrahedra and prisms themselves, and the
+// drag on walls and particles balances the push through inlet and outlet. Not to the 2 % of the
+// meshes without layers (OpenFoamCase.SmallBedPressureDropAgreesWithEisfeldSchnitzlein): on
+// layered meshes the forces read the particles' pressure drag high, by +1.4 to +3.8 % of the push
+// on the 40- and 500-sphere beds' levels and +2.9 % on this mesh (docs/mesh_case_benchmark.json at
+// f96000c, docs/findings.md, 2026-12-07, session 92), not yet explained; the 5 % still catches a
+// patch left out or a sign, which miss by far more (the particles carry about 90 %).
+TEST(RunScene, TheLayeredExampleSolvesOnItsPrismsAndBalancesItsDrag) {
+  const Scene scene = example_scene("layered_bed_accuracy.toml", {{"surface.edge_length_d", 0.3},
+                                                                  {"surface.contact_edge_length_d", 0.1},
+                                                                  {"case.convergence.levels", 0LL}});
+  const fs::path dir = test_support::fresh_dir("layered_example");
+  const RunOutcome r = run(scene, dir);
+  ASSERT_TRUE(r.stages["mesh"].contains("layers")) << r.stages["mesh"].dump();
+  const nlohmann::json& layers = r.stages["mesh"]["layers"];
+  EXPECT_GT(layers["cells"]["prisms"].get<long>(), 0) << layers.dump();
+  EXPECT_GT(layers["stacks_at_full_thickness"].get<long>(), 0) << layers.dump();
+  const nlohmann::json& flow = r.stages["case"]["flow"];
+  EXPECT_EQ(flow["mesh"]["mesher"], "gmsh tetrahedra");
+  EXPECT_TRUE(flow["converged"].get<bool>()) << flow.dump();
+  EXPECT_LT(std::abs(flow["drag"]["force_balance_relative_error"].get<double>()), 0.05) << flow["drag"].dump();
+}
+
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three
 // cells, cyclic inlet and outlet, meanVelocityForce; order 2.05 measured at the example's
 // settings, 2026-11-28).
