@@ -217,11 +217,14 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels) {
 
 double observed_order(const std::vector<GridLevel>& levels, double exact) {
   LineSums line;
+  bool above = false, below = false;
   for (const GridLevel& l : levels) {
-    const double e = std::abs(l.value / exact - 1.0);
+    const double signed_error = l.value / exact - 1.0, e = std::abs(signed_error);
+    above = above || signed_error > 0.0;
+    below = below || signed_error < 0.0;
     if (e > 0.0 && l.cell_size > 0.0) line.add(std::log(l.cell_size), std::log(e));
   }
-  if (line.n < 2.0 || !(line.determinant() > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  if (line.n < 2.0 || !(line.determinant() > 0.0) || (above && below)) return std::numeric_limits<double>::quiet_NaN();
   return line.slope();
 }
 

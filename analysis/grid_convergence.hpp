@@ -79,7 +79,9 @@ PowerLawFit fit_power_law(const std::vector<GridLevel>& levels);
 
 // Verification against a known answer: the order p of the error |phi / exact - 1| ~ C h^p, by
 // least squares on ln error against ln h over `levels` (any order, two or more with distinct
-// sizes). NaN when fewer than two levels have a nonzero error.
+// sizes). NaN when fewer than two levels have a nonzero error, or when the errors change sign:
+// levels on both sides of the exact value follow no C h^p, and a fit of |error| would report
+// the crossing as a high order.
 double observed_order(const std::vector<GridLevel>& levels, double exact);
 
 }  // namespace bedforge::analysis

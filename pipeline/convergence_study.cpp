@@ -323,8 +323,11 @@ ConvergenceStudy convergence_study(const Scene& scene, const Bed& bed, const Stu
     study.order_from_exact = analysis::observed_order(solved, exact);
     study.conclusion += fmt::format("; against the exact {:.5g} Pa/m", exact);
     if (!solved.empty())
-      study.conclusion += fmt::format(": finest solved level {:+.3f} %, order {:.2f} from the exact errors",
-                                      100.0 * (solved.front().value / exact - 1.0), study.order_from_exact);
+      study.conclusion +=
+          fmt::format(": finest solved level {:+.3f} %, ", 100.0 * (solved.front().value / exact - 1.0)) +
+          (std::isfinite(study.order_from_exact)
+               ? fmt::format("order {:.2f} from the exact errors", study.order_from_exact)
+               : std::string("no order from the exact errors (fewer than two, or on both sides of the exact value)"));
     if (study.complete && std::isfinite(study.convergence.extrapolated))
       study.conclusion += fmt::format(", extrapolated {:+.3f} %",
                                       100.0 * (study.convergence.extrapolated / exact - 1.0));

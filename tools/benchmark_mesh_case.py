@@ -166,6 +166,9 @@ def route_key(cells, facets, layers):
     """A verification run's route as its key names it: "cells, facets[, N layers of T d]"."""
     return f"{cells}, {facets}" + (f", {layers} layers of {LAYER_THICKNESS_D:g} d" if layers else "")
 DEFAULT_SCENE = os.path.join(os.path.dirname(DOCS), "scenes", "default.toml")
+# A study's order_from_exact is null when its errors lie on both sides of the exact value (no C h^p
+# fits them) or fewer than two levels have one (analysis::observed_order).
+NO_ORDER = "none (errors on both sides of the exact value, or fewer than two)"
 ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/share/openfoam"), OMP_NUM_THREADS="2")
 
 
@@ -921,7 +924,7 @@ def periodic_target_lines(v):
         error = solved[0]["relative_error_to_exact"]
         met = abs(error) <= 0.01 and order is not None and order >= 1.5
         lines.append(f"- solid fraction {key}: finest error {100 * error:+.2f} %, order "
-                     f"{'none' if order is None else f'{order:.2f}'}: {'met' if met else 'NOT met'}")
+                     f"{NO_ORDER if order is None else f'{order:.2f}'}: {'met' if met else 'NOT met'}")
     return ["Issue 56's target for the cubic arrays: within 1 % of Zick & Homsy on the finest level, order at "
             "least 1.5.", "", *lines, ""]
 
@@ -2164,7 +2167,7 @@ def verification_lines(v, column, png):
         made_by = (f"made at commit {run['commit']} on {run['date']} from a finest edge of {run['edge_d']} d; "
                    if "commit" in run else "")
         lines.append(f"- {key}: {made_by}exact {st['exact_pa_m']:.5g} Pa/m; order of the errors "
-                     f"{'none' if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
+                     f"{NO_ORDER if order is None else f'{order:.2f}'}; whole run {run['wall_s']:.0f} s; "
                      f"the study's own verdict: {st['conclusion']}.")
     return lines + ["", f"![error against cell size]({png})", ""]
 

@@ -144,3 +144,21 @@ TEST(PowerLawFit, RefusesFewerThanFourMeshesOrMeshesOutOfOrder) {
   EXPECT_THROW(fit_power_law({{0.1, 1.0}, {0.13, 1.1}, {0.13, 1.2}, {0.2, 1.3}}), std::invalid_argument);
   EXPECT_THROW(fit_power_law({{0.1, 1.0}, {0.13, 1.1}, {0.17, NAN}, {0.2, 1.3}}), std::invalid_argument);
 }
+
+TEST(ObservedOrder, AnExactPowerLawGivesItsOrderBack) {
+  // phi = exact (1 - 0.5 h^2): errors -0.5 h^2 on every level.
+  std::vector<GridLevel> levels;
+  for (double h : {0.1, 0.13, 0.17, 0.22}) levels.push_back({h, 2.0 * (1.0 - 0.5 * h * h)});
+  EXPECT_NEAR(observed_order(levels, 2.0), 2.0, 1e-9);
+}
+
+TEST(ObservedOrder, ErrorsOnBothSidesOfTheExactValueGiveNoOrder) {
+  // The layered simple cubic array at 0.216 (2026-12-07, docs/mesh_case_benchmark.md): errors
+  // +0.15, -0.11, -0.79, -2.85 % finest to coarsest; a fit of their sizes reported order 4.1.
+  const std::vector<GridLevel> crossing = {{0.0239, 1.0015}, {0.0311, 0.9989}, {0.0404, 0.9921}, {0.0525, 0.9715}};
+  EXPECT_TRUE(std::isnan(observed_order(crossing, 1.0)));
+  // The same sizes all on one side are a power law's to fit.
+  std::vector<GridLevel> one_side = crossing;
+  one_side[0].value = 0.9985;
+  EXPECT_TRUE(std::isfinite(observed_order(one_side, 1.0)));
+}
