@@ -473,8 +473,9 @@ TEST(RunScene, TheBridgedTouchingExampleIsBoundedFromBelowByTheUntreatedArray) {
 // meshes without layers (OpenFoamCase.SmallBedPressureDropAgreesWithEisfeldSchnitzlein): on
 // layered meshes the forces read the particles' pressure drag high, by +1.4 to +3.8 % of the push
 // on the 40- and 500-sphere beds' levels and +2.9 % on this mesh (docs/mesh_case_benchmark.json at
-// f96000c, docs/findings.md, 2026-12-07, session 92), not yet explained; the 5 % still catches a
-// patch left out or a sign, which miss by far more (the particles carry about 90 %).
+// f96000c), traced on one case to the vertex-fitted pressure gradient (docs/findings.md, 2026-12-07,
+// session 92); the 5 % still catches a patch left out or a sign, which miss by far more (the
+// particles carry about 90 %).
 TEST(RunScene, TheLayeredExampleSolvesOnItsPrismsAndBalancesItsDrag) {
   const Scene scene = example_scene("layered_bed_accuracy.toml", {{"surface.edge_length_d", 0.3},
                                                                   {"surface.contact_edge_length_d", 0.1},
