@@ -73,6 +73,9 @@ cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
         and study), and the layered route (LAYERS prism layers of LAYER_THICKNESS_D on tetrahedra with volume
         facets) at the scene's own lengths.
+cost_beds: the same four routes at scenes/default.toml's mesh and study on smaller beds (--cost-beds a:N,
+        default a = 4, N = 40, issue 57's bed, and a = 5, N = 200), and with cost_500 a table of the routes
+        bed by bed: issue 57's item 3 from the 40-sphere bed to the 500-sphere bed at one set of settings.
 verification_spheres: on each of the cost sections' routes and the layered route, a column of a simple cubic array of spheres in
         Stokes flow (Re_p = 0.01) in a square box whose slip walls are the array's mirror planes, as
         scenes/examples/simple_cubic_verification.toml
@@ -145,7 +148,7 @@ RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 # cost_20k's particles split by the gap at their faces (case.drag_by_gap_d, d): the bridges' rims
 # and narrowest gaps, gaps of one to a few contact edges, of a few surface edges, and open pores.
 GAP_BANDS_D = [0.01, 0.03, 0.1, 0.3]
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "cost_beds", "study_reynolds", "study_treatments",
             "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_touching",
             "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
@@ -390,12 +393,17 @@ def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="brid
                                "layer_thickness_d": layer_thickness if layers else 0})
 
 
-def default_study(tmp, cells, sphere_facets, layers=0):
+def default_study(tmp, cells, sphere_facets, layers=0, bed=None):
     """scenes/default.toml as it is, its study included, on `cells` ("polyhedra" or "tetrahedra")
-    with `sphere_facets` ("inscribed" or "volume") and, if `layers`, LAYERS_TOML's prism layers."""
+    with `sphere_facets` ("inscribed" or "volume") and, if `layers`, LAYERS_TOML's prism layers;
+    `bed` (a, N), if given, replaces its container's diameter (d) and its particle count."""
     text, n = re.subn(r'^cells = "\w+"', f'cells = "{cells}"', open(DEFAULT_SCENE).read(), count=1, flags=re.M)
     if n != 1:
         raise SystemExit("scenes/default.toml: no line sets cells; update default_study")
+    for key, value in zip(("diameter_d", "count"), bed or ()):
+        text, n = re.subn(rf'^{key} = [0-9.]+', f"{key} = {value}", text, count=1, flags=re.M)
+        if n != 1:
+            raise SystemExit(f"scenes/default.toml: no line sets {key}; update default_study")
     text = re.sub(r'^sphere_facets = .*\n', "", text, flags=re.M)
     text, n = re.subn(r'^\[surface\]\n', f'[surface]\nsphere_facets = "{sphere_facets}"\n', text, count=1, flags=re.M)
     if n != 1:
@@ -404,7 +412,7 @@ def default_study(tmp, cells, sphere_facets, layers=0):
         text, n = re.subn(r'^\[case\]\n', LAYERS_TOML + "\n[case]\n", text, count=1, flags=re.M)
         if n != 1:
             raise SystemExit("scenes/default.toml: no [case] section; update default_study")
-    path = os.path.join(tmp, f"default_study_{cells}_{sphere_facets}_{layers}")
+    path = os.path.join(tmp, f"default_study_{cells}_{sphere_facets}_{layers}" + ("_{}_{}".format(*bed) if bed else ""))
     open(path + ".toml", "w").write(text)
     sc = lambda key: float(scene_value(text, key))
     return study_record(path, {"a": sc("diameter_d"), "n": int(sc("count")), "treatment": scene_value(text, "treatment"),
@@ -412,7 +420,7 @@ def default_study(tmp, cells, sphere_facets, layers=0):
                                "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"),
                                "contact_edge_d": sc("contact_edge_length_d"), "sphere_facets": sphere_facets,
                                "layers": layers, "layer_thickness_d": LAYER_THICKNESS_D if layers else 0,
-                               "default_scene": True})
+                               "default_scene": True, "bed_changed": bed is not None})
 
 
 def study_record(path, fields):
@@ -639,6 +647,11 @@ def verification_touching(tmp, edge, levels, count=6, cells_measured=4):
     return out
 
 
+def has_layered_run(v):
+    """Whether a verification section ran the layered route (its run keys name route_key's layers)."""
+    return any("layers" in k for k in v["runs"])
+
+
 def touching_bound_pa_m(run):
     """The bound bedforge gives a treated simple cubic column (Pa/m): the untreated array's drag,
     Zick & Homsy's (the study's "bound"), from below for bridges."""
@@ -654,7 +667,7 @@ def touching_lines(v):
              "pressure drop over the middle four, Stokes flow (Re_p = 0.01), through the same route as a bed, on "
              f"{v['levels']} meshes from a surface edge of {v['edge_d']} d, ratio {v['ratio']}, on the cost sections' "
              "routes" + (" and the layered one (prism layers on the particles, their thickness in all as named)"
-                         if any("layers" in k for k in v["runs"]) else "") + ". No exact value is known for the bridged array; Zick & Homsy's untreated touching array "
+                         if has_layered_run(v) else "") + ". No exact value is known for the bridged array; Zick & Homsy's untreated touching array "
              "(1982, Table 2) bounds it from below, since at a fixed flow rate Stokes drag only grows with solid "
              "added (the bridges add about 0.2 % solid; docs/findings.md, 2026-11-27): the bound bedforge reports "
              "for a treated simple cubic column (report.json, stages.case.convergence.bound). "
@@ -1563,7 +1576,9 @@ def cost_lines(runs):
     lines = [f"## Cost per sphere: {', '.join(routes[:-1])} against {routes[-1]} (a = {r0['a']:g}, N = {n}, "
              f"{r0['treatment']}, Re_p = {r0['reynolds']:g}, from {r0['edge_d']:g} d, ratio {r0['ratio']:g})", "",
              f"Made at commit {r0['commit']} on {r0['date']}: "
-             + ("issue 57's bed" if n == 40 else "the README's scene, scenes/default.toml as it is"
+             + (f"the README's scene, scenes/default.toml, with its bed changed to a = {r0['a']:g}, N = {n}"
+                + (", issue 57's bed" if n == 40 else "") if r0.get("bed_changed")
+                else "issue 57's bed" if n == 40 else "the README's scene, scenes/default.toml as it is"
                 if r0.get("default_scene") else "the README's bed at the mesh settings scenes/default.toml had until "
                 "2026-12-04, when its cells were polyhedra")
              + " (seed 1), one `bedforge run` per route with "
@@ -1616,7 +1631,7 @@ def cost_lines(runs):
                      + (f"{ls['order']:.2f}, {ls['extrapolated']:.4g}" if ls.get("order") is not None else "none")
                      + f" | {g['extrapolated']:.4g} | " + ("met" if not missed else "not met: " + ", ".join(missed)) + " |")
     lines += [""] + band_agreement_lines(runs, fits)
-    if not r0.get("default_scene"):
+    if not r0.get("default_scene") or r0.get("bed_changed"):
         return lines + [""]
     # The README's scene is the bed of issue 57's target on this machine.
     lines += ["", "Issue 57's target on this machine (GCI of the finest mesh <= 15 %, scene to extrapolated pressure "
@@ -1633,6 +1648,50 @@ def cost_lines(runs):
                      + f", {r['wall_s'] / 60:.1f} min, at most {whole_gb:.1f} GB (largest process {r['peak_mb']:.0f} MB): "
                      + ("**met**" if not missed else "**not met** (" + ", ".join(missed) + ")") + ".")
     return lines + [""]
+
+
+def mesh_settings(r):
+    """The mesh settings a cost run was made with, which must agree for beds to be compared."""
+    return tuple(r.get(k) for k in ("edge_d", "contact_edge_d", "cells_per_gap", "ratio")) + \
+        (len(r["study"]["levels"]),)
+
+
+def beds_lines(beds):
+    """Issue 57's item 3 across beds: on each bed (a list of cost runs, one per route, all at the
+    README's scene's mesh settings) each route's finest GCI, order, extrapolation and cost, and the
+    route with the narrowest band; the default is the route scenes/default.toml sets."""
+    r0 = beds[0][0]
+    default = ("tetrahedra", "volume", 0)
+    lines = [f"## Cost per sphere from bed to bed: the README's scene's mesh on {len(beds)} beds (issue 57, item 3)", "",
+             "Made at commit " + ", ".join(sorted({r['commit'] + ' on ' + r['date'] for bed in beds for r in bed}))
+             + f": scenes/default.toml's mesh and study (surface edge {r0['edge_d']:g} d, contact edge "
+             f"{r0['contact_edge_d']:g} d, {r0['cells_per_gap']:g} cells per gap, {len(r0['study']['levels'])} levels, "
+             f"ratio {r0['ratio']:g}; seed 1, {r0['treatment']}, Re_p = {r0['reynolds']:g}) on beds from "
+             f"N = {beds[0][0]['n']} to N = {beds[-1][0]['n']}, each route as in the sections above; the default route "
+             "is the scene's own (tetrahedra, facets holding the spheres' volume, no layers). GCI of the finest mesh "
+             "(Celik et al. 2008); cost on the finest level, per sphere.", "",
+             "| bed | route | finest cells per sphere | finest s per sphere | GCI | order, finest three | extrapolation "
+             "(Pa/m) | whole run (min) |", "|---|---|---|---|---|---|---|---|"]
+    verdicts = []
+    for runs in beds:
+        bed = f"a = {runs[0]['a']:g}, N = {runs[0]['n']}"
+        gcis = {}
+        for r in runs:
+            g = r["study"].get("grid_convergence", {})
+            finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+            if finest is None or g.get("gci_fine") is None:
+                lines.append(f"| {bed} | {route(r)} | | | none: {r['study']['conclusion']} | | | {r['wall_s'] / 60:.1f} |")
+                continue
+            gcis[route(r)] = (g["gci_fine"], (r["cells"], r.get("sphere_facets"), r.get("layers", 0)) == default)
+            lines.append(f"| {bed} | {route(r)} | {finest['cells'] / r['n']:,.0f} | {finest['time_s'] / r['n']:.1f} | "
+                         f"{100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | {g['extrapolated']:.4g} | "
+                         f"{r['wall_s'] / 60:.1f} |")
+        if gcis:
+            best = min(gcis, key=lambda k: gcis[k][0])
+            verdicts.append(f"- {bed}: narrowest band {100 * gcis[best][0]:.1f} %, on {best}"
+                            + (", the default." if gcis[best][1] else "; the default's: "
+                               + ", ".join(f"{100 * v[0]:.1f} %" for v in gcis.values() if v[1]) + "."))
+    return lines + [""] + verdicts + [""]
 
 
 def error_seat_lines(r):
@@ -2080,6 +2139,13 @@ def write(results):
             lines += cost_lines(results[key])
             for r in results[key]:
                 lines += error_seat_lines(r)
+    if "cost_beds" in results:
+        for runs in results["cost_beds"]:
+            lines += cost_lines(runs)
+        # The README's bed joins the others where its section was made at the same mesh settings.
+        beds = results["cost_beds"] + [results["cost_500"]] * (
+            "cost_500" in results and mesh_settings(results["cost_500"][0]) == mesh_settings(results["cost_beds"][0][0]))
+        lines += beds_lines(sorted(beds, key=lambda runs: runs[0]["n"]))
     if "verification" in results:
         v = results["verification"]
         lines += ["## Verification: the empty tube against Hagen-Poiseuille, tetrahedra and their polyhedral dual", "",
@@ -2104,9 +2170,9 @@ def write(results):
                      "(inscribed: vertices on the spheres; volume: moved out so that the facets hold each sphere's "
                      "volume)" + (", and on the layered route: prism layers on the particles, `[mesh.layers]`, their "
                                   "thickness in all as named"
-                                  if any("layers" in k for k in v["runs"]) else "") + "." if on_routes else ""), ""]
+                                  if has_layered_run(v) else "") + "." if on_routes else ""), ""]
         lines += verification_lines(v, "solid fraction" + (", cells, facets" if on_routes else "")
-                                    + (", layers" if any("layers" in k for k in v["runs"]) else ""),
+                                    + (", layers" if has_layered_run(v) else ""),
                                     "verification_spheres.png")
         plot_verification(v, "verification_spheres.png", "simple cubic array, Stokes flow", "Zick & Homsy",
                           "solid fraction ")
@@ -2233,6 +2299,9 @@ def main():
     ap.add_argument("--cost-edge", type=float, default=0.07, help="cost: finest surface edge (d)")
     ap.add_argument("--cost-levels", type=int, default=4, help="cost: meshes in all")
     ap.add_argument("--cost-gap-cells", type=float, default=4, help="cost: surface.cells_per_gap on the finest")
+    ap.add_argument("--cost-beds", type=lambda t: tuple(float(x) if i == 0 else int(x) for i, x in enumerate(t.split(":"))),
+                    nargs="+", default=[(4.0, 40), (5.0, 200)],
+                    help="cost_beds: beds as a:N (container diameter in d, particle count)")
     ap.add_argument("--target-edge", type=float, default=0.0868,
                     help="cost_20k: finest surface edge (d), contact edge half of it: some 20 k tetrahedra per sphere")
     ap.add_argument("--target-ratio", type=float, default=1.2, help="cost_20k: cell size ratio between levels")
@@ -2327,6 +2396,10 @@ def main():
             write(results)
         if "cost_500" in args.only:
             results["cost_500"] = [default_study(tmp, cells, facets, layers) for cells, facets, layers in ROUTES]
+            write(results)
+        if "cost_beds" in args.only:
+            results["cost_beds"] = [[default_study(tmp, cells, facets, layers, bed) for cells, facets, layers in ROUTES]
+                                    for bed in args.cost_beds]
             write(results)
         # Runs at other Re_p or treatments are kept, so one can be redone alone.
         for key, field, values in (("study_reynolds", "reynolds", args.reynolds),
