@@ -89,7 +89,8 @@ verification_periodic: periodic sections, cyclic cases driven by meanVelocityFor
         verification (D = 2 d) one period of 3 d long, whose fully developed flow is Hagen-Poiseuille's in every
         cell; and three cells of a simple cubic array as scenes/examples/periodic_cubic_verification.toml at each
         solid fraction (Zick & Homsy's, none of their spheres cut by the periodic planes); one `bedforge run` each
-        with [case.convergence] (--periodic-levels meshes from --periodic-edge d, ratio 1.3): each level's error,
+        with [case.convergence] (--periodic-levels meshes from PERIODIC_EDGES_D, or --periodic-edge d for every
+        run, ratio 1.3): each level's error,
         the order of the errors, and issue 56's target (within 1 % of Zick & Homsy on the finest level, order at
         least 1.5). --periodic-runs redoes some runs (each keeps its own commit, date and edge), e.g.
         --periodic-runs 0.45 --periodic-edge 0.016.
@@ -693,14 +694,21 @@ def touching_lines(v):
     return lines + [""] + verdicts + [""]
 
 
+# verification_periodic's finest surface edge per run (d): finer where the gap between neighbouring
+# spheres is narrower (about 0.15 d at 0.343, 0.05 d at 0.45), as those runs were first made
+# (cc96566, eb4a6ea); the tube's surface takes twice its run's edge.
+PERIODIC_EDGES_D = {"empty tube": 0.025, "0.125": 0.025, "0.216": 0.025, "0.343": 0.019, "0.45": 0.016}
+
+
 def verification_periodic(tmp, edge, levels, runs, kept, cells=3):
     """The periodic empty tube ("empty tube" in `runs`) and periodic simple cubic columns (`cells` cells
     per period) at each solid fraction in `runs`, each a run with a convergence study from a finest
-    edge of `edge` d and its own commit, date and edge; the runs of `kept` (an earlier result) not
-    redone stay as they were."""
+    edge of `edge` d (None: the run's PERIODIC_EDGES_D) and its own commit, date and edge; the runs
+    of `kept` (an earlier result) not redone stay as they were."""
     out = {"levels": levels, "ratio": 1.3, "runs": dict((kept or {}).get("runs", {}))}
     for key in runs:
-        stamp = {**commit_and_date(), "edge_d": edge}
+        edge_d = edge if edge is not None else PERIODIC_EDGES_D[key]
+        stamp = {**commit_and_date(), "edge_d": edge_d}
         if key == "empty tube":
             path = os.path.join(tmp, "periodic_tube")
             open(path + ".toml", "w").write(f"""[container]
@@ -711,7 +719,7 @@ period_z_d = 3.0
 count = 0
 diameter_m = 0.003
 [surface]
-edge_length_d = {edge * 2}
+edge_length_d = {edge_d * 2}
 [case]
 reynolds = 1.0
 processors = 2
@@ -724,7 +732,7 @@ files = ["case"]
             continue
         phi = float(key)
         side = (math.pi / (6.0 * phi)) ** (1.0 / 3.0)  # in d
-        out["runs"][key] = {**stamp, **cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge, levels,
+        out["runs"][key] = {**stamp, **cubic_column_run(tmp, f"periodic_cubic_{phi}", phi, cells, edge_d, levels,
                                                         container=f"period_z_d = {cells * side:.12f}\n")}
     return out
 
@@ -2318,7 +2326,9 @@ def main():
     ap.add_argument("--verify-levels", type=int, default=5, help="verification: meshes in all")
     ap.add_argument("--verify-ratio", type=float, default=1.4, help="verification: cell size ratio between levels")
     ap.add_argument("--sphere-edge", type=float, default=0.05, help="verification_spheres: finest surface edge (d)")
-    ap.add_argument("--periodic-edge", type=float, default=0.025, help="verification_periodic: finest surface edge (d)")
+    ap.add_argument("--periodic-edge", type=float,
+                    help="verification_periodic: finest surface edge (d) of every run redone; by default each run's "
+                         "own, PERIODIC_EDGES_D")
     ap.add_argument("--periodic-levels", type=int, default=4, help="verification_periodic: meshes in all")
     ap.add_argument("--periodic-runs", nargs="+", default=["empty tube", "0.125", "0.216", "0.343", "0.45"],
                     help="verification_periodic: the runs to redo (\"empty tube\", solid fractions Zick & Homsy tabulate); "
