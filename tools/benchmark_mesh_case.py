@@ -1670,8 +1670,11 @@ def beds_lines(beds):
     route with the narrowest band; the default is the route scenes/default.toml sets."""
     r0 = beds[0][0]
     default = ("tetrahedra", "volume", 0)
+    made_on = lambda r: f"{r['commit']} on {r['date']}"
     lines = [f"## Cost per sphere from bed to bed: the README's scene's mesh on {len(beds)} beds (issue 57, item 3)", "",
-             "Made at commit " + ", ".join(sorted({r['commit'] + ' on ' + r['date'] for bed in beds for r in bed}))
+             "Made " + "; ".join(f"at commit {stamp} for " + " and ".join(
+                 f"a = {runs[0]['a']:g}, N = {runs[0]['n']}" for runs in beds if made_on(runs[0]) == stamp)
+                                 for stamp in dict.fromkeys(made_on(runs[0]) for runs in beds))
              + f": scenes/default.toml's mesh and study (surface edge {r0['edge_d']:g} d, contact edge "
              f"{r0['contact_edge_d']:g} d, {r0['cells_per_gap']:g} cells per gap, {len(r0['study']['levels'])} levels, "
              f"ratio {r0['ratio']:g}; seed 1, {r0['treatment']}, Re_p = {r0['reynolds']:g}) on beds from "
