@@ -73,6 +73,10 @@ cost_20k: the same bed on tetrahedra, inscribed and "volume", from --target-edge
 cost_500: the same routes as cost on the README's scene, scenes/default.toml as it is (a = 5, N = 500, its mesh
         and study), and the layered route (LAYERS prism layers of LAYER_THICKNESS_D on tetrahedra with volume
         facets) at the scene's own lengths.
+cost_same_lengths: issue 57's bed (a = 4, N = 40) at each of --same-lengths-seeds, the layered route of
+        cost_20k and the same without layers at the layered route's own lengths (--layered-edge,
+        --layered-contact-edge, --cost-gap-cells, --cost-levels, --target-ratio): whether the layers or the
+        lengths made cost_20k's winner, seed by seed.
 cost_beds: the same four routes at scenes/default.toml's mesh and study on smaller beds (--cost-beds a:N,
         default a = 4, N = 40, issue 57's bed, and a = 5, N = 200), and with cost_500 a table of the routes
         bed by bed: issue 57's item 3 from the 40-sphere bed to the 500-sphere bed at one set of settings.
@@ -149,7 +153,7 @@ RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 # cost_20k's particles split by the gap at their faces (case.drag_by_gap_d, d): the bridges' rims
 # and narrowest gaps, gaps of one to a few contact edges, of a few surface edges, and open pores.
 GAP_BANDS_D = [0.01, 0.03, 0.1, 0.3]
-SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "cost_beds", "study_reynolds", "study_treatments",
+SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_out", "study", "study_gaps", "cost", "cost_20k", "cost_500", "cost_beds", "cost_same_lengths", "study_reynolds", "study_treatments",
             "default", "solver", "solver_tetrahedra", "verification", "verification_spheres", "verification_touching",
             "verification_periodic",
             "periodic_slice", "random_arrays", "pieces", "pieces_bridge", "pieces_large", "weak_scaling", "projection", "pieces_1e4",
@@ -177,7 +181,7 @@ ENV = dict(os.environ, WM_PROJECT_DIR=os.environ.get("WM_PROJECT_DIR", "/usr/sha
 
 
 def scene(a, n, treatment, edge, run, cells_per_gap=0, layers=0, layer_thickness=0.02, reynolds=1.0, iterations=3000,
-          levels=0, ratio=1.3, cells="polyhedra", contact_edge=None, sphere_facets="inscribed", drag_by_gap=()):
+          levels=0, ratio=1.3, cells="polyhedra", contact_edge=None, sphere_facets="inscribed", drag_by_gap=(), seed=1):
     return f"""[container]
 type = "cylinder"
 diameter_d = {a}
@@ -185,7 +189,7 @@ diameter_d = {a}
 count = {n}
 diameter_m = 0.003
 [packing]
-seed = 1
+seed = {seed}
 [contacts]
 treatment = "{treatment}"
 [surface]
@@ -377,21 +381,21 @@ def scale_out(tmp, snappy_cell_d, snappy_level, gmsh_edge, iterations, a=14, n=1
 
 
 def study(tmp, edge, levels, ratio, cells_per_gap=0, a=5, n=500, treatment="bridge", reynolds=1.0, cells="polyhedra",
-          contact_edge=None, sphere_facets="inscribed", drag_by_gap=(), layers=0, layer_thickness=0.02):
+          contact_edge=None, sphere_facets="inscribed", drag_by_gap=(), layers=0, layer_thickness=0.02, seed=1):
     """One run of the scene with a mesh-convergence study; its levels and verdict. contact_edge:
     the contact edge (d), else a third of `edge`; drag_by_gap: case.drag_by_gap_d; layers prism
     layers of layer_thickness d in all."""
     path = os.path.join(tmp, f"study_{treatment}_{a}_{n}_{edge}_{contact_edge}_{cells_per_gap}_{reynolds}_{cells}_{ratio}_"
-                             f"{sphere_facets}_{layers}")
+                             f"{sphere_facets}_{layers}_{seed}")
     text = scene(a, n, treatment, edge, True, cells_per_gap, layers=layers, layer_thickness=layer_thickness,
                  reynolds=reynolds, levels=levels, ratio=ratio, cells=cells, contact_edge=contact_edge,
-                 sphere_facets=sphere_facets, drag_by_gap=drag_by_gap)
+                 sphere_facets=sphere_facets, drag_by_gap=drag_by_gap, seed=seed)
     open(path + ".toml", "w").write(text)
     return study_record(path, {"a": a, "n": n, "treatment": treatment, "reynolds": reynolds, "cells": cells,
                                "edge_d": edge, "ratio": ratio, "cells_per_gap": cells_per_gap,
                                "contact_edge_d": edge / 3 if contact_edge is None else contact_edge,
                                "sphere_facets": sphere_facets, "layers": layers,
-                               "layer_thickness_d": layer_thickness if layers else 0})
+                               "layer_thickness_d": layer_thickness if layers else 0, "seed": seed})
 
 
 def default_study(tmp, cells, sphere_facets, layers=0, bed=None):
@@ -1586,10 +1590,10 @@ def cost_lines(runs):
              f"Made at commit {r0['commit']} on {r0['date']}: "
              + (f"the README's scene, scenes/default.toml, with its bed changed to a = {r0['a']:g}, N = {n}"
                 + (", issue 57's bed" if n == 40 else "") if r0.get("bed_changed")
-                else "issue 57's bed" if n == 40 else "the README's scene, scenes/default.toml as it is"
+                else ("issue 57's bed" if r0.get("seed", 1) == 1 else "issue 57's tube and count") if n == 40 else "the README's scene, scenes/default.toml as it is"
                 if r0.get("default_scene") else "the README's bed at the mesh settings scenes/default.toml had until "
                 "2026-12-04, when its cells were polyhedra")
-             + " (seed 1), one `bedforge run` per route with "
+             + f" (seed {r0.get('seed', 1)}), one `bedforge run` per route with "
              f"a study of {len(r0['study']['levels'])} levels, ratio {r0['ratio']}, from a surface edge of "
              f"{r0['edge_d']} d, contact edge "
              # scene() sets a third of the edge; the default scene its own (rows before 2026-12-05: a third).
@@ -2150,6 +2154,8 @@ def write(results):
             lines += cost_lines(results[key])
             for r in results[key]:
                 lines += error_seat_lines(r)
+    for runs in results.get("cost_same_lengths", []):
+        lines += cost_lines(runs)
     if "cost_beds" in results:
         for runs in results["cost_beds"]:
             lines += cost_lines(runs)
@@ -2313,6 +2319,8 @@ def main():
     ap.add_argument("--cost-beds", type=lambda t: tuple(float(x) if i == 0 else int(x) for i, x in enumerate(t.split(":"))),
                     nargs="+", default=[(4.0, 40), (5.0, 200)],
                     help="cost_beds: beds as a:N (container diameter in d, particle count)")
+    ap.add_argument("--same-lengths-seeds", type=int, nargs="+", default=[1, 2],
+                    help="cost_same_lengths: packing seeds of issue 57's bed (a = 4, N = 40)")
     ap.add_argument("--target-edge", type=float, default=0.0868,
                     help="cost_20k: finest surface edge (d), contact edge half of it: some 20 k tetrahedra per sphere")
     ap.add_argument("--target-ratio", type=float, default=1.2, help="cost_20k: cell size ratio between levels")
@@ -2406,6 +2414,13 @@ def main():
                                              args.cost_gap_cells, a=4, n=40, cells="tetrahedra",
                                              contact_edge=args.layered_contact_edge, sphere_facets="volume",
                                              drag_by_gap=GAP_BANDS_D, layers=LAYERS, layer_thickness=LAYER_THICKNESS_D))
+            write(results)
+        if "cost_same_lengths" in args.only:
+            results["cost_same_lengths"] = [
+                [study(tmp, args.layered_edge, args.cost_levels, args.target_ratio, args.cost_gap_cells, a=4, n=40,
+                       cells="tetrahedra", contact_edge=args.layered_contact_edge, sphere_facets="volume",
+                       layers=layers, layer_thickness=LAYER_THICKNESS_D, seed=seed) for layers in (0, LAYERS)]
+                for seed in args.same_lengths_seeds]
             write(results)
         if "cost_500" in args.only:
             results["cost_500"] = [default_study(tmp, cells, facets, layers) for cells, facets, layers in ROUTES]
