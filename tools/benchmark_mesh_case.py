@@ -1604,7 +1604,7 @@ def cost_lines(runs):
                 if any(r.get("sphere_facets") for r in runs) else "`case.cells` the only difference")
              + ("; a route with prism layers has its own surface lengths, named in it (its study's levels decide "
                 "their stacks at the coarsest level's lengths, so that every level layers the same region)"
-                if any(r.get("layers") for r in runs) else "")
+                if any(r.get("layers") and mesh_settings(r) != mesh_settings(r0) for r in runs) else "")
              + ". Seconds per sphere are a level's wall time (surface, mesh, case and "
              "solve) on the 2 cores over N; core-seconds are at most twice that. The reference is the extrapolation "
              "with the narrowest GCI band"
