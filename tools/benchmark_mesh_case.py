@@ -168,6 +168,8 @@ LAYERS_TOML = f"[mesh.layers]\ncount = {LAYERS}\nthickness_d = {LAYER_THICKNESS_
 # The routes verification_spheres, verification_touching and cost_500 run: the cost routes and the layered one
 # (cells, facets, prism layers).
 ROUTES = [(cells, facets, 0) for cells, facets in COST_ROUTES] + [("tetrahedra", "volume", LAYERS)]
+# The README's route among them: scenes/default.toml's cells, bedforge's default sphere_facets, no layers.
+DEFAULT_ROUTE = ("tetrahedra", "volume", 0)
 
 
 def route_key(cells, facets, layers):
@@ -425,7 +427,7 @@ def default_study(tmp, cells, sphere_facets, layers=0, bed=None):
                                "ratio": sc("ratio"), "cells_per_gap": sc("cells_per_gap"),
                                "contact_edge_d": sc("contact_edge_length_d"), "sphere_facets": sphere_facets,
                                "layers": layers, "layer_thickness_d": LAYER_THICKNESS_D if layers else 0,
-                               "default_scene": True, "bed_changed": bed is not None})
+                               "default_scene": True, "bed_changed": bed is not None, "seed": int(sc("seed"))})
 
 
 def study_record(path, fields):
@@ -1545,13 +1547,18 @@ def route(r):
          f"{r['contact_edge_d']:g} d)" if r.get("layers") else "")
 
 
+def finest_solved(r):
+    """A study run's finest level that did not fail, or None."""
+    return next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+
+
 def band_agreement_lines(runs, fits):
     """Issue 57's target that the new mesh's extrapolation (the last route's) and today's agree
     within their bands: each band the finest level's dp/L +- its GCI (Celik et al. 2008), the
     new route's against each other route's."""
     def band(r):
         g = fits(r)[0]
-        finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+        finest = finest_solved(r)
         if g.get("gci_fine") is None or finest is None:
             return None
         dp = finest["pressure_gradient_bed_pa_m"]
@@ -1626,7 +1633,7 @@ def cost_lines(runs):
                   "by the finest three and by least squares over all, the two within 0.3) |", "|---|---|---|---|---|---|"]
     for r in runs:
         g, ls = fits(r)
-        finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+        finest = finest_solved(r)
         if g.get("gci_fine") is None or finest is None:
             lines.append(f"| {route(r)} | none: {r['study']['conclusion']} | | | | not met |")
             continue
@@ -1673,7 +1680,6 @@ def beds_lines(beds):
     README's scene's mesh settings) each route's finest GCI, order, extrapolation and cost, and the
     route with the narrowest band; the default is the route scenes/default.toml sets."""
     r0 = beds[0][0]
-    default = ("tetrahedra", "volume", 0)
     made_on = lambda r: f"{r['commit']} on {r['date']}"
     lines = [f"## Cost per sphere from bed to bed: the README's scene's mesh on {len(beds)} beds (issue 57, item 3)", "",
              "Made " + "; ".join(f"at commit {stamp} for " + " and ".join(
@@ -1681,7 +1687,7 @@ def beds_lines(beds):
                                  for stamp in dict.fromkeys(made_on(runs[0]) for runs in beds))
              + f": scenes/default.toml's mesh and study (surface edge {r0['edge_d']:g} d, contact edge "
              f"{r0['contact_edge_d']:g} d, {r0['cells_per_gap']:g} cells per gap, {len(r0['study']['levels'])} levels, "
-             f"ratio {r0['ratio']:g}; seed 1, {r0['treatment']}, Re_p = {r0['reynolds']:g}) on beds from "
+             f"ratio {r0['ratio']:g}; seed {r0.get('seed', 1)}, {r0['treatment']}, Re_p = {r0['reynolds']:g}) on beds from "
              f"N = {beds[0][0]['n']} to N = {beds[-1][0]['n']}, each route as in the sections above; the default route "
              "is the scene's own (tetrahedra, facets holding the spheres' volume, no layers). GCI of the finest mesh "
              "(Celik et al. 2008); cost on the finest level, per sphere.", "",
@@ -1693,11 +1699,11 @@ def beds_lines(beds):
         gcis = {}
         for r in runs:
             g = r["study"].get("grid_convergence", {})
-            finest = next((lv for lv in r["study"]["levels"] if "failure" not in lv), None)
+            finest = finest_solved(r)
             if finest is None or g.get("gci_fine") is None:
                 lines.append(f"| {bed} | {route(r)} | | | none: {r['study']['conclusion']} | | | {r['wall_s'] / 60:.1f} |")
                 continue
-            gcis[route(r)] = (g["gci_fine"], (r["cells"], r.get("sphere_facets"), r.get("layers", 0)) == default)
+            gcis[route(r)] = (g["gci_fine"], (r["cells"], r.get("sphere_facets"), r.get("layers", 0)) == DEFAULT_ROUTE)
             lines.append(f"| {bed} | {route(r)} | {finest['cells'] / r['n']:,.0f} | {finest['time_s'] / r['n']:.1f} | "
                          f"{100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f} | {g['extrapolated']:.4g} | "
                          f"{r['wall_s'] / 60:.1f} |")
@@ -2299,6 +2305,18 @@ def plot(results):
     fig.savefig(os.path.join(DOCS, "mesh_case_convergence.png"), dpi=120)
 
 
+def bed_argument(text):
+    """--cost-beds' a:N (container diameter in d, particle count), refused unless both are positive."""
+    try:
+        a, n = text.split(":")
+        bed = (float(a), int(n))
+    except ValueError:
+        bed = None
+    if bed is None or bed[0] <= 0 or bed[1] <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: a bed is a:N, a positive diameter in d and a positive count")
+    return bed
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", nargs="+", choices=SECTIONS, default=SECTIONS)
@@ -2316,7 +2334,7 @@ def main():
     ap.add_argument("--cost-edge", type=float, default=0.07, help="cost: finest surface edge (d)")
     ap.add_argument("--cost-levels", type=int, default=4, help="cost: meshes in all")
     ap.add_argument("--cost-gap-cells", type=float, default=4, help="cost: surface.cells_per_gap on the finest")
-    ap.add_argument("--cost-beds", type=lambda t: tuple(float(x) if i == 0 else int(x) for i, x in enumerate(t.split(":"))),
+    ap.add_argument("--cost-beds", type=bed_argument,
                     nargs="+", default=[(4.0, 40), (5.0, 200)],
                     help="cost_beds: beds as a:N (container diameter in d, particle count)")
     ap.add_argument("--same-lengths-seeds", type=int, nargs="+", default=[1, 2],
