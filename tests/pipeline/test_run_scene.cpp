@@ -175,11 +175,18 @@ TEST(RunScene, AConvergenceStudySolvesCoarserMeshesOfTheSameBed) {
   }
   // Each coarser level's solved cells are 1.3 times the size of the finer one's: the sizing
   // search stops within 3 % of its target, on the points of the tetrahedra (one polyhedron each).
+  // The sizing measures gmsh's tetrahedra; the case first cuts the flat ears that gmsh leaves on
+  // some runs and not others (meshing/volume/flat_ears.hpp), slivers whose volume is far below one
+  // cell's: so the solved size is at most the predicted one and less than a cell's volume below it
+  // (a CI run of 2026-12-07 measured 1e-6 of the volume, 0.5 % of one of its 5,395 cells).
   for (int k = 1; k < 4; ++k) {
     const auto& level = study["levels"][k];
     const double h = level["cell_size_m"].get<double>(), h1 = study["levels"][0]["cell_size_m"].get<double>();
     EXPECT_NEAR(h / h1, std::pow(1.3, k), 0.03 * std::pow(1.3, k)) << level.dump();
-    EXPECT_NEAR(level["sizing"].back()["predicted_cell_size_m"].get<double>(), h, 1e-9 * h) << level.dump();
+    const double predicted = level["sizing"].back()["predicted_cell_size_m"].get<double>();
+    const double one_cell = 1.0 / (3.0 * level["cells"].get<double>());  // of h, as d(h^3)/h^3 = 3 dh/h
+    EXPECT_GE(predicted, h * (1.0 - 1e-12)) << level.dump();
+    EXPECT_LT(predicted - h, one_cell * h) << level.dump();
   }
   // The scene's own mesh is the finest; the flow is solved on its polyhedral dual.
   EXPECT_EQ(study["levels"][0]["cells"], r.stages["case"]["flow"]["mesh"]["cells"]);
