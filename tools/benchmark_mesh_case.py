@@ -161,15 +161,37 @@ SECTIONS = ["sizes", "gaps", "layers", "snappy", "scale", "scale_1e4", "scale_ou
             "projection_1e4"]
 # The cost sections' routes: case.cells, surface.sphere_facets.
 COST_ROUTES = [("polyhedra", "inscribed"), ("tetrahedra", "inscribed"), ("tetrahedra", "volume")]
-# Issue 57's layered route, which met its target on the 40-sphere bed (cost_20k): tetrahedra with volume facets
-# and this many prism layers of this total thickness (d) on the particles, [mesh.layers].
+# Issue 57's layered route: tetrahedra with volume facets and this many prism layers of this total thickness (d)
+# on the particles, [mesh.layers]. It met issue 57's target on the 40-sphere bed at that issue's lengths
+# (cost_20k), as the same lengths without layers did too (cost_same_lengths).
 LAYERS, LAYER_THICKNESS_D = 3, 0.02
 LAYERS_TOML = f"[mesh.layers]\ncount = {LAYERS}\nthickness_d = {LAYER_THICKNESS_D}\n"
 # The routes verification_spheres, verification_touching and cost_500 run: the cost routes and the layered one
 # (cells, facets, prism layers).
 ROUTES = [(cells, facets, 0) for cells, facets in COST_ROUTES] + [("tetrahedra", "volume", LAYERS)]
-# The README's route among them: scenes/default.toml's cells, bedforge's default sphere_facets, no layers.
+# The README's route among them: scenes/default.toml's cells, bedforge's default sphere_facets, no layers
+# (check_default_route holds it to the scene and the program before a run that relies on it).
 DEFAULT_ROUTE = ("tetrahedra", "volume", 0)
+
+
+def check_default_route():
+    """SystemExit unless DEFAULT_ROUTE is what scenes/default.toml gives: its case.cells, its
+    surface.sphere_facets or else the program's default for it (`bedforge scene-keys`), no layers."""
+    text = open(DEFAULT_SCENE).read()
+    m = re.search(r'^sphere_facets = "(\w+)"', text, re.M)
+    if m:
+        facets = m.group(1)
+    else:
+        keys = subprocess.run([BEDFORGE, "scene-keys"], check=True, capture_output=True, text=True).stdout
+        surface = keys.split("## [surface]", 1)[-1].split("\n## ", 1)[0]
+        row = re.search(r"^\| `sphere_facets` \|[^|]*\|[^|]*\| (\w+) \|", surface, re.M)
+        if not row:
+            raise SystemExit("bedforge scene-keys lists no default for surface.sphere_facets; update check_default_route")
+        facets = row.group(1)
+    layers = 1 if re.search(r"^\[mesh\.layers\]", text, re.M) else 0
+    route = (scene_value(text, "cells"), facets, layers and LAYERS)
+    if route != DEFAULT_ROUTE:
+        raise SystemExit(f"scenes/default.toml runs on {route}, DEFAULT_ROUTE says {DEFAULT_ROUTE}; update DEFAULT_ROUTE")
 
 
 def route_key(cells, facets, layers):
@@ -2381,6 +2403,8 @@ def main():
     ap.add_argument("--weak-1e4-spheres", type=int, default=1250, help="weak_scaling_1e4: spheres per rank (1, 2, 4 ranks)")
     args = ap.parse_args()
     results = json.load(open(RESULTS)) if os.path.exists(RESULTS) else {}
+    if {"cost_500", "cost_beds"} & set(args.only):
+        check_default_route()  # their pages name the README's route: refused before any run if it moved
     with tempfile.TemporaryDirectory() as tmp:
         if "sizes" in args.only:
             results["sizes"] = [{**commit_and_date(), **r} for r in sizes(tmp, [(e, 0, 0, 0.02) for e in args.edges])]
