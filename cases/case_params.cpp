@@ -16,9 +16,11 @@ CaseParams read_case_params(SceneSection& s) {
   p.density_kg_m3 = s.number("density_kg_m3", p.density_kg_m3, Range::positive());
   p.viscosity_pa_s = s.number("viscosity_pa_s", p.viscosity_pa_s, Range::positive());
   p.iterations = static_cast<int>(s.integer("iterations", p.iterations, 1, 1'000'000));
-  p.residual_p = s.number("residual_p", p.residual_p, Range::open(0.0, 1.0));
+  p.residual_p = s.optional_number("residual_p", Range::open(0.0, 1.0),
+                                  fmt::format("{}; {} on a periodic section", kResidualP, kResidualPeriodic));
   p.residual_u = s.optional_number("residual_u", Range::open(0.0, 1.0),
-                                  fmt::format("{}; {} on cells with prism layers", kResidualU, kResidualULayered));
+                                  fmt::format("{}; {} on a periodic section; {} on cells with prism layers", kResidualU,
+                                              kResidualPeriodic, kResidualULayered));
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
@@ -61,7 +63,8 @@ CaseParams read_case_params(SceneSection& s) {
 nlohmann::json to_json(const CaseParams& p) {
   return {{"reynolds", p.reynolds},         {"density_kg_m3", p.density_kg_m3},
           {"viscosity_pa_s", p.viscosity_pa_s}, {"iterations", p.iterations},
-          {"residual_p", p.residual_p},     {"residual_u", p.residual_u ? nlohmann::json(*p.residual_u) : nlohmann::json()},
+          {"residual_p", p.residual_p ? nlohmann::json(*p.residual_p) : nlohmann::json()},
+          {"residual_u", p.residual_u ? nlohmann::json(*p.residual_u) : nlohmann::json()},
           {"processors", p.processors},     {"decomposition", p.decomposition},
           {"format", p.binary ? "binary" : "ascii"}, {"cells", p.polyhedra ? "polyhedra" : "tetrahedra"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},

@@ -325,7 +325,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   // the residuals keep falling geometrically to their targets, and follows the one furthest
   // from its target.
   auto run = std::async(std::launch::async, [&cmd] { return std::system(cmd.c_str()); });
-  const double target_p = c.params.residual_p, target_u = c.params.residual_u.value();
+  const double target_p = c.params.residual_p.value(), target_u = c.params.residual_u.value();
   double start_p = 0.0, start_u = 0.0;
   DivergenceWatch watch(target_u, target_p);
   std::optional<Divergence> diverging;

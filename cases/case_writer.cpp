@@ -476,7 +476,7 @@ void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool period
                               "relaxationFactors\n{{\n    equations\n    {{\n        U               0.9;\n    }}\n"
                               "    fields\n    {{\n        p               1;\n    }}\n}}\n",
                               // With cyclic inlet and outlet no boundary fixes the pressure's level.
-                              periodic ? "    pRefCell        0;\n    pRefValue       0;\n" : "", p.residual_p,
+                              periodic ? "    pRefCell        0;\n    pRefValue       0;\n" : "", *p.residual_p,
                               *p.residual_u)));
   write_text(tmp / "system/decomposeParDict",
              dict("dictionary", "system", "decomposeParDict", note,
@@ -646,7 +646,11 @@ CaseInfo write_case(const fs::path& case_dir, bool overwrite, const meshing::Pol
                     const std::string& bed_csv, const fs::path& fluid_stl, const TreatedSolid& treated) {
   refuse_existing_case(case_dir, overwrite);
   CaseParams p = given;
-  if (!p.residual_u) p.residual_u = mesh && meshing::has_prisms(*mesh) ? kResidualULayered : kResidualU;
+  // The residual targets: prism layers stall U's residual and keep the general targets otherwise;
+  // a periodic section's driving gradient settles slowly and needs tighter ones (case_params.hpp).
+  const bool prisms = mesh && meshing::has_prisms(*mesh);
+  if (!p.residual_u) p.residual_u = prisms ? kResidualULayered : g.periodic ? kResidualPeriodic : kResidualU;
+  if (!p.residual_p) p.residual_p = g.periodic && !prisms ? kResidualPeriodic : kResidualP;
   const double nu = p.viscosity_pa_s / p.density_kg_m3;
   const double u = p.reynolds * nu / g.d_ref;  // superficial velocity
   // On polyhedra the tetrahedra lose their flat ears first (slivers on the wall that no optimiser

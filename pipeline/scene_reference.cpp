@@ -23,7 +23,7 @@ const char* const kWhyMeshSizes = "Mesh: surface-driven sizes, `max_size_d = 0.2
 const char* const kWhySlabs = "Mesh: `slabs = 0`, one slab per million surface triangles (shrink and none)";
 const char* const kWhyLayers = "Mesh: prism layers off (`[mesh.layers] count = 0`); when on, 0.02 d, growth 1.2, "
                                "`gap_fraction = 0.2`";
-const char* const kWhyResiduals = "Flow solve: `residual_p = residual_u = 1e-4`";
+const char* const kWhyResiduals = "Flow solve: `residual_p = residual_u = 1e-4`, 1e-6 on a periodic section";
 const char* const kWhyCells = "Case: `cells = \"polyhedra\"` (gmsh's tetrahedra turned into their dual), least-squares "
                               "gradients";
 
@@ -273,10 +273,12 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
       {"case.iterations",
        {"simpleFoam's iteration cap; a solve whose residual of U or p climbs past 10 times the least it reached (or its "
         "target) is stopped sooner, its fields written there, and the run exits 3 (cases/case_runner.hpp)"}},
-      {"case.residual_p", {"simpleFoam's convergence target for p", "1", kWhyResiduals}},
+      {"case.residual_p",
+       {"simpleFoam's convergence target for p; tighter on a periodic section, whose driving gradient settles slowly",
+        "1", kWhyResiduals}},
       {"case.residual_u",
-       {"the same for U; its own default on cells with prism layers, where U's residual stalls near 3e-3 while dp/L "
-        "has settled",
+       {"the same for U; tighter on a periodic section, and its own default on cells with prism layers, where U's "
+        "residual stalls near 3e-3 while dp/L has settled",
         "1", kWhyResiduals}},
       {"case.processors", {"subdomains of decomposeParDict: `Allrun -np N` runs on N of them"}},
       {"case.decomposition", {"decomposition method"}},

@@ -65,7 +65,7 @@ cases::CaseInfo failing_case(const std::string& name, const std::string& solver_
   fs::permissions(dir / "Allrun", fs::perms::owner_all);
   cases::CaseInfo c;
   c.directory = dir;
-  c.params.residual_u = 1e-4;
+  c.params.residual_u = c.params.residual_p = 1e-4;
   return c;
 }
 
@@ -184,7 +184,7 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
   fs::permissions(dir / "Allrun", fs::perms::owner_all);
   cases::CaseInfo c;
   c.directory = dir;
-  c.params.residual_u = 1e-4;
+  c.params.residual_u = c.params.residual_p = 1e-4;
   Progress quiet("case", false);
   try {
     cases::run_case(c, quiet);

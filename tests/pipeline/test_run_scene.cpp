@@ -501,7 +501,9 @@ TEST(RunScene, TheLayeredExampleSolvesOnItsPrismsAndBalancesItsDrag) {
 
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three
 // cells, cyclic inlet and outlet, meanVelocityForce; order 2.05 measured at the example's
-// settings, 2026-11-28).
+// settings, 2026-11-28). Its solve stops only once the driving gradient has settled: over the
+// last tenth of the iterations it moves by less than a tenth of Zick & Homsy's 0.1 % (at the
+// general targets of 1e-4 it still moved by 2.3e-4 on this mesh, 2026-12-07).
 TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const Scene scene = example_scene("periodic_cubic_verification.toml", {{"surface.edge_length_d", 0.1},
                                                                          {"surface.contact_edge_length_d", 0.05}});
@@ -509,6 +511,7 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& c = r.stages["case"];
   EXPECT_TRUE(c["periodic_mean_velocity_m_s"].is_number());
+  EXPECT_LT(c["flow"]["pressure_gradient_change_last_tenth"].get<double>(), 1e-4) << c["parameters"].dump();
   expect_converging_to_zick_homsy(c);
 }
 
