@@ -520,10 +520,14 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
 // pair's points and finds the mesh OK, and the three levels fall towards Zick & Homsy's drag as
 // the cells refine. On these polyhedra the finest level read -13.5 and -13.6 % and the study's
 // order 0.95 and 1.07 (two runs, 2026-12-04; gmsh's meshes differ between runs), so the order is
-// not asserted here and the finest error is bounded by 16 %, above both.
+// not asserted here and the finest error is bounded by 16 %, above both. Solved to the general
+// residual targets of 1e-4, as those runs were: the periodic default of 1e-6 took some 4 times as
+// long here and moves dp/L by tenths of a per cent (the test above checks it).
 TEST(RunScene, ABoxPeriodicOnEverySideConvergesToZickAndHomsy) {
   const fs::path dir = test_support::fresh_dir("periodic_box_cubic");
-  const RunOutcome r = run(example_scene("periodic_box_cubic_verification.toml"), dir);
+  const RunOutcome r = run(example_scene("periodic_box_cubic_verification.toml",
+                                         {{"case.residual_u", 1e-4}, {"case.residual_p", 1e-4}}),
+                           dir);
   double finest_error = -1.0;
   expect_converging_to_zick_homsy(r.stages["case"], &finest_error);
   EXPECT_GT(finest_error, -0.16) << r.stages["case"]["convergence"].dump();
@@ -543,10 +547,14 @@ TEST(RunScene, ABoxPeriodicOnEverySideConvergesToZickAndHomsy) {
 // the three-level studies 0.74-0.91, their extrapolations 0.90-1.16): the bounds 0.8 and 1.0 lie
 // 0.09 and 0.11 from seed 1's value, within the seeds' spread of 0.16. vdH's gradient without the
 // 1 / (1 - phi) of its drag would put the ratio at 1.45; the fraction is checked on its own.
+// Solved, as those runs were, to the general residual targets of 1e-4 (the periodic default of
+// 1e-6 moves dp/L by tenths of a per cent, far inside the bounds, for some 4 times the solve).
 TEST(RunScene, TheRandomArrayExampleIsComparedWithVanDerHoef) {
   const Scene scene = example_scene("random_array_stokes.toml", {{"surface.edge_length_d", 0.15},
                                                                  {"surface.contact_edge_length_d", 0.06},
-                                                                 {"case.convergence.levels", 0LL}});
+                                                                 {"case.convergence.levels", 0LL},
+                                                                 {"case.residual_u", 1e-4},
+                                                                 {"case.residual_p", 1e-4}});
   const fs::path dir = test_support::fresh_dir("random_array");
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& c = r.stages["case"];
