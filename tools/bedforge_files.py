@@ -47,17 +47,35 @@ def made_line(result, unstamped=UNSTAMPED):
 GAPS_COARSENED_FROM = "ac6e6bc"
 
 
-def gaps_not_coarsened(study):
-    """Whether a gap-refined study's result was made before its coarser levels coarsened the gaps."""
-    if not study.get("cells_per_gap"):
-        return False
-    known = subprocess.run(["git", "merge-base", "--is-ancestor", GAPS_COARSENED_FROM, study["commit"].removesuffix("-dirty")],
+# From this commit on, a periodic section's solve stops at residuals of 1e-6 (cases/case_params.hpp);
+# before it at 1e-4, where its dp/L read high by 0.3-0.8 % on Stokes arrays (docs/defaults.md).
+PERIODIC_RESIDUALS_FROM = "f58b447"
+
+
+def made_before(result, change, what):
+    """Whether `result` (a dict stamped with its commit) was made by code older than commit `change`;
+    `what` names the change for the error when git cannot tell."""
+    known = subprocess.run(["git", "merge-base", "--is-ancestor", change, result["commit"].removesuffix("-dirty")],
                            cwd=ROOT, capture_output=True, text=True)
     if known.returncode not in (0, 1):  # 1: not an ancestor; anything else: git could not tell
-        raise SystemExit(f"cannot tell whether the study made at {study['commit']} coarsened its gaps (after "
-                         f"{GAPS_COARSENED_FROM}): {known.stderr.strip()}; a shallow clone lacks the commits: "
-                         "git fetch --unshallow")
+        raise SystemExit(f"cannot tell whether the result made at {result['commit']} {what} (from {change}): "
+                         f"{known.stderr.strip()}; a shallow clone lacks the commits: git fetch --unshallow")
     return known.returncode == 1
+
+
+def gaps_not_coarsened(study):
+    """Whether a gap-refined study's result was made before its coarser levels coarsened the gaps."""
+    return bool(study.get("cells_per_gap")) and made_before(study, GAPS_COARSENED_FROM, "coarsened its gaps")
+
+
+def periodic_residuals_note(result):
+    """A sentence (with its leading space) for a result whose periodic sections were solved at the old
+    residual targets, else ""."""
+    if not made_before(result, PERIODIC_RESIDUALS_FROM, "solved to the periodic residual targets"):
+        return ""
+    return (f" Its periodic sections were solved before {PERIODIC_RESIDUALS_FROM}, at residual targets of 1e-4, where "
+            "their dp/L reads high by the iterative error: 0.3-0.8 % on Stokes arrays, growing with the cells "
+            "(docs/defaults.md); not regenerated since.")
 
 
 def read_bed(path):

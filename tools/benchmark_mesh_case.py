@@ -147,7 +147,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from bedforge_files import BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line  # noqa: E402
+from bedforge_files import (BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line,  # noqa: E402
+                            periodic_residuals_note)
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 # cost_20k's particles split by the gap at their faces (case.drag_by_gap_d, d): the bridges' rims
@@ -864,7 +865,7 @@ def random_array_lines(v):
              "periodic on every side, 3 mm spheres Monte Carlo packed and compressed to the period, shrunk by 0.99, "
              "Re_p = 0.01, three-level study on polyhedra, surface edge 0.1 d) with particles.count set for each solid "
              "fraction as packed, at each seed. vdH: van der Hoef, Beetstra & Kuipers (2005) at the solid fraction as "
-             "solved (the shrunk spheres'); band: the finest dp/L +- its GCI.", "",
+             "solved (the shrunk spheres'); band: the finest dp/L +- its GCI." + periodic_residuals_note(v), "",
              "| count | seed | solid packed | solid solved | cells (finest) | dp/L finest (Pa/m) | extrapolated | GCI fine "
              "| order | vdH (Pa/m) | finest / vdH | extrapolated / vdH | band holds vdH | wall (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -912,7 +913,8 @@ def slice_lines(v):
              f"{v['period_d']:.3f} d), at the same settings, seed after seed (a slice that jams before its period is "
              f"listed and the next seed taken; so is a run that fails). dp/L: the full bed's over its section "
              f"({v.get('full_section_exclude_d', 0.5):g} d clear of floor and top), "
-             "the slice's over one period; E&S at that section's meshed void fraction.", "",
+             "the slice's over one period; E&S at that section's meshed void fraction."
+             + periodic_residuals_note(v), "",
              "| bed | seed | central eps (packed) | section eps (meshed) | cells (finest) | dp/L finest (Pa/m) | "
              "/ E&S | extrapolated (Pa/m) | GCI fine | order | opened | wall (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
