@@ -42,6 +42,8 @@ nlohmann::json FlowResult::to_json() const {
           {"final_initial_residual", {{"U", residual_u}, {"p", residual_p}}},
           {"pressure_gradient_bed_pa_m", pressure_gradient_bed_pa_m},
           {"pressure_gradient_change_last_tenth", pressure_gradient_change_last_tenth},
+          {"pressure_gradient_iteration_error",
+           pressure_gradient_iteration ? pressure_gradient_iteration->to_json() : nlohmann::json()},
           {"pressure_drop_inlet_outlet_pa", pressure_drop_inlet_outlet_pa},
           {"flow_rate_m3_s", flow_rate_m3_s},
           {"flow_rate_relative_error", flow_rate_relative_error},
@@ -394,8 +396,12 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
     throw std::runtime_error(fmt::format("{}/log.simpleFoam: meanVelocityForce drove the flow at a pressure gradient "
                                          "of {} Pa/m; please report it with the case",
                                          case_dir.string(), gradient));
-  // Convergence of the quantity itself: its change over the last tenth of the iterations.
-  const double change = std::abs(gradient - bed_gradient(n - 1 - (n - 1) / 10)) / std::abs(gradient);
+  // Convergence of the quantity itself: its change over the last tenth of the iterations, and
+  // what it would still move had the solve run on.
+  std::vector<double> gradients(n);
+  for (std::size_t k = 0; k < n; ++k) gradients[k] = bed_gradient(k);
+  const std::optional<analysis::IterationError> iteration =
+      n >= 3 && std::isfinite(gradient) && gradient != 0.0 ? std::optional(analysis::iteration_error(gradients)) : std::nullopt;
   const double overall = periodic ? gradient * (zh - zl)
                                   : rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
   const double flow = flows.back();
@@ -413,7 +419,7 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   for (std::size_t k = 0; k < its.size(); ++k) {
     nlohmann::json point = {{"iteration", k + 1}, {"time_s", its[k].time_s}, {"residual_U", its[k].res_u},
                             {"residual_p", its[k].res_p}};
-    if (k < n) point["pressure_gradient_bed_pa_m"] = bed_gradient(k);
+    if (k < n) point["pressure_gradient_bed_pa_m"] = gradients[k];
     history.push_back(std::move(point));
   }
   r.time_s = time;
@@ -424,7 +430,8 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.residual_u = res_u;
   r.residual_p = res_p;
   r.pressure_gradient_bed_pa_m = gradient;
-  r.pressure_gradient_change_last_tenth = change;
+  r.pressure_gradient_iteration = iteration;
+  if (iteration) r.pressure_gradient_change_last_tenth = std::abs(iteration->last_change);
   r.pressure_drop_inlet_outlet_pa = overall;
   r.flow_rate_m3_s = flow;
   r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/iteration_error.hpp"
 #include "cases/case_writer.hpp"
 #include "core/progress.hpp"
 
@@ -36,6 +37,9 @@ struct FlowResult {
   // (case_runner.cpp says why).
   double pressure_gradient_bed_pa_m = 0.0;
   double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
+  // What the gradient would still have moved had the solve run on, from how its last changes
+  // shrank (unset with fewer than 3 iterations).
+  std::optional<analysis::IterationError> pressure_gradient_iteration;
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
   Drag drag;  // the forces on the walls and particles, and the push through inlet and outlet

@@ -36,6 +36,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"cell_size_m", l.cell_size_m},
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged},
+                {"iteration_error", l.iteration ? l.iteration->to_json() : nlohmann::json()},
                 {"cells_failing_check_mesh", l.cells_failing_check_mesh},
                 {"own_time_s", l.own_time_s},
                 {"drag", l.drag.to_json()}});
@@ -78,6 +79,8 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   l.cell_size_m = j.at("cell_size_m").get<double>();
   l.pressure_gradient_pa_m = j.at("pressure_gradient_bed_pa_m").get<double>();
   l.converged = j.at("converged").get<bool>();
+  if (const nlohmann::json e = j.value("iteration_error", nlohmann::json()); e.is_object())
+    l.iteration = analysis::IterationError::from_json(e);
   l.cells_failing_check_mesh = j.value("cells_failing_check_mesh", 0L);  // reports before 2026-11-29 lack it
   l.own_time_s = j.at("own_time_s").get<double>();
   l.drag = cases::Drag::from_json(j.at("drag"));
@@ -118,6 +121,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.cell_size_m = std::cbrt(solved.info.fluid_volume_m3.value() / static_cast<double>(l.cells));  // gmsh cells: known
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
+  l.iteration = solved.flow->pressure_gradient_iteration;
   if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
   l.drag = solved.flow->drag;
   l.exact_pa_m = solved.flow->exact_pa_m;

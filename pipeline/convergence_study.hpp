@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "analysis/grid_convergence.hpp"
+#include "analysis/iteration_error.hpp"
 #include "core/bed.hpp"
 #include "core/report.hpp"
 #include "pipeline/case_stage.hpp"
@@ -22,6 +23,9 @@ struct StudyLevel {
   double cell_size_m = 0.0;   // (V / N)^(1/3), V the volume of the mesh's cells
   double pressure_gradient_pa_m = 0.0;
   bool converged = false;     // the solver's own verdict
+  // What its dp/L would still have moved had the solve run on (cases::FlowResult's; unset in
+  // reports before 2026-12-07).
+  std::optional<analysis::IterationError> iteration;
   long cells_failing_check_mesh = 0;  // polyhedra that fail checkMesh's limits (meshing::check_polyhedra)
   // The drag by kind, and with case.drag_by_gap_d the particles' by the gap at their faces
   // (cases::FlowResult): where the level's error sits.

@@ -101,7 +101,11 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
   if (const nlohmann::json why = entry.value("stokes_array_not_compared", nlohmann::json()); why.is_string())
     a.stokes_array_not_compared = why.get<std::string>();
   const double solver_peak_mb = flow.value("solver_peak_memory_mb", 0.0);
+  a.residual_u = entry["parameters"].value("residual_u", 0.0);
+  a.residual_p = entry["parameters"].value("residual_p", 0.0);
   if (!study) {
+    if (const nlohmann::json e = flow.value("pressure_gradient_iteration_error", nlohmann::json()); e.is_object())
+      a.iteration_errors.emplace_back(1, analysis::IterationError::from_json(e));
     if (entry["fluid_volume_m3"].is_number())  // gmsh's cells (snappyHexMesh's volume is not known beforehand)
       a.levels.push_back({std::cbrt(entry["fluid_volume_m3"].get<double>() / static_cast<double>(a.finest_cells)), a.finest_pa_m});
     a.why_no_estimate = "the flow was solved on one mesh only, so its discretisation error is not known (on the beds "
@@ -115,6 +119,7 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
   for (const StudyLevel& l : study->levels)
     if (l.failure.empty()) {
       a.levels.push_back({l.cell_size_m, l.pressure_gradient_pa_m});
+      if (l.iteration) a.iteration_errors.emplace_back(l.level, *l.iteration);
       if (l.cells_failing_check_mesh > 0) a.failing_check_mesh.emplace_back(l.level, l.cells_failing_check_mesh);
     }
   const bool from_finest = study->complete && study->levels.size() >= 3 && study->levels[0].failure.empty() &&
@@ -136,8 +141,64 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.order = g.order;
     a.band_low_pa_m = a.finest_pa_m - g.gci_fine * std::abs(a.finest_pa_m);
     a.band_high_pa_m = a.finest_pa_m + g.gci_fine * std::abs(a.finest_pa_m);
+    // The same three levels with each one's iteration error taken out, when all three have one.
+    std::vector<analysis::GridLevel> settled;
+    for (int k = 0; k < 3; ++k)
+      if (const auto& e = study->levels[k].iteration; e && e->geometric)
+        settled.push_back({study->levels[k].cell_size_m, study->levels[k].pressure_gradient_pa_m * (1.0 + e->remaining)});
+    if (settled.size() == 3) a.without_iteration_error = analysis::grid_convergence(settled);
   }
   return a;
+}
+
+namespace {
+
+// "+0.24 %" for an estimate, or what was seen instead.
+std::string iteration_error_text(const analysis::IterationError& e) {
+  return e.geometric ? fmt::format("{:+.2g} %", 100.0 * e.remaining)
+                     : fmt::format("not estimated (dp/L moved {:+.2g} % over the last tenth of the iterations and did "
+                                   "not settle)",
+                                   100.0 * e.last_change);
+}
+
+}  // namespace
+
+std::vector<std::string> PressureDropAnswer::iteration_lines() const {
+  if (iteration_errors.empty()) return {};
+  std::vector<std::string> each;
+  bool unsettled = false;  // a level the band rests on whose dp/L had not settled
+  for (const auto& [level, e] : iteration_errors) {
+    each.push_back(fmt::format("level {} {}", level, iteration_error_text(e)));
+    unsettled = unsettled || (best_pa_m && level <= 3 && !e.geometric);
+  }
+  std::string line = fmt::format("  iteration error, what each solve's dp/L would still have moved had it run on (by "
+                                 "how its last changes shrank; Ferziger & Peric 2002, 5.7): {}",
+                                 fmt::join(each, ", "));
+  bool moves = false;  // the best estimate, by more than kIterationErrorShareOfBand of the band's half-width
+  if (without_iteration_error) {
+    const analysis::GridConvergence& w = *without_iteration_error;
+    if (w.verdict == analysis::GridConvergence::Verdict::monotone) {
+      const double moved = w.extrapolated / *best_pa_m - 1.0;
+      moves = std::abs(moved) > kIterationErrorShareOfBand * gci_fine;
+      line += fmt::format("; taken out of the three levels, the best estimate would be {:.4g} Pa/m ({:+.2g} %) at "
+                          "order {:.2f}",
+                          w.extrapolated, 100.0 * moved, w.order);
+    } else {
+      moves = true;
+      line += "; taken out of the three levels, they would not converge monotonically (" +
+              std::string(analysis::verdict_name(w.verdict)) + ")";
+    }
+  }
+  std::vector<std::string> out = {line};
+  if (unsettled || moves)
+    out.push_back(fmt::format("  that is not small against the band: {}; set case.residual_u and case.residual_p below "
+                              "the {:g} and {:g} solved to",
+                              unsettled ? "a level it rests on had not settled"
+                                        : fmt::format("it moves the best estimate by more than {:g} of the band's "
+                                                      "half-width ({:.2g} %)",
+                                                      kIterationErrorShareOfBand, 100.0 * gci_fine),
+                              residual_u, residual_p));
+  return out;
 }
 
 std::vector<std::string> PressureDropAnswer::lines() const {
@@ -175,6 +236,7 @@ std::vector<std::string> PressureDropAnswer::lines() const {
     out.push_back(fmt::format("  band: {:.4g} to {:.4g} Pa/m, the finest mesh's {:.4g} Pa/m ({} cells) +- its grid "
                               "convergence index {:.1f} % (Roache's, about 95 % confidence)",
                               *band_low_pa_m, *band_high_pa_m, finest_pa_m, finest_cells, 100.0 * gci_fine));
+    for (std::string& l : iteration_lines()) out.push_back(std::move(l));
     out.push_back(reference);
     out.push_back(fmt::format("  best estimate / reference: {:.3f}", *best_pa_m / reference_pa_m));
     if (reference_bound && !reference_bound->reached_by(*band_low_pa_m, *band_high_pa_m))
@@ -189,6 +251,7 @@ std::vector<std::string> PressureDropAnswer::lines() const {
     out.push_back("answer: " + where + ": no error band, so no best estimate");
     out.push_back(fmt::format("  finest mesh: {:.4g} Pa/m ({} cells), {}", finest_pa_m, finest_cells,
                               finest_converged ? "its discretisation error unknown" : "NOT converged"));
+    for (std::string& l : iteration_lines()) out.push_back(std::move(l));
     out.push_back("  why: " + why_no_estimate);
     out.push_back("  to get one: " + advice);
     out.push_back(reference);
@@ -214,6 +277,8 @@ std::vector<std::string> PressureDropAnswer::lines() const {
 nlohmann::json PressureDropAnswer::to_json() const {
   nlohmann::json levels_json = nlohmann::json::array();
   for (const analysis::GridLevel& l : levels) levels_json.push_back({{"cell_size_m", l.cell_size}, {"pa_m", l.value}});
+  nlohmann::json iteration_json = nlohmann::json::array();
+  for (const auto& [level, e] : iteration_errors) iteration_json.push_back({{"level", level}, {"estimate", e.to_json()}});
   nlohmann::json j = {{"quantity", "dp/L over the bed section (Pa/m)"},
                       {"section_z_m", {section_low_m, section_high_m}},
                       {"reynolds", reynolds},
@@ -221,6 +286,7 @@ nlohmann::json PressureDropAnswer::to_json() const {
                       {"finest_cells", finest_cells},
                       {"finest_converged", finest_converged},
                       {"levels", levels_json},
+                      {"iteration_errors", iteration_json},
                       {"reference",
                        {{"name", reference_name},
                         {"pa_m", reference_pa_m},

@@ -21,6 +21,8 @@ namespace bedforge::pipeline {
 //   reference:     Eisfeld & Schnitzlein (2001) at the section's void fraction of the spheres as
 //                  packed, +- its stated accuracy (docs/reference.md), or a known answer (an
 //                  empty tube's, a simple cubic array's), exact, or a treated array's bound.
+//   iteration error: what each level's dp/L would still have moved had its solve run on
+//                  (analysis::iteration_error), said beside the band it is not part of.
 struct PressureDropAnswer {
   double section_low_m = 0.0, section_high_m = 0.0;  // the section's planes
   bool periodic = false;                              // the section is one period of a periodic bed
@@ -48,9 +50,18 @@ struct PressureDropAnswer {
   std::string why_no_estimate;
   // The levels given a value whose polyhedra fail checkMesh's limits: (level, cells failing).
   std::vector<std::pair<int, long>> failing_check_mesh;
+  // Each level that gave a value and has an estimate (reports before 2026-12-07 have none): the
+  // level and its iteration error; and the residual targets its solves stopped at.
+  std::vector<std::pair<int, analysis::IterationError>> iteration_errors;
+  // With a best estimate and an estimate on each of its three levels: the study of their values
+  // with those iteration errors taken out.
+  std::optional<analysis::GridConvergence> without_iteration_error;
+  double residual_u = 0.0, residual_p = 0.0;
   std::string advice;
   // The lines printed at the end of a run and kept in summary.txt.
   std::vector<std::string> lines() const;
+  // The iteration errors' line, and advice when they are not small against the band.
+  std::vector<std::string> iteration_lines() const;
   nlohmann::json to_json() const;
 };
 
@@ -60,6 +71,13 @@ struct PressureDropAnswer {
 // velocity u / eps, pore size (2/3) eps / (1 - eps) d: 1.1 Re_p). Past it simpleFoam's steady
 // solution is not the flow the bed has, and the answer says so.
 inline constexpr double kUnsteadyFlowReynolds = 150.0;
+
+// The levels' iteration errors are called out, with the residual targets to lower, when taking
+// them out of the three levels the band rests on moves the best estimate by more than this share
+// of the band's half-width (the GCI), or when one of those levels has no estimate because its
+// dp/L had not settled. bedforge's choice, not a published rule: a tenth keeps what the
+// iterations leave below a tenth of what the meshes do.
+inline constexpr double kIterationErrorShareOfBand = 0.1;
 
 // What a finer study would cost, from this study's levels: a study whose every mesh length is
 // 1 / ratio of this one's (level_lengths(scene, 1 / ratio)).

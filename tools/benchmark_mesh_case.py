@@ -148,7 +148,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from bedforge_files import (BEDFORGE, DOCS, GAPS_COARSENED_FROM, commit_and_date, gaps_not_coarsened, made_line,  # noqa: E402
-                            periodic_residuals_note)
+                            iteration_errors, periodic_residuals_note)
 
 RESULTS = os.path.join(DOCS, "mesh_case_benchmark.json")
 # cost_20k's particles split by the gap at their faces (case.drag_by_gap_d, d): the bridges' rims
@@ -867,13 +867,14 @@ def random_array_lines(v):
              "fraction as packed, at each seed. vdH: van der Hoef, Beetstra & Kuipers (2005) at the solid fraction as "
              "solved (the shrunk spheres'); band: the finest dp/L +- its GCI." + periodic_residuals_note(v), "",
              "| count | seed | solid packed | solid solved | cells (finest) | dp/L finest (Pa/m) | extrapolated | GCI fine "
-             "| order | vdH (Pa/m) | finest / vdH | extrapolated / vdH | band holds vdH | wall (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| order | iteration error (levels) | vdH (Pa/m) | finest / vdH | extrapolated / vdH | band holds vdH "
+             "| wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     by_count = {}
     for r in v["runs"]:
         if "failed" in r:
             lines.append(f"| {r['count']} | {r['seed']} | {r['solid_packed']:.4f} | failed: {r['failed']} "
-                         "| | | | | | | | | | |")
+                         "| | | | | | | | | | | |")
             continue
         g = r["study"].get("grid_convergence", {})
         ext = g.get("extrapolated")
@@ -881,7 +882,7 @@ def random_array_lines(v):
         lines.append(f"| {r['count']} | {r['seed']} | {r['solid_packed']:.4f} | {r['solid_solved']:.4f} | {r['cells']} | "
                      f"{r['dp_pa_m']:.4g} | " + (f"{ext:.4g} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f}"
                                                   if ext is not None else f"none ({r['study']['conclusion']}) | | ")
-                     + f" | {r['vdh_pa_m']:.4g} | {r['dp_pa_m'] / r['vdh_pa_m']:.3f} | "
+                     + f" | {iteration_errors(r['study'])} | {r['vdh_pa_m']:.4g} | {r['dp_pa_m'] / r['vdh_pa_m']:.3f} | "
                      + (f"{ext / r['vdh_pa_m']:.3f} | {'yes' if holds else 'NO'}" if ext is not None else " | ")
                      + f" | {r['wall_s']:.0f} |")
         if ext is not None:
@@ -916,13 +917,13 @@ def slice_lines(v):
              "the slice's over one period; E&S at that section's meshed void fraction."
              + periodic_residuals_note(v), "",
              "| bed | seed | central eps (packed) | section eps (meshed) | cells (finest) | dp/L finest (Pa/m) | "
-             "/ E&S | extrapolated (Pa/m) | GCI fine | order | opened | wall (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "/ E&S | extrapolated (Pa/m) | GCI fine | order | iteration error (levels) | opened | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for kind in ("full", "slice"):
         for seed, r in v[kind].items():
             if "study" not in r:
                 what = "jammed" if "jammed" in r else "failed"
-                lines.append(f"| {kind} | {seed} | {what}: {r[what]} | | | | | | | | | |")
+                lines.append(f"| {kind} | {seed} | {what}: {r[what]} | | | | | | | | | | |")
                 continue
             g = r["study"].get("grid_convergence", {})
             ext = g.get("extrapolated")
@@ -930,7 +931,7 @@ def slice_lines(v):
                          f"{r['dp_pa_m']:.4g} | {r['dp_pa_m'] / r['es_pa_m']:.3f} | "
                          + (f"{ext:.4g} | {100 * g['gci_fine']:.1f} % | {g['apparent_order']:.2f}" if ext is not None
                             else f"none ({r['study']['conclusion']}) | | ")
-                         + f" | {r.get('contacts_opened', 0) if kind == 'slice' else ''} | {r['wall_s']:.0f} |")
+                         + f" | {iteration_errors(r['study'])} | {r.get('contacts_opened', 0) if kind == 'slice' else ''} | {r['wall_s']:.0f} |")
     solved = {k: [r for r in v[k].values() if "study" in r] for k in ("full", "slice")}
     if not solved["full"] or not solved["slice"]:
         return lines + ["", "Too few beds solved for a comparison.", ""]

@@ -1,0 +1,37 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <cstddef>
+#include <vector>
+
+namespace bedforge::analysis {
+
+// The iteration error still in the last value of a quantity followed over a steady solver's
+// iterations, from how its last changes shrink (Ferziger & Peric, Computational Methods for Fluid
+// Dynamics, 3rd ed. 2002, sec. 5.7): late in the iterations the error decays by the iteration
+// matrix's largest eigenvalue lambda < 1 per iteration, so the change over a block of m
+// iterations shrinks by q = lambda^m from one block to the next, and the change still to come
+// after the last value sums to the last block's times q / (1 - q).
+struct IterationError {
+  // The last two blocks' changes shrank geometrically: of one sign and the later smaller
+  // (0 < q < 1), or both within kIterationResolution of the value. Only then is `remaining` an
+  // estimate.
+  bool geometric = false;
+  double ratio = 0.0;        // q: the last block's change over the block's before it (0 if that was none)
+  double last_change = 0.0;  // the last block's change, relative to the last value
+  double remaining = 0.0;    // (settled - last) / last, estimated (0 unless geometric)
+  std::size_t block = 0;     // m, the iterations in a block
+  nlohmann::json to_json() const;
+  static IterationError from_json(const nlohmann::json& j);
+};
+
+// Changes of a value within this fraction of it are taken as settled: the digits the solver
+// writes its monitors with (10) resolve it, but SIMPLE's round-off between iterations moves a
+// settled value by this order.
+inline constexpr double kIterationResolution = 1e-9;
+
+// `values`: the quantity at each iteration, the last one last; a block is a tenth of the
+// iterations (at least one, at most half). std::invalid_argument with fewer than three
+// values, or with a last value that is zero or not finite.
+IterationError iteration_error(const std::vector<double>& values);
+
+}  // namespace bedforge::analysis

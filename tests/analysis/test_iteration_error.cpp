@@ -1,0 +1,88 @@
+// The iteration error left in a monitored value (Ferziger & Peric 2002, sec. 5.7) on sequences
+// whose limit is known: an exact geometric decay must give its limit back, a sum of two decays
+// nearly so once the slower one dominates, and sequences that do not shrink geometrically must
+// not be given an estimate.
+#include "analysis/iteration_error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+using namespace bedforge::analysis;
+
+namespace {
+
+// limit + sum of amplitude * rate^k for k = 0 .. n - 1.
+std::vector<double> decay(double limit, std::vector<std::pair<double, double>> modes, int n) {
+  std::vector<double> v;
+  for (int k = 0; k < n; ++k) {
+    double x = limit;
+    for (const auto& [amplitude, rate] : modes) x += amplitude * std::pow(rate, k);
+    v.push_back(x);
+  }
+  return v;
+}
+
+double remaining_exact(const std::vector<double>& v, double limit) { return (limit - v.back()) / v.back(); }
+
+}  // namespace
+
+TEST(IterationError, AGeometricDecayGivesItsLimitBack) {
+  for (double rate : {0.5, 0.9, 0.98})
+    for (double amplitude : {3.0, -3.0})
+      for (int n : {21, 147, 340}) {
+        const std::vector<double> v = decay(10.0, {{amplitude, rate}}, n);
+        const IterationError e = iteration_error(v);
+        ASSERT_TRUE(e.geometric) << rate << " " << amplitude << " " << n;
+        EXPECT_EQ(e.block, static_cast<std::size_t>(std::max(1, (n - 1) / 10)));
+        // The fast, long decays settle to round-off before their end, where no ratio is taken.
+        if (std::abs(e.last_change) > kIterationResolution) {
+          EXPECT_NEAR(e.ratio, std::pow(rate, e.block), 1e-9);
+        }
+        // Exact but for round-off, which limits the slowest, longest decay.
+        EXPECT_NEAR(e.remaining, remaining_exact(v, 10.0), 1e-12 + 1e-6 * std::abs(remaining_exact(v, 10.0)))
+            << rate << " " << amplitude << " " << n;
+        EXPECT_NEAR(e.last_change, (v.back() - v[v.size() - 1 - e.block]) / v.back(), 1e-15);
+      }
+}
+
+// Two modes, the faster gone by the last blocks: the estimate is the slower mode's, within the
+// faster one's share of the last changes.
+TEST(IterationError, TheSlowestModeDominatesLateIterations) {
+  const std::vector<double> v = decay(10.0, {{3.0, 0.95}, {-20.0, 0.7}}, 200);
+  const IterationError e = iteration_error(v);
+  ASSERT_TRUE(e.geometric);
+  EXPECT_NEAR(e.remaining / remaining_exact(v, 10.0), 1.0, 1e-6);
+}
+
+TEST(IterationError, ASettledValueLeavesNothing) {
+  const IterationError e = iteration_error(std::vector<double>(50, 7.5));
+  EXPECT_TRUE(e.geometric);
+  EXPECT_EQ(e.remaining, 0.0);
+  EXPECT_EQ(e.last_change, 0.0);
+}
+
+// Changes that do not shrink from block to block, or swing in sign, say nothing of where the
+// value will settle.
+TEST(IterationError, NoEstimateUnlessTheChangesShrink) {
+  std::vector<double> drifting, growing, swinging;
+  for (int k = 0; k < 100; ++k) {
+    drifting.push_back(10.0 + 0.01 * k);
+    growing.push_back(10.0 + 0.001 * std::pow(1.05, k));
+    swinging.push_back(10.0 + std::pow(-0.9, k));  // a block of 9 iterations: its changes alternate in sign
+  }
+  for (const auto* v : {&drifting, &growing, &swinging}) {
+    const IterationError e = iteration_error(*v);
+    EXPECT_FALSE(e.geometric) << e.to_json().dump();
+    EXPECT_EQ(e.remaining, 0.0);
+    EXPECT_TRUE(e.to_json()["remaining"].is_null());
+  }
+}
+
+TEST(IterationError, RefusesTooFewValuesAndAZeroLastValue) {
+  EXPECT_THROW(iteration_error({1.0, 2.0}), std::invalid_argument);
+  EXPECT_THROW(iteration_error({1.0, 2.0, 0.0}), std::invalid_argument);
+  EXPECT_THROW(iteration_error({1.0, 2.0, std::nan("")}), std::invalid_argument);
+}
