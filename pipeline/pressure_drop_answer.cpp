@@ -141,10 +141,11 @@ std::optional<PressureDropAnswer> pressure_drop_answer(const Scene& scene, const
     a.order = g.order;
     a.band_low_pa_m = a.finest_pa_m - g.gci_fine * std::abs(a.finest_pa_m);
     a.band_high_pa_m = a.finest_pa_m + g.gci_fine * std::abs(a.finest_pa_m);
-    // The same three levels with each one's iteration error taken out, when all three have one.
+    // The same three levels with each one's iteration error taken out, when all three were looked
+    // at; a level whose changes did not shrink counts as solved (iteration_lines says how far it moved).
     std::vector<analysis::GridLevel> settled;
     for (int k = 0; k < 3; ++k)
-      if (const auto& e = study->levels[k].iteration; e && e->geometric)
+      if (const auto& e = study->levels[k].iteration)
         settled.push_back({study->levels[k].cell_size_m, study->levels[k].pressure_gradient_pa_m * (1.0 + e->remaining)});
     if (settled.size() == 3) a.without_iteration_error = analysis::grid_convergence(settled);
   }
@@ -156,8 +157,8 @@ namespace {
 // "+0.24 %" for an estimate, or what was seen instead.
 std::string iteration_error_text(const analysis::IterationError& e) {
   return e.geometric ? fmt::format("{:+.2g} %", 100.0 * e.remaining)
-                     : fmt::format("not estimated (dp/L moved {:+.2g} % over the last tenth of the iterations and did "
-                                   "not settle)",
+                     : fmt::format("not estimated (its changes did not shrink; dp/L moved {:+.2g} % over the last "
+                                   "tenth of the iterations)",
                                    100.0 * e.last_change);
 }
 
@@ -166,10 +167,13 @@ std::string iteration_error_text(const analysis::IterationError& e) {
 std::vector<std::string> PressureDropAnswer::iteration_lines() const {
   if (iteration_errors.empty()) return {};
   std::vector<std::string> each;
-  bool unsettled = false;  // a level the band rests on whose dp/L had not settled
+  // A level the band rests on whose dp/L had not settled: its changes did not shrink, and it moved
+  // by more than the share of the band's half-width over its last tenth alone.
+  bool unsettled = false;
   for (const auto& [level, e] : iteration_errors) {
     each.push_back(fmt::format("level {} {}", level, iteration_error_text(e)));
-    unsettled = unsettled || (best_pa_m && level <= 3 && !e.geometric);
+    unsettled = unsettled || (best_pa_m && level <= 3 && !e.geometric &&
+                              std::abs(e.last_change) > kIterationErrorShareOfBand * gci_fine);
   }
   std::string line = fmt::format("  iteration error, what each solve's dp/L would still have moved had it run on (by "
                                  "how its last changes shrank; Ferziger & Peric 2002, 5.7): {}",
@@ -180,24 +184,22 @@ std::vector<std::string> PressureDropAnswer::iteration_lines() const {
     if (w.verdict == analysis::GridConvergence::Verdict::monotone) {
       const double moved = w.extrapolated / *best_pa_m - 1.0;
       moves = std::abs(moved) > kIterationErrorShareOfBand * gci_fine;
-      line += fmt::format("; taken out of the three levels, the best estimate would be {:.4g} Pa/m ({:+.2g} %) at "
+      line += fmt::format("; taken out where estimated, the best estimate would be {:.4g} Pa/m ({:+.2g} %) at "
                           "order {:.2f}",
                           w.extrapolated, 100.0 * moved, w.order);
     } else {
       moves = true;
-      line += "; taken out of the three levels, they would not converge monotonically (" +
+      line += "; taken out where estimated, the three levels would not converge monotonically (" +
               std::string(analysis::verdict_name(w.verdict)) + ")";
     }
   }
   std::vector<std::string> out = {line};
   if (unsettled || moves)
-    out.push_back(fmt::format("  that is not small against the band: {}; set case.residual_u and case.residual_p below "
-                              "the {:g} and {:g} solved to",
-                              unsettled ? "a level it rests on had not settled"
-                                        : fmt::format("it moves the best estimate by more than {:g} of the band's "
-                                                      "half-width ({:.2g} %)",
-                                                      kIterationErrorShareOfBand, 100.0 * gci_fine),
-                              residual_u, residual_p));
+    out.push_back(fmt::format("  that is not small against the band: {} by more than {:g} of the band's half-width "
+                              "({:.2g} %); set case.residual_u and case.residual_p below the {:g} and {:g} solved to",
+                              unsettled ? "a level it rests on did not settle, and moved over its last tenth of iterations"
+                                        : "it moves the best estimate",
+                              kIterationErrorShareOfBand, 100.0 * gci_fine, residual_u, residual_p));
   return out;
 }
 
@@ -306,6 +308,7 @@ nlohmann::json PressureDropAnswer::to_json() const {
     j["gci_fine"] = gci_fine;
     j["apparent_order"] = order;
     j["ratio_to_reference"] = *best_pa_m / reference_pa_m;
+    if (without_iteration_error) j["without_iteration_error"] = without_iteration_error->to_json();
   } else {
     j["why_no_estimate"] = why_no_estimate;
     j["advice"] = advice;

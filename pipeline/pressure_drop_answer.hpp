@@ -53,8 +53,8 @@ struct PressureDropAnswer {
   // Each level that gave a value and has an estimate (reports before 2026-12-07 have none): the
   // level and its iteration error; and the residual targets its solves stopped at.
   std::vector<std::pair<int, analysis::IterationError>> iteration_errors;
-  // With a best estimate and an estimate on each of its three levels: the study of their values
-  // with those iteration errors taken out.
+  // With a best estimate whose three levels were each looked at: the study of their values with
+  // the iteration errors estimated taken out (a level whose changes did not shrink as solved).
   std::optional<analysis::GridConvergence> without_iteration_error;
   double residual_u = 0.0, residual_p = 0.0;
   std::string advice;
@@ -74,9 +74,10 @@ inline constexpr double kUnsteadyFlowReynolds = 150.0;
 
 // The levels' iteration errors are called out, with the residual targets to lower, when taking
 // them out of the three levels the band rests on moves the best estimate by more than this share
-// of the band's half-width (the GCI), or when one of those levels has no estimate because its
-// dp/L had not settled. bedforge's choice, not a published rule: a tenth keeps what the
-// iterations leave below a tenth of what the meshes do.
+// of the band's half-width (the GCI), or when one of those levels' dp/L did not settle (its
+// changes did not shrink) and moved by more than that share over its last tenth of iterations.
+// bedforge's choice, not a published rule: a tenth keeps what the iterations leave below a tenth
+// of what the meshes do.
 inline constexpr double kIterationErrorShareOfBand = 0.1;
 
 // What a finer study would cost, from this study's levels: a study whose every mesh length is
