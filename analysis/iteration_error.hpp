@@ -24,9 +24,8 @@ struct IterationError {
   static IterationError from_json(const nlohmann::json& j);
 };
 
-// Changes of a value within this fraction of it are taken as settled: the digits the solver
-// writes its monitors with (10) resolve it, but SIMPLE's round-off between iterations moves a
-// settled value by this order.
+// Changes of a value within this fraction of it are taken as settled: the cases write their
+// monitors with 10 significant digits, so such a change is a few units of the last one.
 inline constexpr double kIterationResolution = 1e-9;
 
 // `values`: the quantity at each iteration, the last one last; a block is a tenth of the
