@@ -41,7 +41,8 @@ nlohmann::json FlowResult::to_json() const {
           {"converged", converged},
           {"final_initial_residual", {{"U", residual_u}, {"p", residual_p}}},
           {"pressure_gradient_bed_pa_m", pressure_gradient_bed_pa_m},
-          {"pressure_gradient_change_last_tenth", pressure_gradient_change_last_tenth},
+          {"pressure_gradient_change_last_tenth",
+           pressure_gradient_iteration ? std::abs(pressure_gradient_iteration->last_change) : 0.0},
           {"pressure_gradient_iteration_error",
            pressure_gradient_iteration ? pressure_gradient_iteration->to_json() : nlohmann::json()},
           {"pressure_drop_inlet_outlet_pa", pressure_drop_inlet_outlet_pa},
@@ -431,7 +432,6 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.residual_p = res_p;
   r.pressure_gradient_bed_pa_m = gradient;
   r.pressure_gradient_iteration = iteration;
-  if (iteration) r.pressure_gradient_change_last_tenth = std::abs(iteration->last_change);
   r.pressure_drop_inlet_outlet_pa = overall;
   r.flow_rate_m3_s = flow;
   r.flow_rate_relative_error = flow / (u * c.inlet_area_m2) - 1.0;

@@ -36,9 +36,9 @@ struct FlowResult {
   // Over the bed section; in a periodic section the driving gradient, scaled to the flow rate set
   // (case_runner.cpp says why).
   double pressure_gradient_bed_pa_m = 0.0;
-  double pressure_gradient_change_last_tenth = 0.0;  // relative change over the last tenth of the iterations
   // What the gradient would still have moved had the solve run on, from how its last changes
-  // shrank (unset with fewer than 3 iterations).
+  // shrank (unset with fewer than 3 iterations); its last change, over the last tenth of the
+  // iterations, is the report's pressure_gradient_change_last_tenth.
   std::optional<analysis::IterationError> pressure_gradient_iteration;
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;
