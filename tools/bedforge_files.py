@@ -78,19 +78,22 @@ def periodic_residuals_note(result):
             "(docs/defaults.md); not regenerated since.")
 
 
+def level_iteration_error(level):
+    """One study level's iteration error (analysis/iteration_error.hpp) in per cent, "-0.25"; a level
+    whose changes did not shrink as "(moved x)", its change over the last tenth of its iterations;
+    "not recorded" for a level solved before they were."""
+    e = level.get("iteration_error")
+    return ("not recorded" if not e else f"{100 * e['remaining']:+.2g}" if e["geometric"]
+            else f"(moved {100 * e['last_change']:+.2g})")
+
+
 def iteration_errors(study):
-    """A study's levels' iteration errors (analysis/iteration_error.hpp), finest first, as "-0.25/-0.13/-0.065 %"
-    (a level whose changes did not shrink: "(moved x)", its change over the last tenth of its iterations);
-    "not recorded" for a study made before they were."""
+    """A study's levels' iteration errors, finest first, as "-0.25/-0.13/-0.065 %"; "not recorded"
+    for a study made before they were."""
     levels = [level for level in study["levels"] if "failure" not in level]
     if not any(level.get("iteration_error") for level in levels):
         return "not recorded"
-
-    def one(level):
-        e = level.get("iteration_error")
-        return ("?" if not e else f"{100 * e['remaining']:+.2g}" if e["geometric"]
-                else f"(moved {100 * e['last_change']:+.2g})")
-    return "/".join(one(level) for level in levels) + " %"
+    return "/".join(level_iteration_error(level) for level in levels) + " %"
 
 
 def read_bed(path):
