@@ -48,4 +48,8 @@ IterationError iteration_error(const std::vector<double>& values) {
   return e;
 }
 
+bool settled_within(const IterationError& e, double tolerance) {
+  return std::abs(e.geometric ? e.remaining : e.last_change) <= tolerance;
+}
+
 }  // namespace bedforge::analysis

@@ -33,4 +33,9 @@ inline constexpr double kIterationResolution = 1e-9;
 // values, or with a last value that is zero or not finite.
 IterationError iteration_error(const std::vector<double>& values);
 
+// Whether the quantity is settled to `tolerance` (a fraction of its value): its estimated
+// remaining change is within it, or, without an estimate (its changes did not shrink), its last
+// block's change is.
+bool settled_within(const IterationError& e, double tolerance);
+
 }  // namespace bedforge::analysis

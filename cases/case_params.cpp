@@ -21,6 +21,7 @@ CaseParams read_case_params(SceneSection& s) {
   p.residual_u = s.optional_number("residual_u", Range::open(0.0, 1.0),
                                   fmt::format("{}; {} on a periodic section; {} on cells with prism layers", kResidualU,
                                               kResidualPeriodic, kResidualULayered));
+  p.iteration_tolerance = s.number("iteration_tolerance", p.iteration_tolerance, Range{0.0, 0.1, true, false});
   p.processors = static_cast<int>(s.integer("processors", p.processors, 1, 4096));
   p.decomposition = s.choice("decomposition", p.decomposition, {"hierarchical", "scotch"});
   p.binary = s.choice("format", "binary", {"binary", "ascii"}) == "binary";
@@ -65,6 +66,7 @@ nlohmann::json to_json(const CaseParams& p) {
           {"viscosity_pa_s", p.viscosity_pa_s}, {"iterations", p.iterations},
           {"residual_p", p.residual_p ? nlohmann::json(*p.residual_p) : nlohmann::json()},
           {"residual_u", p.residual_u ? nlohmann::json(*p.residual_u) : nlohmann::json()},
+          {"iteration_tolerance", p.iteration_tolerance},
           {"processors", p.processors},     {"decomposition", p.decomposition},
           {"format", p.binary ? "binary" : "ascii"}, {"cells", p.polyhedra ? "polyhedra" : "tetrahedra"},
           {"snappy", p.snappy},             {"snappy_cell_d", p.snappy_cell_d},

@@ -39,6 +39,7 @@ nlohmann::json FlowResult::to_json() const {
           {"iterations", iterations},
           {"history", history},
           {"converged", converged},
+          {"stopped_by", stopped_by},
           {"final_initial_residual", {{"U", residual_u}, {"p", residual_p}}},
           {"pressure_gradient_bed_pa_m", pressure_gradient_bed_pa_m},
           {"pressure_gradient_change_last_tenth",
@@ -151,15 +152,20 @@ std::vector<Iteration> read_iterations(std::istream& log, bool* converged = null
 
 // Controls a running solve through its controlDict (OpenFOAM reads it again when it changes, the
 // case being written with runTimeModifiable): stopAt writeNow ends the run after the current
-// iteration with its fields written. Written beside and renamed, so that the solver never
-// reads half a file.
-void stop_at_write_now(const fs::path& case_dir) {
+// iteration with its fields written; endTime is the case's own. Written beside and renamed, so
+// that the solver never reads half a file. OpenFOAM takes a file as changed only when its time
+// stamp is past the one it read by more than fileModificationSkew (10 s in Debian's
+// etc/controlDict): a small case stopped within 10 s of being written ran on to its end, so the
+// new file is stamped at least twice that after the old one.
+void set_stop_at(const fs::path& case_dir, const std::string& when) {
   const fs::path dict = case_dir / "system" / "controlDict", written = case_dir / "system" / "controlDict.stopping";
+  const fs::file_time_type was = fs::last_write_time(dict);
   std::ifstream in(dict);
   std::ofstream out(written);
   for (std::string line; std::getline(in, line);)
-    out << (line.rfind("stopAt", 0) == 0 ? "stopAt          writeNow;" : line) << '\n';
+    out << (line.rfind("stopAt", 0) == 0 ? fmt::format("stopAt          {};", when) : line) << '\n';
   out.close();
+  fs::last_write_time(written, std::max(fs::last_write_time(written), was + std::chrono::seconds(20)));
   fs::rename(written, dict);
 }
 
@@ -177,6 +183,62 @@ Iteration last_iteration(const fs::path& log_path) {
   for (auto it = its.rbegin(); it != its.rend(); ++it)
     if (it->time_s > 0.0) return *it;  // ExecutionTime closes an iteration
   return {};
+}
+
+// The bed's pressure gradient (Pa/m) at each iteration of `its`: between the section planes, or
+// in a periodic section the one that drove the flow, at the superficial velocity set.
+// meanVelocityForce holds the cells' volume-mean velocity, whose flow rate differs from the one
+// set by a discretisation error (-8 % at 250 polyhedra per sphere, -2.6 % at 2.6 k, falling with
+// the cells); the gradient is scaled by the flow rate set over the one solved, as Darcy's law has
+// it (at Re_p = 1 inertia is a few % of the drag, so the scaling errs by a few % of that error).
+// `running`: the monitors are still being written, so their last row, perhaps cut, is left out.
+std::vector<double> bed_gradients(const CaseInfo& c, const std::vector<Iteration>& its, bool running) {
+  const double rho = c.params.density_kg_m3;
+  std::vector<double> g;
+  if (c.mean_velocity_m_s) {
+    const std::vector<double> flows = series(c.directory, "flowRate");
+    const std::size_t n = std::max<std::size_t>(std::min(its.size(), flows.size()), 1) - (running ? 1 : 0);
+    for (std::size_t k = 0; k < n; ++k)
+      g.push_back(rho * its[k].driving_gradient * c.velocity_m_s * c.inlet_area_m2 / flows[k]);
+    return g;
+  }
+  const std::vector<double> bottom = series(c.directory, "pBedBottom"), top = series(c.directory, "pBedTop");
+  const std::size_t n = std::min(bottom.size(), top.size()) - (running ? 1 : 0);  // series() gives at least one
+  for (std::size_t k = 0; k < n; ++k) g.push_back(rho * (bottom[k] - top[k]) / (c.section.z_high - c.section.z_low));
+  return g;
+}
+
+// A solve watched past its residual targets: the first iteration of its log with both residuals
+// at them (0 while there is none), and why to stop it now ("settled" or "run_on_limit",
+// FlowResult::stopped_by), or nothing while dp/L is still settling. Reads the whole log (every
+// iteration, since the residuals may dip below their targets between two looks) and the
+// monitors, as they are being written; `step` is the last finished iteration.
+struct Settling {
+  long reached = 0;
+  std::optional<std::string> stop;
+};
+Settling settle_check(const CaseInfo& c, long step) {
+  std::ifstream log(c.directory / "log.simpleFoam");
+  const std::vector<Iteration> its = read_iterations(log);
+  Settling s;
+  for (const Iteration& it : its)
+    if (it.p_seen && it.res_u > 0.0 && it.res_u <= *c.params.residual_u && it.res_p <= *c.params.residual_p) {
+      s.reached = it.step;
+      break;
+    }
+  if (s.reached == 0) return s;
+  std::vector<double> g;
+  try {
+    g = bed_gradients(c, its, true);
+  } catch (const std::runtime_error&) {
+    return s;  // a monitor not written yet
+  }
+  if (g.size() >= 3 && std::isfinite(g.back()) && g.back() != 0.0 &&
+      analysis::settled_within(analysis::iteration_error(g), c.params.iteration_tolerance))
+    s.stop = "settled";
+  else if (step >= 2 * s.reached)
+    s.stop = "run_on_limit";
+  return s;
 }
 
 // Allrun's steps as GNU time logged them in log.time ("name seconds kB" per step; a failed
@@ -332,21 +394,31 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   double start_p = 0.0, start_u = 0.0;
   DivergenceWatch watch(target_u, target_p);
   std::optional<Divergence> diverging;
+  long reached = 0;                     // the first iteration with both residuals at their targets
+  std::optional<std::string> stopped;   // why bedforge stopped the solve past them
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");
     if (now.step == 0 || now.res_p <= 0.0 || now.res_u <= 0.0) {
       progress.update(snappy ? "snappyHexMesh, then simpleFoam" : "preparing simpleFoam");
       continue;
     }
-    if (!diverging && (diverging = watch.follow(case_dir / "log.simpleFoam"))) stop_at_write_now(case_dir);
+    if (!diverging && (diverging = watch.follow(case_dir / "log.simpleFoam"))) set_stop_at(case_dir, "writeNow");
+    if (!diverging && !stopped) {
+      const Settling settling = settle_check(c, now.step);
+      reached = settling.reached;
+      if ((stopped = settling.stop)) set_stop_at(case_dir, "writeNow");
+    }
     if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
     const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),
                                  std::log(start_u / now.res_u) / std::log(start_u / target_u));
-    progress.update(fmt::format("simpleFoam iteration {}, residuals U {:.1e} p {:.1e} (targets {:.0e}, {:.0e})",
-                                now.step, now.res_u, now.res_p, target_u, target_p),
+    progress.update(reached ? fmt::format("simpleFoam iteration {}, residuals at their targets; dp/L settling to {:g} %",
+                                          now.step, 100.0 * c.params.iteration_tolerance)
+                            : fmt::format("simpleFoam iteration {}, residuals U {:.1e} p {:.1e} (targets {:.0e}, {:.0e})",
+                                          now.step, now.res_u, now.res_p, target_u, target_p),
                     std::clamp(done, 0.0, 1.0));
   }
   progress.finish();
+  if (stopped) set_stop_at(case_dir, "endTime");  // the case as written, for a run by hand
   if (diverging) {
     const Divergence& d = *diverging;
     const Iteration last = last_iteration(case_dir / "log.simpleFoam");
@@ -373,39 +445,26 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   if (its.empty()) throw std::runtime_error(fmt::format("{}/log.simpleFoam holds no iteration", case_dir.string()));
   const long iterations = static_cast<long>(its.size());
   const double res_u = its.back().res_u, res_p = its.back().res_p;
+  converged = converged || stopped.has_value();  // bedforge stopped it past the targets
   // Walls the flow slips along are mirror planes: the correlation's bed is then unbounded.
   const double a = c.params.slip_walls ? std::numeric_limits<double>::infinity() : c.aspect_ratio;
   const double rho = c.params.density_kg_m3, u = c.velocity_m_s, d = c.d_ref_m;
   const double zl = c.section.z_low, zh = c.section.z_high, re = c.params.reynolds;
-  // The bed's pressure gradient per iteration: between the section planes, or in a periodic
-  // section the one that drove the flow, at the superficial velocity set. meanVelocityForce holds
-  // the cells' volume-mean velocity, whose flow rate differs from the one set by a discretisation
-  // error (-8 % at 250 polyhedra per sphere, -2.6 % at 2.6 k, falling with the cells); the
-  // gradient is scaled by the flow rate set over the one solved, as Darcy's law has it (at
-  // Re_p = 1 inertia is a few % of the drag, so the scaling errs by a few % of that error).
+  // The bed's pressure gradient per iteration (bed_gradients).
   const bool periodic = c.mean_velocity_m_s.has_value();
-  const std::vector<double> bottom = periodic ? std::vector<double>{} : series(case_dir, "pBedBottom");
-  const std::vector<double> top = periodic ? std::vector<double>{} : series(case_dir, "pBedTop");
-  const std::vector<double> flows = series(case_dir, "flowRate");
-  const std::size_t n = periodic ? std::min(its.size(), flows.size()) : std::min(bottom.size(), top.size());
-  auto bed_gradient = [&](std::size_t k) {
-    return periodic ? rho * its[k].driving_gradient * u * c.inlet_area_m2 / flows[k]
-                    : rho * (bottom[k] - top[k]) / (zh - zl);
-  };
-  const double gradient = bed_gradient(n - 1);
+  const std::vector<double> gradients = bed_gradients(c, its, false);
+  const std::size_t n = gradients.size();
+  const double gradient = gradients.back();
   if (periodic && !(gradient > 0.0))
     throw std::runtime_error(fmt::format("{}/log.simpleFoam: meanVelocityForce drove the flow at a pressure gradient "
                                          "of {} Pa/m; please report it with the case",
                                          case_dir.string(), gradient));
-  // Convergence of the quantity itself: its change over the last tenth of the iterations, and
-  // what it would still move had the solve run on.
-  std::vector<double> gradients(n);
-  for (std::size_t k = 0; k < n; ++k) gradients[k] = bed_gradient(k);
+  // Convergence of the quantity itself: what it would still move had the solve run on.
   const std::optional<analysis::IterationError> iteration =
       n >= 3 && std::isfinite(gradient) && gradient != 0.0 ? std::optional(analysis::iteration_error(gradients)) : std::nullopt;
   const double overall = periodic ? gradient * (zh - zl)
                                   : rho * (series(case_dir, "pInlet").back() - series(case_dir, "pOutlet").back());
-  const double flow = flows.back();
+  const double flow = series(case_dir, "flowRate").back();
   FlowResult r;
   r.mesher = snappy ? "snappyHexMesh" : c.params.polyhedra ? "gmsh polyhedral dual" : "gmsh tetrahedra";
   r.solved_cells = snappy || c.params.polyhedra ? -1 : c.cells;
@@ -428,6 +487,9 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   r.iterations = iterations;
   r.history = thin_history(history);
   r.converged = converged;
+  r.stopped_by = stopped                         ? *stopped
+                 : converged                     ? "residual_control"
+                                                 : "iteration_cap";
   r.residual_u = res_u;
   r.residual_p = res_p;
   r.pressure_gradient_bed_pa_m = gradient;
@@ -453,7 +515,8 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
     r.drag.walls_ends_n = ends.total, r.drag.walls_ends_viscous_n = ends.viscous;
   }
   // The section's mean pressure (Pa), linear between its planes: p_low - gradient (z - z_low).
-  const double p_low = periodic ? 0.0 : rho * bottom[n - 1], mean_gradient = periodic ? 0.0 : gradient;
+  const double p_low = periodic ? 0.0 : rho * series(case_dir, "pBedBottom")[n - 1],
+               mean_gradient = periodic ? 0.0 : gradient;
   for (GapBand& b : r.drag.particles_by_gap) {
     if (b.faces == 0) continue;  // no forces object
     const ForceZ f = last_force_z(case_dir, b.force_object());

@@ -31,7 +31,12 @@ struct FlowResult {
   };
   std::vector<Step> steps;
   long iterations = 0;
-  bool converged = false;                // SIMPLE's own verdict at the residual targets
+  bool converged = false;                // the residual targets reached (SIMPLE's verdict, or bedforge's stop past them)
+  // What ended the solve: "settled" (the targets reached and dp/L settled to
+  // case.iteration_tolerance), "run_on_limit" (the targets reached, dp/L not settled within as many
+  // iterations again), "residual_control" (SIMPLE's own, at kResidualControlShare of the targets),
+  // "iteration_cap" (case.iterations).
+  std::string stopped_by;
   double residual_u = 0.0, residual_p = 0.0;  // the last iteration's initial residuals
   // Over the bed section; in a periodic section the driving gradient, scaled to the flow rate set
   // (case_runner.cpp says why).
@@ -130,7 +135,10 @@ std::optional<Divergence> find_divergence(std::istream& log, double target_u, do
 // while it runs, and watches it for a divergence (DivergenceWatch): the run is then stopped at
 // that iteration with its fields written (controlDict's stopAt set to writeNow, which OpenFOAM
 // reads while it runs) and ConvergenceError says where, rather than the solve running on to
-// case.iterations. ConvergenceError also when the solver stopped on a floating-point exception,
+// case.iterations. Once both residuals are at their targets it goes on watching dp/L and stops
+// the solve the same way when it has settled to case.iteration_tolerance (analysis::
+// settled_within), or when it has run as many iterations again as it took to reach them; the
+// controlDict then gets its stopAt endTime back. ConvergenceError also when the solver stopped on a floating-point exception,
 // and when snappyHexMesh's cells lost the inlet or the outlet (the
 // fluid they kept does not reach it), naming the settings that make finer cells;
 // std::runtime_error naming the log and Allrun's last words when another step fails.

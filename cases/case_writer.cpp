@@ -472,12 +472,14 @@ void write_solver_settings(const fs::path& tmp, const CaseParams& p, bool period
                               // of an iteration's time on tetrahedra; the solution does not change).
                               "cache\n{{\n    grad(U);\n    grad(p);\n}}\n\n"
                               "SIMPLE\n{{\n    nNonOrthogonalCorrectors 1;\n    consistent      yes;\n{}"
-                              "    residualControl\n    {{\n        p               {};\n        U               {};\n    }}\n}}\n\n"
+                              "    // A hundredth of case.residual_p and residual_u: bedforge stops the solve before,\n"
+                              "    // once those are reached and dp/L has settled (case.iteration_tolerance).\n"
+                              "    residualControl\n    {{\n        p               {:g};\n        U               {:g};\n    }}\n}}\n\n"
                               "relaxationFactors\n{{\n    equations\n    {{\n        U               0.9;\n    }}\n"
                               "    fields\n    {{\n        p               1;\n    }}\n}}\n",
                               // With cyclic inlet and outlet no boundary fixes the pressure's level.
-                              periodic ? "    pRefCell        0;\n    pRefValue       0;\n" : "", *p.residual_p,
-                              *p.residual_u)));
+                              periodic ? "    pRefCell        0;\n    pRefValue       0;\n" : "",
+                              *p.residual_p * kResidualControlShare, *p.residual_u * kResidualControlShare)));
   write_text(tmp / "system/decomposeParDict",
              dict("dictionary", "system", "decomposeParDict", note,
                   fmt::format("numberOfSubdomains {};\n\nmethod          {};\n\n"

@@ -37,6 +37,7 @@ nlohmann::json ConvergenceStudy::to_json() const {
                 {"pressure_gradient_bed_pa_m", l.pressure_gradient_pa_m},
                 {"converged", l.converged},
                 {"iteration_error", l.iteration ? l.iteration->to_json() : nlohmann::json()},
+                {"stopped_by", l.stopped_by},
                 {"cells_failing_check_mesh", l.cells_failing_check_mesh},
                 {"own_time_s", l.own_time_s},
                 {"drag", l.drag.to_json()}});
@@ -81,6 +82,7 @@ StudyLevel study_level_from_json(const nlohmann::json& j, std::optional<double> 
   l.converged = j.at("converged").get<bool>();
   if (const nlohmann::json e = j.value("iteration_error", nlohmann::json()); e.is_object())
     l.iteration = analysis::IterationError::from_json(e);
+  l.stopped_by = j.value("stopped_by", "");  // reports before 2026-12-07 (session 96) lack it
   l.cells_failing_check_mesh = j.value("cells_failing_check_mesh", 0L);  // reports before 2026-11-29 lack it
   l.own_time_s = j.at("own_time_s").get<double>();
   l.drag = cases::Drag::from_json(j.at("drag"));
@@ -122,6 +124,7 @@ StudyLevel study_level(const CaseStage& solved, int level, double scale, double 
   l.pressure_gradient_pa_m = solved.flow->pressure_gradient_bed_pa_m;
   l.converged = solved.flow->converged;
   l.iteration = solved.flow->pressure_gradient_iteration;
+  l.stopped_by = solved.flow->stopped_by;
   if (solved.info.polyhedra_quality) l.cells_failing_check_mesh = solved.info.polyhedra_quality->failing_cells;
   l.drag = solved.flow->drag;
   l.exact_pa_m = solved.flow->exact_pa_m;

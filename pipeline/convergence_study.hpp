@@ -26,6 +26,7 @@ struct StudyLevel {
   // What its dp/L would still have moved had the solve run on (cases::FlowResult's; unset in
   // reports before 2026-12-07).
   std::optional<analysis::IterationError> iteration;
+  std::string stopped_by;     // what ended its solve (cases::FlowResult's; empty in older reports)
   long cells_failing_check_mesh = 0;  // polyhedra that fail checkMesh's limits (meshing::check_polyhedra)
   // The drag by kind, and with case.drag_by_gap_d the particles' by the gap at their faces
   // (cases::FlowResult): where the level's error sits.

@@ -24,6 +24,7 @@ const char* const kWhySlabs = "Mesh: `slabs = 0`, one slab per million surface t
 const char* const kWhyLayers = "Mesh: prism layers off (`[mesh.layers] count = 0`); when on, 0.02 d, growth 1.2, "
                                "`gap_fraction = 0.2`";
 const char* const kWhyResiduals = "Flow solve: `residual_p = residual_u = 1e-4`, 1e-6 on a periodic section";
+const char* const kWhySettled = "Flow solve: `iteration_tolerance = 1e-3`, run on until dp/L has settled";
 const char* const kWhyCells = "Case: `cells = \"polyhedra\"` (gmsh's tetrahedra turned into their dual), least-squares "
                               "gradients";
 
@@ -280,6 +281,11 @@ const std::map<std::string, KeyMeaning>& scene_key_meanings() {
        {"the same for U; tighter on a periodic section, and its own default on cells with prism layers, where U's "
         "residual stalls near 3e-3 while dp/L has settled",
         "1", kWhyResiduals}},
+      {"case.iteration_tolerance",
+       {"past the residual targets the solve runs on until dp/L's estimated iteration error (from how its last changes "
+        "shrank) is within this fraction of it, by at most as many iterations again; SIMPLE's own stop is written at a "
+        "hundredth of the targets, where a case run by hand stops",
+        "1", kWhySettled}},
       {"case.processors", {"subdomains of decomposeParDict: `Allrun -np N` runs on N of them"}},
       {"case.decomposition", {"decomposition method"}},
       {"case.format", {"polyMesh and field format"}},

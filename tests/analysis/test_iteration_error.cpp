@@ -86,3 +86,24 @@ TEST(IterationError, RefusesTooFewValuesAndAZeroLastValue) {
   EXPECT_THROW(iteration_error({1.0, 2.0, 0.0}), std::invalid_argument);
   EXPECT_THROW(iteration_error({1.0, 2.0, std::nan("")}), std::invalid_argument);
 }
+
+// Settled to a tolerance: by the estimate where there is one, else by the last block's change.
+// Over 100 values (blocks of 9), 100 + 0.5 x 0.9^k has 1.5e-7 of its value still to come, 100 +
+// 0.5 x 0.99^k 1.8e-3 (0.5 x 0.9^99 and 0.5 x 0.99^99, over 100); 100 + 0.04 (-1)^k, with no
+// estimate (its blocks' changes swing in sign), moved 0.08 over its last block, 8.0e-4 of its value.
+TEST(IterationError, SettledWithinATolerance) {
+  std::vector<double> fast, slow, swinging;
+  for (int k = 0; k < 100; ++k) {
+    fast.push_back(100.0 + 0.5 * std::pow(0.9, k));
+    slow.push_back(100.0 + 0.5 * std::pow(0.99, k));
+    swinging.push_back(100.0 + (k % 2 == 0 ? 0.04 : -0.04));
+  }
+  EXPECT_TRUE(settled_within(iteration_error(fast), 1e-6));
+  EXPECT_FALSE(settled_within(iteration_error(fast), 1e-7));
+  EXPECT_TRUE(settled_within(iteration_error(slow), 2e-3));
+  EXPECT_FALSE(settled_within(iteration_error(slow), 1e-3));
+  const IterationError e = iteration_error(swinging);
+  ASSERT_FALSE(e.geometric);
+  EXPECT_FALSE(settled_within(e, 5e-4));
+  EXPECT_TRUE(settled_within(e, 1e-3));
+}

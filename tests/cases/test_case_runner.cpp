@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
+#include <iomanip>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -67,6 +69,29 @@ cases::CaseInfo failing_case(const std::string& name, const std::string& solver_
   c.directory = dir;
   c.params.residual_u = c.params.residual_p = 1e-4;
   return c;
+}
+
+// A stand-in Allrun in `dir` (with its system/controlDict): iteration i of `count` appends
+// iterations/i to log.simpleFoam and runs the shell lines `also`, then, like simpleFoam, ends with
+// its fields written (a directory named i) once the controlDict says stopAt writeNow; `pause`
+// seconds between iterations. Run to the end, it stops nowhere.
+void write_stand_in_allrun(const fs::path& dir, int count, const std::string& also, const std::string& pause) {
+  std::ofstream(dir / "system/controlDict") << "application     simpleFoam;\nstopAt          endTime;\nendTime         3000;\n";
+  std::ofstream(dir / "Allrun")
+      << "#!/bin/sh\ncd \"$(dirname \"$0\")\"\npp=postProcessing\nfor i in $(seq 1 " << count << "); do\n"
+      << "  cat iterations/$i >> log.simpleFoam\n" << also
+      << "  if grep -q '^stopAt *writeNow;' system/controlDict; then mkdir $i; echo End >> log.simpleFoam; exit 0; fi\n"
+      << "  sleep " << pause << "\ndone\nexit 0\n";
+  fs::permissions(dir / "Allrun", fs::perms::owner_all);
+}
+
+// The iteration a stand-in Allrun was stopped at (the directory of its fields), 0 if it ran out.
+long stopped_at(const fs::path& dir) {
+  long stopped = 0;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.is_directory() && std::isdigit(static_cast<unsigned char>(entry.path().filename().string()[0])))
+      stopped = std::stol(entry.path().filename());
+  return stopped;
 }
 
 }  // namespace
@@ -175,13 +200,7 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
     const double r = 1e-3 * std::pow(1.5, std::max(0, i - 5));
     std::ofstream(dir / "iterations" / std::to_string(i)) << iteration_text(i, r, r);
   }
-  std::ofstream(dir / "system/controlDict") << "application     simpleFoam;\nstopAt          endTime;\nendTime         3000;\n";
-  std::ofstream(dir / "Allrun")
-      << "#!/bin/sh\ncd \"$(dirname \"$0\")\"\nfor i in $(seq 1 100); do\n"
-         "  cat iterations/$i >> log.simpleFoam\n"
-         "  if grep -q '^stopAt *writeNow;' system/controlDict; then mkdir $i; echo End >> log.simpleFoam; exit 0; fi\n"
-         "  sleep 0.1\ndone\nexit 0\n";
-  fs::permissions(dir / "Allrun", fs::perms::owner_all);
+  write_stand_in_allrun(dir, 100, "", "0.1");
   cases::CaseInfo c;
   c.directory = dir;
   c.params.residual_u = c.params.residual_p = 1e-4;
@@ -201,12 +220,94 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
     EXPECT_NE(text.find("endTime         3000;"), std::string::npos) << text;  // the rest kept
     // Stopped within a few iterations of the divergence (the runner looks every half second),
     // not at the script's hundredth, and said at which, where its fields are.
-    long stopped = 0;
-    for (const auto& entry : fs::directory_iterator(dir))
-      if (entry.is_directory() && entry.path().filename() != "system" && entry.path().filename() != "iterations")
-        stopped = std::stol(entry.path().filename());
+    const long stopped = stopped_at(dir);
     EXPECT_GT(stopped, 10);
     EXPECT_LT(stopped, 40);
     EXPECT_NE(what.find("stopped at iteration " + std::to_string(stopped)), std::string::npos) << what;
   }
+}
+
+namespace {
+
+// A stand-in Allrun for a solve past its residual targets: iteration i (0.05 s each, up to 150)
+// appends its log text (U and p at 1e-3 until iteration `reached`, 1e-5 from there) and its
+// monitors' rows, the kinematic pressure on the section's lower plane 1 + 0.1 decay^i, 0 on the
+// upper one a metre above, so that dp/L (density 1) settles to 1 Pa/m geometrically; like
+// simpleFoam it ends with its fields written once the controlDict says stopAt writeNow.
+cases::CaseInfo settling_case(const std::string& name, int reached, double decay) {
+  const fs::path dir = test_support::fresh_dir(name);
+  for (const char* d : {"system", "iterations", "bottom", "postProcessing/pBedBottom/0", "postProcessing/pBedTop/0",
+                        "postProcessing/flowRate/0", "postProcessing/pInlet/0", "postProcessing/pOutlet/0",
+                        "postProcessing/forceInlet/0", "postProcessing/forceOutlet/0"})
+    fs::create_directories(dir / d);
+  for (int i = 1; i <= 150; ++i) {
+    const double r = i < reached ? 1e-3 : 1e-5;
+    std::ofstream(dir / "iterations" / std::to_string(i)) << iteration_text(i, r, r);
+    std::ofstream(dir / "bottom" / std::to_string(i)) << i << '\t' << std::setprecision(12) << 1.0 + 0.1 * std::pow(decay, i)
+                                                      << '\n';
+  }
+  std::ofstream(dir / "postProcessing/pInlet/0/surfaceFieldValue.dat") << "# Time areaAverage(p)\n1\t1\n";
+  std::ofstream(dir / "postProcessing/pOutlet/0/surfaceFieldValue.dat") << "# Time areaAverage(p)\n1\t0\n";
+  for (const char* f : {"forceInlet", "forceOutlet"})
+    std::ofstream(dir / "postProcessing" / f / "0/force.dat") << "# Time total pressure viscous\n1\t(0 0 0)\t(0 0 0)\t(0 0 0)\n";
+  write_stand_in_allrun(dir, 150,
+                        "  cat bottom/$i >> $pp/pBedBottom/0/surfaceFieldValue.dat\n"
+                        "  printf '%s\\t0\\n' $i >> $pp/pBedTop/0/surfaceFieldValue.dat\n"
+                        "  printf '%s\\t1\\n' $i >> $pp/flowRate/0/surfaceFieldValue.dat\n",
+                        "0.05");
+  cases::CaseInfo c;
+  c.directory = dir;
+  c.params.residual_u = c.params.residual_p = 1e-4;
+  c.params.density_kg_m3 = 1.0;
+  c.velocity_m_s = 1.0;
+  c.inlet_area_m2 = 1.0;  // the flow rate of 1 m3/s the monitor says
+  c.section.z_low = 0.0;
+  c.section.z_high = 1.0;
+  c.walls = false;
+  c.exact_pressure_gradient_pa_m = 1.0;
+  return c;
+}
+
+std::string text_of(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+// dp/L = 1 + 0.1 x 0.9^i after the targets are reached at iteration 30: 0.1 x 0.9^i is within the
+// tolerance of 1e-3 from iteration 44 on, where the runner must stop the solve (it looks every
+// half second, 10 iterations here), not at the targets and not at the script's end.
+TEST(CaseRunner, PastItsResidualTargetsASolveRunsOnUntilDpLHasSettledToTheTolerance) {
+  const cases::CaseInfo c = settling_case("settling", 30, 0.9);
+  Progress quiet("case", false);
+  const cases::FlowResult r = cases::run_case(c, quiet);
+  const long stopped = stopped_at(c.directory);
+  EXPECT_GE(stopped, 44);
+  EXPECT_LT(stopped, 60);  // the run-on limit, twice the 30 iterations to the targets
+  EXPECT_EQ(r.stopped_by, "settled");
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(std::abs(r.pressure_gradient_bed_pa_m - 1.0), 1e-3);
+  ASSERT_TRUE(r.pressure_gradient_iteration);
+  EXPECT_LE(std::abs(r.pressure_gradient_iteration->remaining), 1e-3);
+  // The controlDict as written again, so that Allrun run by hand solves to its end.
+  const std::string dict = text_of(c.directory / "system/controlDict");
+  EXPECT_NE(dict.find("stopAt          endTime;"), std::string::npos) << dict;
+  EXPECT_NE(dict.find("endTime         3000;"), std::string::npos) << dict;
+}
+
+// dp/L = 1 + 0.1 x 0.99^i settles too slowly (still 5 % to go at iteration 60): the solve stops
+// once it has run as many iterations past its targets (reached at 30) as it took to reach them,
+// and says so, with the iteration error it leaves.
+TEST(CaseRunner, ASolveThatDoesNotSettleStopsAfterAsManyIterationsAgainAndSaysSo) {
+  const cases::CaseInfo c = settling_case("not_settling", 30, 0.99);
+  Progress quiet("case", false);
+  const cases::FlowResult r = cases::run_case(c, quiet);
+  const long stopped = stopped_at(c.directory);
+  EXPECT_GE(stopped, 60);
+  EXPECT_LT(stopped, 100);
+  EXPECT_EQ(r.stopped_by, "run_on_limit");
+  EXPECT_TRUE(r.converged);
+  ASSERT_TRUE(r.pressure_gradient_iteration);
+  EXPECT_GT(std::abs(r.pressure_gradient_iteration->remaining), 1e-2);
 }
