@@ -33,7 +33,7 @@ IterationError iteration_error(const std::vector<double>& values) {
   if (!std::isfinite(last) || last == 0.0)
     throw std::invalid_argument(fmt::format("iteration_error: the last value is {}, a finite non-zero one needed", last));
   IterationError e;
-  const std::size_t m = std::min(std::max<std::size_t>(1, (n - 1) / 10), (n - 1) / 2);
+  const std::size_t m = std::min(std::max(kMinimumBlock, (n - 1) / 10), (n - 1) / 2);
   e.block = m;
   const double later = values[n - 1] - values[n - 1 - m], earlier = values[n - 1 - m] - values[n - 1 - 2 * m];
   e.last_change = later / std::abs(last);

@@ -28,9 +28,17 @@ struct IterationError {
 // monitors with 10 significant digits, so such a change is a few units of the last one.
 inline constexpr double kIterationResolution = 1e-9;
 
+// A block holds at least this many iterations: on beds SIMPLE's dp/L alternates a large and a
+// small step from one iteration to the next, and blocks of 4 (a tenth of a 40-iteration solve)
+// swung the estimate by up to 0.3 % of dp/L between neighbouring iterations where blocks of 10
+// moved it by at most 0.02 % (seven solves of the README's bed; docs/findings.md, 2026-12-07,
+// session 97).
+inline constexpr std::size_t kMinimumBlock = 10;
+
 // `values`: the quantity at each iteration, the last one last; a block is a tenth of the
-// iterations (at least one, at most half). std::invalid_argument with fewer than three
-// values, or with a last value that is zero or not finite.
+// iterations, at least kMinimumBlock and at most half of them (so a block of one on three
+// values). std::invalid_argument with fewer than three values, or with a last value that is
+// zero or not finite.
 IterationError iteration_error(const std::vector<double>& values);
 
 // Whether the quantity is settled to `tolerance` (a fraction of its value): its estimated

@@ -157,9 +157,9 @@ namespace {
 // "+0.24 %" for an estimate, or what was seen instead.
 std::string iteration_error_text(const analysis::IterationError& e) {
   return e.geometric ? fmt::format("{:+.2g} %", 100.0 * e.remaining)
-                     : fmt::format("not estimated (its changes did not shrink; dp/L moved {:+.2g} % over the last "
-                                   "tenth of the iterations)",
-                                   100.0 * e.last_change);
+                     : fmt::format("not estimated (its changes did not shrink; dp/L moved {:+.2g} % over its last "
+                                   "{} iterations)",
+                                   100.0 * e.last_change, e.block);
 }
 
 }  // namespace
@@ -168,7 +168,7 @@ std::vector<std::string> PressureDropAnswer::iteration_lines() const {
   if (iteration_errors.empty()) return {};
   std::vector<std::string> each;
   // A level the band rests on whose dp/L had not settled: its changes did not shrink, and it moved
-  // by more than the share of the band's half-width over its last tenth alone.
+  // by more than the share of the band's half-width over its last block of iterations alone.
   bool unsettled = false;
   for (const auto& [level, e] : iteration_errors) {
     each.push_back(fmt::format("level {} {}", level, iteration_error_text(e)));
@@ -197,7 +197,7 @@ std::vector<std::string> PressureDropAnswer::iteration_lines() const {
   if (unsettled || moves)
     out.push_back(fmt::format("  that is not small against the band: {} by more than {:g} of the band's half-width "
                               "({:.2g} %); set case.residual_u and case.residual_p below the {:g} and {:g} solved to",
-                              unsettled ? "a level it rests on did not settle, and moved over its last tenth of iterations"
+                              unsettled ? "a level it rests on did not settle, and moved over its last block of iterations"
                                         : "it moves the best estimate",
                               kIterationErrorShareOfBand, 100.0 * gci_fine, residual_u, residual_p));
   return out;

@@ -75,7 +75,8 @@ inline constexpr double kUnsteadyFlowReynolds = 150.0;
 // The levels' iteration errors are called out, with the residual targets to lower, when taking
 // them out of the three levels the band rests on moves the best estimate by more than this share
 // of the band's half-width (the GCI), or when one of those levels' dp/L did not settle (its
-// changes did not shrink) and moved by more than that share over its last tenth of iterations.
+// changes did not shrink) and moved by more than that share over its last block of iterations
+// (analysis::iteration_error's).
 // bedforge's choice, not a published rule: a tenth keeps what the iterations leave below a tenth
 // of what the meshes do.
 inline constexpr double kIterationErrorShareOfBand = 0.1;

@@ -80,7 +80,7 @@ def periodic_residuals_note(result):
 
 def level_iteration_error(level):
     """One study level's iteration error (analysis/iteration_error.hpp) in per cent, "-0.25"; a level
-    whose changes did not shrink as "(moved x)", its change over the last tenth of its iterations;
+    whose changes did not shrink as "(moved x)", its change over its last block of iterations;
     "not recorded" for a level solved before they were."""
     e = level.get("iteration_error")
     return ("not recorded" if not e else f"{100 * e['remaining']:+.2g}" if e["geometric"]

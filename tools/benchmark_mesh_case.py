@@ -2282,7 +2282,7 @@ def level_rows(v, column, error_name, error_of):
     return lines + ["", "Iteration error: what the level's dp/L would still have moved had its solve run on past its "
                     "residual targets, estimated from how its last changes shrank (stages.case.convergence.levels"
                     "[].iteration_error); in brackets, for a level whose changes did not shrink, how far it moved over "
-                    "its last tenth of iterations."]
+                    "its last block of iterations."]
 
 
 def verification_lines(v, column, png):

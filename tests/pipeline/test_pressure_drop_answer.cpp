@@ -112,7 +112,7 @@ TEST(PressureDropAnswer, LevelsWhosePolyhedraFailCheckMeshAreSaidBesideTheAnswer
 // rests on redone with those errors taken out. Lower residual targets are called for when that
 // moves the best estimate by more than a tenth of the band's half-width (kIterationErrorShareOfBand
 // of the GCI, 62.5 % here), or when one of those levels did not settle and moved by more than that
-// over its last tenth; a level without an estimate (a report from before they were made) is left out.
+// over its last block of iterations; a level without an estimate (a report from before they were made) is left out.
 TEST(PressureDropAnswer, IterationErrorsAreSaidAndLargeOnesCallForLowerResidualTargets) {
   auto estimate = [](double remaining) {
     analysis::IterationError e;
@@ -123,6 +123,7 @@ TEST(PressureDropAnswer, IterationErrorsAreSaidAndLargeOnesCallForLowerResidualT
   auto unsettled = [](double last_change) {
     analysis::IterationError e;
     e.last_change = last_change;
+    e.block = 10;
     return e;
   };
   auto lines_of = [](const nlohmann::json& entry, const ConvergenceStudy* study) {
@@ -158,16 +159,16 @@ TEST(PressureDropAnswer, IterationErrorsAreSaidAndLargeOnesCallForLowerResidualT
   EXPECT_FALSE(has(lines, "taken out"));
   EXPECT_FALSE(has(lines, advice));
   // A level whose changes did not shrink counts as solved; it calls for lower targets only when
-  // its last tenth alone moved it by more than a tenth of the band's half-width.
+  // its last block alone moved it by more than a tenth of the band's half-width.
   study.levels[2].iteration = unsettled(0.003);
   lines = lines_of(entry, &study);
-  EXPECT_TRUE(has(lines, "level 3 not estimated (its changes did not shrink; dp/L moved +0.3 % over the last tenth of "
-                         "the iterations); taken out where estimated, the best estimate would be"));
+  EXPECT_TRUE(has(lines, "level 3 not estimated (its changes did not shrink; dp/L moved +0.3 % over its last 10 "
+                         "iterations); taken out where estimated, the best estimate would be"));
   EXPECT_FALSE(has(lines, advice));
   study.levels[2].iteration = unsettled(-0.07);
   lines = lines_of(entry, &study);
   EXPECT_TRUE(has(lines, "not small against the band: a level it rests on did not settle, and moved over its last "
-                         "tenth of iterations by more than 0.1 " + advice));
+                         "block of iterations by more than 0.1 " + advice));
   // One mesh: the flow's own estimate, and no band to hold it against.
   entry["flow"]["pressure_gradient_iteration_error"] = estimate(0.5).to_json();
   lines = lines_of(entry, nullptr);
