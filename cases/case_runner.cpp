@@ -42,7 +42,7 @@ nlohmann::json FlowResult::to_json() const {
           {"stopped_by", stopped_by},
           {"final_initial_residual", {{"U", residual_u}, {"p", residual_p}}},
           {"pressure_gradient_bed_pa_m", pressure_gradient_bed_pa_m},
-          {"pressure_gradient_change_last_tenth",
+          {"pressure_gradient_change_last_block",
            pressure_gradient_iteration ? std::abs(pressure_gradient_iteration->last_change) : 0.0},
           {"pressure_gradient_iteration_error",
            pressure_gradient_iteration ? pressure_gradient_iteration->to_json() : nlohmann::json()},

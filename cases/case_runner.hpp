@@ -42,8 +42,8 @@ struct FlowResult {
   // (case_runner.cpp says why).
   double pressure_gradient_bed_pa_m = 0.0;
   // What the gradient would still have moved had the solve run on, from how its last changes
-  // shrank (unset with fewer than 3 iterations); its last change, over the last tenth of the
-  // iterations, is the report's pressure_gradient_change_last_tenth.
+  // shrank (unset with fewer than 3 iterations); its last change, over the last block of
+  // iterations (a tenth of them, at least 10), is the report's pressure_gradient_change_last_block.
   std::optional<analysis::IterationError> pressure_gradient_iteration;
   double pressure_drop_inlet_outlet_pa = 0.0;
   double flow_rate_m3_s = 0.0, flow_rate_relative_error = 0.0;

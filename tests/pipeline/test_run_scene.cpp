@@ -502,7 +502,7 @@ TEST(RunScene, TheLayeredExampleSolvesOnItsPrismsAndBalancesItsDrag) {
 // The same array as a periodic section (scenes/examples/periodic_cubic_verification.toml: three
 // cells, cyclic inlet and outlet, meanVelocityForce; order 2.05 measured at the example's
 // settings, 2026-11-28). Its solve stops only once the driving gradient has settled: over the
-// last tenth of the iterations it moves by less than a tenth of Zick & Homsy's 0.1 % (at the
+// last block of iterations it moves by less than a tenth of Zick & Homsy's 0.1 % (at the
 // general targets of 1e-4 it still moved by 2.3e-4 on this mesh, 2026-12-07).
 TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const Scene scene = example_scene("periodic_cubic_verification.toml", {{"surface.edge_length_d", 0.1},
@@ -511,10 +511,10 @@ TEST(RunScene, ThePeriodicCubicExampleConvergesToZickAndHomsy) {
   const RunOutcome r = run(scene, dir);
   const nlohmann::json& c = r.stages["case"];
   EXPECT_TRUE(c["periodic_mean_velocity_m_s"].is_number());
-  EXPECT_LT(c["flow"]["pressure_gradient_change_last_tenth"].get<double>(), 1e-4) << c["parameters"].dump();
+  EXPECT_LT(c["flow"]["pressure_gradient_change_last_block"].get<double>(), 1e-4) << c["parameters"].dump();
   // Each level's iteration error reaches the answer, and at these targets is below 1e-4 (-1e-5
   // on 38 k polyhedra of this array, docs/findings.md, session 95): estimated, or if its changes
-  // did not shrink, moved by less than that over the last tenth.
+  // did not shrink, moved by less than that over its last block.
   const nlohmann::json& iteration = c["answer"]["iteration_errors"];
   ASSERT_EQ(iteration.size(), 3u) << c["answer"].dump();
   for (const nlohmann::json& level : iteration) {
