@@ -6,10 +6,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <iomanip>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <optional>
 #include <sstream>
@@ -92,6 +92,11 @@ long stopped_at(const fs::path& dir) {
     if (entry.is_directory() && std::isdigit(static_cast<unsigned char>(entry.path().filename().string()[0])))
       stopped = std::stol(entry.path().filename());
   return stopped;
+}
+
+std::string text_of(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -214,8 +219,7 @@ TEST(CaseRunner, ADivergingSolveIsStoppedWithItsFieldsWrittenAndSaidWhere) {
               std::string::npos) << what;
     // 1e-3 x 1.5^6 = 1.1e-2 at iteration 11 is the first past 10 times the least.
     EXPECT_NE(what.find("to 1.14e-02 at iteration 11"), std::string::npos) << what;
-    std::ifstream dict(dir / "system/controlDict");
-    const std::string text((std::istreambuf_iterator<char>(dict)), std::istreambuf_iterator<char>());
+    const std::string text = text_of(dir / "system/controlDict");
     EXPECT_NE(text.find("stopAt          writeNow;"), std::string::npos) << text;
     EXPECT_NE(text.find("endTime         3000;"), std::string::npos) << text;  // the rest kept
     // Stopped within a few iterations of the divergence (the runner looks every half second),
@@ -266,11 +270,6 @@ cases::CaseInfo settling_case(const std::string& name, int reached, double decay
   c.walls = false;
   c.exact_pressure_gradient_pa_m = 1.0;
   return c;
-}
-
-std::string text_of(const fs::path& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
