@@ -118,6 +118,19 @@ ForceZ last_force_z(const fs::path& case_dir, const std::string& name) {
   return {total[2], viscous[2]};
 }
 
+// What the log `path`, being written, gained since its first `read` bytes, up to its last
+// "Time = " line (the iterations before it are finished); `read` moves past it. Empty while no
+// iteration has finished since, or while there is no log.
+std::string finished_since(const fs::path& path, std::streamoff& read) {
+  std::ifstream log(path, std::ios::binary);
+  if (!log.seekg(read)) return {};
+  const std::string added{std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>()};
+  const std::size_t next = added.rfind("\nTime = ");
+  if (next == std::string::npos) return {};
+  read += static_cast<std::streamoff>(next + 1);
+  return added.substr(0, next + 1);
+}
+
 // One SIMPLE iteration of a simpleFoam log: its `Time = N`, the initial residuals (the largest
 // of U's components, p's first solve), the ExecutionTime at its end and, in a periodic section,
 // the kinematic pressure gradient meanVelocityForce applied (its last line of the iteration).
@@ -208,38 +221,43 @@ std::vector<double> bed_gradients(const CaseInfo& c, const std::vector<Iteration
   return g;
 }
 
-// A solve watched past its residual targets: the first iteration of its log with both residuals
-// at them (0 while there is none), and why to stop it now ("settled" or "run_on_limit",
-// FlowResult::stopped_by), or nothing while dp/L is still settling. Reads the whole log (every
-// iteration, since the residuals may dip below their targets between two looks) and the
-// monitors, as they are being written; `step` is the last finished iteration.
-struct Settling {
-  long reached = 0;
-  std::optional<std::string> stop;
-};
-Settling settle_check(const CaseInfo& c, long step) {
-  std::ifstream log(c.directory / "log.simpleFoam");
-  const std::vector<Iteration> its = read_iterations(log);
-  Settling s;
-  for (const Iteration& it : its)
-    if (it.p_seen && it.res_u > 0.0 && it.res_u <= *c.params.residual_u && it.res_p <= *c.params.residual_p) {
-      s.reached = it.step;
-      break;
+// A solve watched past its residual targets, as its log and monitors are being written.
+class SettleWatch {
+ public:
+  explicit SettleWatch(const CaseInfo& c) : c_(c) {}
+  // Why to stop the solve now ("settled" or "run_on_limit", FlowResult::stopped_by), or nothing
+  // before its targets or while dp/L is still settling. Reads the iterations the log finished
+  // since the last call (every one, since the residuals may dip below their targets between two
+  // looks); `step` is the last finished iteration.
+  std::optional<std::string> follow(long step) {
+    std::istringstream finished(finished_since(c_.directory / "log.simpleFoam", read_));
+    for (const Iteration& it : read_iterations(finished)) {
+      if (reached_ == 0 && it.p_seen && it.res_u > 0.0 && it.res_u <= *c_.params.residual_u &&
+          it.res_p <= *c_.params.residual_p)
+        reached_ = it.step;
+      its_.push_back(it);
     }
-  if (s.reached == 0) return s;
-  std::vector<double> g;
-  try {
-    g = bed_gradients(c, its, true);
-  } catch (const std::runtime_error&) {
-    return s;  // a monitor not written yet
+    if (reached_ == 0) return std::nullopt;
+    std::vector<double> g;
+    try {
+      g = bed_gradients(c_, its_, true);
+    } catch (const std::runtime_error&) {
+      return std::nullopt;  // a monitor not written yet
+    }
+    if (g.size() >= 3 && std::isfinite(g.back()) && g.back() != 0.0 &&
+        analysis::settled_within(analysis::iteration_error(g), c_.params.iteration_tolerance))
+      return "settled";
+    if (step >= 2 * reached_) return "run_on_limit";
+    return std::nullopt;
   }
-  if (g.size() >= 3 && std::isfinite(g.back()) && g.back() != 0.0 &&
-      analysis::settled_within(analysis::iteration_error(g), c.params.iteration_tolerance))
-    s.stop = "settled";
-  else if (step >= 2 * s.reached)
-    s.stop = "run_on_limit";
-  return s;
-}
+  long reached() const { return reached_; }  // the first iteration with both residuals at their targets (0: none yet)
+
+ private:
+  const CaseInfo& c_;
+  std::streamoff read_ = 0;  // of the log: the bytes read
+  std::vector<Iteration> its_;
+  long reached_ = 0;
+};
 
 // Allrun's steps as GNU time logged them in log.time ("name seconds kB" per step; a failed
 // step's extra line, and a machine without GNU time, give none).
@@ -351,13 +369,8 @@ std::optional<Divergence> DivergenceWatch::feed(std::istream& log) {
 }
 
 std::optional<Divergence> DivergenceWatch::follow(const fs::path& path) {
-  std::ifstream log(path, std::ios::binary);
-  if (found_ || !log.seekg(read_)) return found_;
-  const std::string added{std::istreambuf_iterator<char>(log), std::istreambuf_iterator<char>()};
-  const std::size_t next = added.rfind("\nTime = ");
-  if (next == std::string::npos) return found_;
-  std::istringstream finished(added.substr(0, next + 1));
-  read_ += static_cast<std::streamoff>(next + 1);
+  if (found_) return found_;
+  std::istringstream finished(finished_since(path, read_));
   return feed(finished);
 }
 
@@ -394,8 +407,8 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
   double start_p = 0.0, start_u = 0.0;
   DivergenceWatch watch(target_u, target_p);
   std::optional<Divergence> diverging;
-  long reached = 0;                     // the first iteration with both residuals at their targets
-  std::optional<std::string> stopped;   // why bedforge stopped the solve past them
+  SettleWatch settle(c);
+  std::optional<std::string> stopped;   // why bedforge stopped the solve past its residual targets
   while (run.wait_for(std::chrono::milliseconds(500)) != std::future_status::ready) {
     const Iteration now = last_iteration(case_dir / "log.simpleFoam");
     if (now.step == 0 || now.res_p <= 0.0 || now.res_u <= 0.0) {
@@ -403,15 +416,11 @@ FlowResult run_case(const CaseInfo& c, Progress& progress) {
       continue;
     }
     if (!diverging && (diverging = watch.follow(case_dir / "log.simpleFoam"))) set_stop_at(case_dir, "writeNow");
-    if (!diverging && !stopped) {
-      const Settling settling = settle_check(c, now.step);
-      reached = settling.reached;
-      if ((stopped = settling.stop)) set_stop_at(case_dir, "writeNow");
-    }
+    if (!diverging && !stopped && (stopped = settle.follow(now.step))) set_stop_at(case_dir, "writeNow");
     if (start_p == 0.0) start_p = std::max(now.res_p, 10.0 * target_p), start_u = std::max(now.res_u, 10.0 * target_u);
     const double done = std::min(std::log(start_p / now.res_p) / std::log(start_p / target_p),
                                  std::log(start_u / now.res_u) / std::log(start_u / target_u));
-    progress.update(reached ? fmt::format("simpleFoam iteration {}, residuals at their targets; dp/L settling to {:g} %",
+    progress.update(settle.reached() ? fmt::format("simpleFoam iteration {}, residuals at their targets; dp/L settling to {:g} %",
                                           now.step, 100.0 * c.params.iteration_tolerance)
                             : fmt::format("simpleFoam iteration {}, residuals U {:.1e} p {:.1e} (targets {:.0e}, {:.0e})",
                                           now.step, now.res_u, now.res_p, target_u, target_p),
