@@ -99,7 +99,7 @@ struct CaseInfo {
   // other beds, which are compared with Eisfeld & Schnitzlein instead.
   std::optional<double> exact_pressure_gradient_pa_m;
   // Such a column or array whose contacts were treated: its untreated answer, as a bound.
-  std::optional<KnownBound> bound;
+  std::optional<KnownBound> bound{};
   bool particles = false;                // the bed has spheres (a particles patch)
   bool walls = true;                     // the container has walls (a box periodic on every side has none)
   // A random array of equal spheres in a box periodic on every side at Re_p <= 0.01: van der Hoef
