@@ -59,8 +59,8 @@ struct CaseParams {
   bool binary = true;                   // polyMesh and fields in binary, else ASCII
   // cells = "polyhedra": the case holds the dual polyhedra of gmsh's tetrahedra (as OpenFOAM's
   // polyDualMesh makes them, meshing/volume/dual_mesh.hpp), on which an empty tube's pressure drop
-  // comes within 0.25 % of the exact one; "tetrahedra" solves on gmsh's cells, where it reads up
-  // to 0.6 % high (docs/defaults.md).
+  // comes within 0.25 % of the exact one from some 20 k cells on, not converging to it;
+  // "tetrahedra" solves on gmsh's cells, where it reads up to 0.6 % high (docs/defaults.md).
   bool polyhedra = true;
   // mesher = "snappy": snappyHexMesh makes the cells in Allrun from the fluid surface, on as
   // many processes as the run has, and no gmsh mesh is made: the route past one machine's memory.
